@@ -1,0 +1,82 @@
+//! Static-frame ray intersection behind one trait, with backends chosen by name.
+//!
+//! The renderer boosts every ray into a group's rest frame before it gets here, so a backend
+//! only ever sees static geometry and static rays `o + t d`. `d` is unnormalised: its length is
+//! the boost's lookback factor, so `t` is already the world-frame lookback time and hits of all
+//! groups compare directly (DESIGN.md, "the one trick").
+
+mod bvh;
+
+pub use bvh::{Bvh, BvhBackend};
+
+use crate::geometry::{Aabb, Geometry};
+use glam::DVec3;
+use std::sync::Arc;
+
+/// A static ray `origin + t dir`, searched for `tmin < t < tmax`. A ray with `tmin > tmax` is
+/// inactive (masked) and must be skipped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    pub origin: DVec3,
+    pub dir: DVec3,
+    pub tmin: f64,
+    pub tmax: f64,
+}
+
+impl Ray {
+    pub fn is_active(&self) -> bool {
+        self.tmin <= self.tmax
+    }
+}
+
+/// The closest hit of a ray: its parameter and the primitive's index in the group geometry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f64,
+    pub prim: u32,
+}
+
+/// Intersection of batches of rays with one group's static geometry.
+pub trait Accelerator: Send + Sync {
+    /// For each active ray, the closest hit with `tmin < t < tmax`, else None.
+    fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]);
+    /// For each active ray, whether anything lies at `tmin < t < tmax` (inactive: false).
+    fn occluded(&self, rays: &[Ray], out: &mut [bool]);
+    /// The geometry this accelerator was built over.
+    fn geometry(&self) -> &Arc<Geometry>;
+}
+
+/// Builds accelerators; one per kind of backend.
+pub trait Backend: Send + Sync {
+    fn name(&self) -> &'static str;
+    fn build(&self, geometry: Arc<Geometry>) -> Result<Box<dyn Accelerator>, String>;
+}
+
+/// The names `--backend` accepts in this build, default first.
+pub fn backend_names() -> Vec<&'static str> {
+    vec!["bvh"]
+}
+
+pub fn default_backend_name() -> &'static str {
+    backend_names()[0]
+}
+
+/// The backend of that name, or an error that lists the choices.
+pub fn backend_by_name(name: &str) -> Result<Box<dyn Backend>, String> {
+    match name {
+        "bvh" => Ok(Box::new(BvhBackend)),
+        "embree" => Err(
+            "backend 'embree' is not in this build: rebuild with `--features embree` (needs libembree-dev and libclang-dev)"
+                .to_string(),
+        ),
+        other => Err(format!(
+            "unknown backend '{other}' (choose one of: {})",
+            backend_names().join(", ")
+        )),
+    }
+}
+
+/// Bounds of a geometry, for culling.
+pub fn bounds_of(g: &Geometry) -> Aabb {
+    g.bounds()
+}

@@ -1,0 +1,80 @@
+use glam::DVec3;
+
+/// An axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: DVec3,
+    pub max: DVec3,
+}
+
+impl Default for Aabb {
+    fn default() -> Self {
+        Self::EMPTY
+    }
+}
+
+impl Aabb {
+    pub const EMPTY: Aabb = Aabb {
+        min: DVec3::splat(f64::INFINITY),
+        max: DVec3::splat(f64::NEG_INFINITY),
+    };
+
+    pub fn new(min: DVec3, max: DVec3) -> Self {
+        Self { min, max }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
+    }
+
+    pub fn union(&self, o: &Aabb) -> Aabb {
+        Aabb::new(self.min.min(o.min), self.max.max(o.max))
+    }
+
+    pub fn grow(&mut self, p: DVec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    pub fn centroid(&self) -> DVec3 {
+        0.5 * (self.min + self.max)
+    }
+
+    pub fn extent(&self) -> DVec3 {
+        (self.max - self.min).max(DVec3::ZERO)
+    }
+
+    pub fn diagonal(&self) -> f64 {
+        if self.is_empty() {
+            0.0
+        } else {
+            self.extent().length()
+        }
+    }
+
+    pub fn surface_area(&self) -> f64 {
+        if self.is_empty() {
+            return 0.0;
+        }
+        let e = self.extent();
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
+
+    /// The largest absolute coordinate of the box.
+    pub fn max_abs(&self) -> f64 {
+        self.min.abs().max(self.max.abs()).max_element()
+    }
+
+    /// Slab test: the parameter interval `[t0, t1]` of `o + t d` inside the box, clipped to
+    /// `[tmin, tmax]`, or None.
+    pub fn clip(&self, o: DVec3, inv_d: DVec3, tmin: f64, tmax: f64) -> Option<(f64, f64)> {
+        let a = (self.min - o) * inv_d;
+        let b = (self.max - o) * inv_d;
+        let lo = a.min(b);
+        let hi = a.max(b);
+        // NaN (0 * inf on a slab boundary) is dropped by f64::max / f64::min.
+        let t0 = tmin.max(lo.x).max(lo.y).max(lo.z);
+        let t1 = tmax.min(hi.x).min(hi.y).min(hi.z);
+        (t0 <= t1).then_some((t0, t1))
+    }
+}

@@ -1,0 +1,10 @@
+//! Rest-frame geometry in f64: bounding boxes, primitives and their exact ray intersections.
+//!
+//! Rays here are static rays `o + t d` with an unnormalised `d`: the renderer passes the boosted
+//! null direction whose length is the Doppler-like factor, so `t` is the world-frame lookback time.
+
+mod aabb;
+mod primitive;
+
+pub use aabb::Aabb;
+pub use primitive::{Geometry, Part, Primitive};

@@ -1,0 +1,73 @@
+//! Writing a rendered frame: EXR (linear float, with the extra passes) or PNG (tone-mapped
+//! sRGB), chosen by the file extension. Files are written whole or not at all.
+
+mod exr_out;
+mod png_out;
+
+use crate::render::Frame;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Exr,
+    Png,
+}
+
+impl Format {
+    /// The format for an output path, from its extension.
+    pub fn for_path(path: &Path) -> Result<Format, String> {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("exr") => Ok(Format::Exr),
+            Some("png") => Ok(Format::Png),
+            _ => Err(format!(
+                "cannot tell the image format of `{}`: the name must end in .exr or .png",
+                path.display()
+            )),
+        }
+    }
+}
+
+/// Write the frame; the file appears only when it is complete (written beside it, then renamed).
+pub fn write(frame: &Frame, path: &Path) -> Result<(), String> {
+    let format = Format::for_path(path)?;
+    let tmp = temp_path(path);
+    let result = match format {
+        Format::Exr => exr_out::write(frame, &tmp),
+        Format::Png => png_out::write(frame, &tmp),
+    }
+    .and_then(|_| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(format!("cannot write `{}`: {e}", path.display()));
+    }
+    Ok(())
+}
+
+fn temp_path(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{name}.partial-{}", std::process::id()))
+}
+
+/// Linear to sRGB-encoded, after clamping to [0, 1].
+pub fn srgb_encode(linear: f32) -> f32 {
+    let c = if linear.is_finite() {
+        linear.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+pub use exr_out::read_channels as read_exr_channels;

@@ -1,0 +1,20 @@
+use super::srgb_encode;
+use crate::render::Frame;
+use std::io::BufWriter;
+use std::path::Path;
+
+pub fn write(frame: &Frame, path: &Path) -> Result<(), String> {
+    let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
+    let mut enc = png::Encoder::new(BufWriter::new(file), frame.width, frame.height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    let data: Vec<u8> = frame
+        .pixels
+        .iter()
+        .flat_map(|p| p.color.map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8))
+        .collect();
+    let mut w = enc.write_header().map_err(|e| e.to_string())?;
+    w.write_image_data(&data).map_err(|e| e.to_string())?;
+    w.finish().map_err(|e| e.to_string())
+}

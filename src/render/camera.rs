@@ -1,0 +1,76 @@
+use crate::scene::{Camera, Projection};
+use crate::spacetime::{Boost, Event, NullRay};
+use glam::DVec3;
+use std::f64::consts::PI;
+
+/// Primary rays: a pixel's direction is defined in the camera's rest frame and boosted into the
+/// world frame, so a moving camera sees the aberrated sky (DESIGN.md, "Frames and conventions").
+pub struct CameraRays {
+    camera: Camera,
+    event: Event,
+    to_world: Boost,
+    to_camera: Boost,
+    width: f64,
+    height: f64,
+    focal: f64,
+}
+
+impl CameraRays {
+    pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
+        let focal = match camera.projection {
+            Projection::Pinhole { fov_y } => 0.5 * height as f64 / (0.5 * fov_y).tan(),
+            _ => 0.0,
+        };
+        Self {
+            camera: camera.clone(),
+            event: camera.imaging_event(),
+            to_world: Boost::from_rest(&camera.velocity),
+            to_camera: Boost::to_rest(&camera.velocity),
+            width: width as f64,
+            height: height as f64,
+            focal,
+        }
+    }
+
+    /// Focal length in pixels of a pinhole camera: (height / 2) / tan(fov_y / 2).
+    pub fn focal_px(&self) -> f64 {
+        self.focal
+    }
+
+    /// The world-frame past null ray through image point (px, py), in pixels from the top-left
+    /// corner (pixel (i, j) has its centre at (i + 0.5, j + 0.5)).
+    pub fn ray(&self, px: f64, py: f64) -> NullRay {
+        let c = &self.camera;
+        let (u, v) = (px - 0.5 * self.width, 0.5 * self.height - py);
+        let (origin, dir_cam) = match c.projection {
+            Projection::Pinhole { .. } => (
+                self.event,
+                (self.focal * c.forward + u * c.right + v * c.up).normalize(),
+            ),
+            Projection::Orthographic { view_height } => {
+                let s = view_height / self.height;
+                let offset = (u * c.right + v * c.up) * s;
+                // The image plane is simultaneous in the camera's rest frame.
+                (
+                    self.event + self.to_world.event(Event::new(0.0, offset)),
+                    c.forward,
+                )
+            }
+            Projection::Equirectangular => {
+                let lon = (px / self.width - 0.5) * 2.0 * PI;
+                let lat = (0.5 - py / self.height) * PI;
+                let d =
+                    lat.cos() * (lon.cos() * c.forward + lon.sin() * c.right) + lat.sin() * c.up;
+                (self.event, d)
+            }
+        };
+        let (dir, _) = self.to_world.view_dir(dir_cam);
+        NullRay::new(origin, dir)
+    }
+
+    /// γ_c(1 + β_c·a): the camera's lookback factor for a world-frame looking direction `a`;
+    /// the Doppler factor of a surface with factor s is this over s.
+    pub fn lookback_factor(&self, dir_world: DVec3) -> f64 {
+        self.to_camera.null_dir(dir_world).1
+    }
+}

@@ -1,0 +1,72 @@
+/// One pixel's values.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelValue {
+    pub color: [f32; 3],
+    pub alpha: f32,
+    /// World-frame lookback time of the primary hit (0 where nothing was hit).
+    pub lookback: f32,
+    /// Frequency ratio camera / surface of the primary hit (0 where nothing was hit).
+    pub doppler: f32,
+    /// Index + 1 of the scene object hit by the primary ray; 0 for background.
+    pub object_id: u32,
+    /// Rest-frame outward normal of the primary hit's surface (0 for background).
+    pub normal: [f32; 3],
+}
+
+/// The rendered image and its extra passes, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<PixelValue>,
+}
+
+impl Frame {
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            pixels: vec![PixelValue::default(); (width * height) as usize],
+        }
+    }
+
+    pub fn set(&mut self, x: u32, y: u32, v: &PixelValue) {
+        self.pixels[(y * self.width + x) as usize] = *v;
+    }
+
+    pub fn get(&self, x: u32, y: u32) -> &PixelValue {
+        &self.pixels[(y * self.width + x) as usize]
+    }
+
+    /// A channel by its EXR name.
+    pub fn channel(&self, name: &str) -> Option<Vec<f32>> {
+        let f: fn(&PixelValue) -> f32 = match name {
+            "R" => |p| p.color[0],
+            "G" => |p| p.color[1],
+            "B" => |p| p.color[2],
+            "A" => |p| p.alpha,
+            "lookback" => |p| p.lookback,
+            "doppler" => |p| p.doppler,
+            "object_id" => |p| p.object_id as f32,
+            "N.X" => |p| p.normal[0],
+            "N.Y" => |p| p.normal[1],
+            "N.Z" => |p| p.normal[2],
+            _ => return None,
+        };
+        Some(self.pixels.iter().map(f).collect())
+    }
+}
+
+/// Channel names written to EXR, in this order.
+pub const CHANNELS: [&str; 10] = [
+    "R",
+    "G",
+    "B",
+    "A",
+    "lookback",
+    "doppler",
+    "object_id",
+    "N.X",
+    "N.Y",
+    "N.Z",
+];

@@ -1,0 +1,66 @@
+//! Rendering: camera rays on the past light cone of the imaging event, a boost of every ray into
+//! each velocity group's rest frame, the merge of hits by world-frame lookback time, and Whitted
+//! shading in the rest frame of the surface hit.
+
+mod camera;
+mod frame;
+mod sampler;
+mod shade;
+mod world;
+
+pub use camera::CameraRays;
+pub use frame::{Frame, PixelValue, CHANNELS};
+pub use world::{SurfaceHit, World};
+
+use crate::accel::Backend;
+use crate::scene::Scene;
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+pub const TILE: u32 = 16;
+
+/// What a render did, for the command's report and the benchmarks.
+#[derive(Clone, Debug, Default)]
+pub struct RenderStats {
+    pub build_time: Duration,
+    pub trace_time: Duration,
+    pub primary_rays: u64,
+    /// Pixels whose colour came out NaN or infinite and were replaced by black (a bug if > 0).
+    pub nonfinite_pixels: u64,
+}
+
+/// Build the acceleration structures with `backend` and render the scene.
+pub fn render(scene: &Scene, backend: &dyn Backend) -> Result<(Frame, RenderStats), String> {
+    let t0 = Instant::now();
+    let world = World::build(scene, backend)?;
+    let build_time = t0.elapsed();
+    let t1 = Instant::now();
+    let (frame, mut stats) = render_world(scene, &world);
+    stats.build_time = build_time;
+    stats.trace_time = t1.elapsed();
+    Ok((frame, stats))
+}
+
+/// Render with acceleration structures already built.
+pub fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
+    let (w, h) = (scene.image.width, scene.image.height);
+    let cam = CameraRays::new(&scene.camera, w, h);
+    let tiles_x = w.div_ceil(TILE);
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty)))
+        .collect();
+    let results: Vec<_> = tiles
+        .par_iter()
+        .map(|&(tx, ty)| shade::render_tile(scene, world, &cam, tx * TILE, ty * TILE))
+        .collect();
+    let mut frame = Frame::new(w, h);
+    let mut stats = RenderStats::default();
+    for tile in results {
+        stats.primary_rays += tile.primary_rays;
+        stats.nonfinite_pixels += tile.nonfinite;
+        for p in tile.pixels {
+            frame.set(p.x, p.y, &p.value);
+        }
+    }
+    (frame, stats)
+}

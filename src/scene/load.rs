@@ -1,0 +1,605 @@
+//! From the scene tree to a validated [`Scene`].
+
+use super::doc::Doc;
+use super::model::*;
+use super::procedural::{BarArray, Lattice};
+use super::reader::{Table, R};
+use super::SceneError;
+use crate::geometry::{Geometry, Primitive};
+use crate::spacetime::Velocity;
+use glam::DVec3;
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// The most primitives one scene may hold (a guard against typos like `counts = [1000000, ...]`).
+pub const MAX_PRIMITIVES: u64 = 200_000_000;
+
+/// Read a scene file, apply overrides `(shown, KEY=VALUE)` in order (`shown` names the flag in
+/// errors, e.g. `--set camera.time=3`), and validate the result.
+pub fn load_file(
+    path: &std::path::Path,
+    overrides: &[(String, String)],
+) -> Result<Scene, SceneError> {
+    let shown = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        SceneError::new(
+            shown.clone(),
+            "",
+            format!("cannot read the scene file: {e}"),
+        )
+    })?;
+    load_str(&shown, &text, overrides)
+}
+
+/// As [`load_file`], from text; `file` names it in errors.
+pub fn load_str(
+    file: &str,
+    text: &str,
+    overrides: &[(String, String)],
+) -> Result<Scene, SceneError> {
+    let mut doc = Doc::parse(file, text)?;
+    for (shown, set) in overrides {
+        doc.apply_set(shown, set)?;
+    }
+    build(&doc)
+}
+
+fn build(doc: &Doc) -> R<Scene> {
+    let root = Table::root(doc)?;
+    let camera = match root.table("camera")? {
+        Some(t) => camera(&t)?,
+        None => return Err(root.error("camera", "missing: the scene needs a [camera] table")),
+    };
+    let image = match root.table("image")? {
+        Some(t) => image(&t)?,
+        None => ImageSettings {
+            width: 512,
+            height: 512,
+            samples: 1,
+            background: DVec3::ZERO,
+        },
+    };
+    let render = match root.table("render")? {
+        Some(t) => render_settings(&t)?,
+        None => RenderSettings {
+            max_depth: 5,
+            ambient: DVec3::splat(0.1),
+        },
+    };
+    let mut materials = vec![Material::default_white()];
+    let mut material_ids: HashMap<String, u32> = HashMap::new();
+    for t in root.tables("material")? {
+        let m = material(&t)?;
+        if material_ids.contains_key(&m.name) {
+            return Err(t.error(
+                "name",
+                format!("a material named `{}` is defined twice", m.name),
+            ));
+        }
+        material_ids.insert(m.name.clone(), materials.len() as u32);
+        materials.push(m);
+    }
+    let group_tables = root.tables("group")?;
+    let mut groups = Vec::new();
+    let mut objects = Vec::new();
+    let mut total: u64 = 0;
+    for t in &group_tables {
+        let name = t.req_string("name")?.to_string();
+        if groups.iter().any(|g: &Group| g.name == name) {
+            return Err(t.error("name", format!("a group named `{name}` is defined twice")));
+        }
+        let velocity = velocity(t, "direction")?.unwrap_or(Velocity::ZERO);
+        let mut geometry = Geometry::default();
+        for o in t.tables("object")? {
+            let id = objects.len() as u32;
+            let kind = add_object(&o, id, &material_ids, &mut geometry, &mut total)?;
+            objects.push(ObjectInfo {
+                name: o.string("name")?.map(str::to_string),
+                kind,
+                group: groups.len(),
+            });
+            o.finish(OBJECT_KEYS)?;
+        }
+        t.finish(&[
+            "name",
+            "velocity",
+            "direction",
+            "beta",
+            "rapidity",
+            "one_minus_beta",
+            "object",
+        ])?;
+        groups.push(Group {
+            name,
+            velocity,
+            geometry: Arc::new(geometry),
+        });
+    }
+    if groups.iter().all(|g| g.geometry.is_empty()) {
+        return Err(root.error(
+            "group",
+            "the scene is empty: add a [[group]] with at least one [[group.object]] (box, sphere, rod, mesh, lattice or bar_array)",
+        ));
+    }
+    let mut lights = Vec::new();
+    for t in root.tables("light")? {
+        lights.push(light(&t, &groups)?);
+    }
+    root.finish(&["camera", "image", "render", "material", "light", "group"])?;
+    Ok(Scene {
+        camera,
+        image,
+        render,
+        materials,
+        lights,
+        groups,
+        objects,
+    })
+}
+
+/// A velocity: `velocity = [bx, by, bz]`, or `<dir_key> = [...]` with one of `beta`,
+/// `rapidity`, `one_minus_beta`. None when none of these keys is present.
+fn velocity(t: &Table, dir_key: &str) -> R<Option<Velocity>> {
+    let forms: Vec<&str> = ["beta", "rapidity", "one_minus_beta"]
+        .into_iter()
+        .filter(|k| t.has(k))
+        .collect();
+    if t.has("velocity") {
+        if let Some(k) = forms.first().copied().or(t.has(dir_key).then_some(dir_key)) {
+            return Err(t.error(
+                k,
+                format!("give either `velocity = [...]` or `{dir_key}` with one speed, not both"),
+            ));
+        }
+        let n = t.get("velocity").expect("checked");
+        let v = t.vec3("velocity")?.expect("checked");
+        return Velocity::from_beta_vec(v)
+            .map(Some)
+            .map_err(|e| t.error_at(n, "velocity", e.to_string()));
+    }
+    if forms.is_empty() {
+        if t.has(dir_key) && dir_key != "direction" {
+            return Err(t.error(
+                dir_key,
+                "give the speed too: one of beta, rapidity, one_minus_beta",
+            ));
+        }
+        return Ok(None);
+    }
+    if forms.len() > 1 {
+        return Err(t.error(
+            forms[1],
+            format!(
+                "give only one of beta, rapidity, one_minus_beta (found {})",
+                forms.join(", ")
+            ),
+        ));
+    }
+    let form = forms[0];
+    let dir = t.vec3(dir_key)?.ok_or_else(|| {
+        t.error(
+            dir_key,
+            format!("`{form}` needs a direction: {dir_key} = [x, y, z]"),
+        )
+    })?;
+    let n = t.get(form).expect("checked");
+    let s = t.f64(form)?.expect("checked");
+    let v = match form {
+        "beta" => Velocity::from_beta(dir, s),
+        "rapidity" => Velocity::from_rapidity(dir, s),
+        _ => Velocity::from_one_minus_beta(dir, s),
+    };
+    v.map(Some).map_err(|e| t.error_at(n, form, e.to_string()))
+}
+
+fn camera(t: &Table) -> R<Camera> {
+    let position = t.req_vec3("position")?;
+    let forward = match (t.vec3("look_at")?, t.vec3("direction")?) {
+        (Some(_), Some(_)) => {
+            return Err(t.error("direction", "give either look_at or direction, not both"))
+        }
+        (Some(p), None) => p - position,
+        (None, Some(d)) => d,
+        (None, None) => {
+            return Err(t.error(
+                "look_at",
+                "missing: give look_at = [x, y, z] or direction = [x, y, z]",
+            ))
+        }
+    };
+    if forward.length() == 0.0 {
+        let k = if t.has("look_at") {
+            "look_at"
+        } else {
+            "direction"
+        };
+        return Err(t.error(
+            k,
+            "the view direction has zero length (look_at equals position?)",
+        ));
+    }
+    let forward = forward.normalize();
+    let up_in = t.vec3("up")?.unwrap_or(DVec3::Z);
+    let right = forward.cross(up_in);
+    if right.length() < 1e-9 * up_in.length().max(1e-300) || up_in.length() == 0.0 {
+        return Err(t.error(
+            "up",
+            "`up` must not be zero or parallel to the view direction",
+        ));
+    }
+    let right = right.normalize();
+    let up = right.cross(forward);
+    let projection = match t.string("projection")?.unwrap_or("pinhole") {
+        "pinhole" | "perspective" => Projection::Pinhole {
+            fov_y: t
+                .f64_where(
+                    "fov_y",
+                    Some(40.0),
+                    |v| v > 0.0 && v < 180.0,
+                    "between 0 and 180 degrees",
+                )?
+                .to_radians(),
+        },
+        "orthographic" => Projection::Orthographic {
+            view_height: t.f64_where("view_height", None, |v| v > 0.0, "greater than 0")?,
+        },
+        "equirectangular" => Projection::Equirectangular,
+        other => {
+            let n = t.get("projection").expect("read above");
+            return Err(t.error_at(
+                n,
+                "projection",
+                format!("unknown projection `{other}` (pinhole, orthographic, equirectangular)"),
+            ));
+        }
+    };
+    let time = t.f64_or("time", 0.0)?;
+    let velocity = velocity(t, "velocity_direction")?.unwrap_or(Velocity::ZERO);
+    t.finish(&[
+        "position",
+        "look_at",
+        "direction",
+        "up",
+        "fov_y",
+        "time",
+        "velocity",
+        "velocity_direction",
+        "beta",
+        "rapidity",
+        "one_minus_beta",
+        "projection",
+        "view_height",
+    ])?;
+    Ok(Camera {
+        position,
+        time,
+        forward,
+        right,
+        up,
+        projection,
+        velocity,
+    })
+}
+
+fn image(t: &Table) -> R<ImageSettings> {
+    let s = ImageSettings {
+        width: t.uint("width", Some(512), 1, 32768)? as u32,
+        height: t.uint("height", Some(512), 1, 32768)? as u32,
+        samples: t.uint("samples", Some(1), 1, 4096)? as u32,
+        background: t.color("background")?.unwrap_or(DVec3::ZERO),
+    };
+    t.finish(&["width", "height", "samples", "background"])?;
+    Ok(s)
+}
+
+fn render_settings(t: &Table) -> R<RenderSettings> {
+    let s = RenderSettings {
+        max_depth: t.uint("max_depth", Some(5), 0, 64)? as u32,
+        ambient: t.color("ambient")?.unwrap_or(DVec3::splat(0.1)),
+    };
+    t.finish(&["max_depth", "ambient"])?;
+    Ok(s)
+}
+
+fn material(t: &Table) -> R<Material> {
+    let d = Material::default_white();
+    let unit = |v: f64| (0.0..=1.0).contains(&v);
+    let m = Material {
+        name: t.req_string("name")?.to_string(),
+        color: t.color("color")?.unwrap_or(d.color),
+        specular: t.color("specular")?.unwrap_or(d.specular),
+        shininess: t.f64_where("shininess", Some(d.shininess), |v| v >= 0.0, "0 or more")?,
+        reflect: t.f64_where("reflect", Some(0.0), unit, "between 0 and 1")?,
+        transmit: t.f64_where("transmit", Some(0.0), unit, "between 0 and 1")?,
+        ior: t.f64_where("ior", Some(d.ior), |v| v >= 1.0, "1 or more")?,
+        emission: t.color("emission")?,
+    };
+    t.finish(&[
+        "name",
+        "color",
+        "specular",
+        "shininess",
+        "reflect",
+        "transmit",
+        "ior",
+        "emission",
+    ])?;
+    Ok(m)
+}
+
+fn light(t: &Table, groups: &[Group]) -> R<Light> {
+    let position = t.req_vec3("position")?;
+    let intensity = t.f64_where("intensity", Some(1.0), |v| v >= 0.0, "0 or more")?;
+    let color = t.color("color")?.unwrap_or(DVec3::ONE);
+    let own = velocity(t, "velocity_direction")?;
+    let velocity = match (t.string("group")?, own) {
+        (Some(_), Some(_)) => {
+            return Err(t.error("group", "give either `group` or a velocity, not both"))
+        }
+        (Some(g), None) => match groups.iter().find(|x| x.name == g) {
+            Some(x) => x.velocity,
+            None => {
+                let names: Vec<&str> = groups.iter().map(|x| x.name.as_str()).collect();
+                let n = t.get("group").expect("read above");
+                return Err(t.error_at(
+                    n,
+                    "group",
+                    format!("no group named `{g}` (groups: {})", names.join(", ")),
+                ));
+            }
+        },
+        (None, v) => v.unwrap_or(Velocity::ZERO),
+    };
+    let inverse_square = match t.string("falloff")?.unwrap_or("none") {
+        "none" => false,
+        "inverse_square" => true,
+        other => {
+            let n = t.get("falloff").expect("read above");
+            return Err(t.error_at(
+                n,
+                "falloff",
+                format!("unknown falloff `{other}` (none, inverse_square)"),
+            ));
+        }
+    };
+    t.string("name")?;
+    t.finish(&[
+        "position",
+        "intensity",
+        "color",
+        "group",
+        "falloff",
+        "velocity",
+        "velocity_direction",
+        "beta",
+        "rapidity",
+        "one_minus_beta",
+        "name",
+    ])?;
+    Ok(Light {
+        position,
+        radiance: color * intensity,
+        velocity,
+        inverse_square,
+    })
+}
+
+const OBJECT_KEYS: &[&str] = &[
+    "type",
+    "name",
+    "material",
+    "min",
+    "max",
+    "center",
+    "radius",
+    "from",
+    "to",
+    "vertices",
+    "indices",
+    "counts",
+    "spacing",
+    "origin",
+    "rod_radius",
+    "sphere_radius",
+    "rod_material",
+    "sphere_material",
+    "bar_size",
+    "length",
+    "axis",
+];
+
+fn material_ref(t: &Table, key: &str, ids: &HashMap<String, u32>, default: u32) -> R<u32> {
+    match t.string(key)? {
+        None => Ok(default),
+        Some(name) => ids.get(name).copied().ok_or_else(|| {
+            let mut known: Vec<&str> = ids.keys().map(String::as_str).collect();
+            known.sort();
+            let n = t.get(key).expect("read above");
+            t.error_at(
+                n,
+                key,
+                format!(
+                    "no material named `{name}` (materials: {})",
+                    if known.is_empty() {
+                        "none defined".into()
+                    } else {
+                        known.join(", ")
+                    }
+                ),
+            )
+        }),
+    }
+}
+
+fn budget(t: &Table, key: &str, total: &mut u64, add: u64) -> R<()> {
+    *total = total.saturating_add(add);
+    if *total > MAX_PRIMITIVES {
+        return Err(t.error(
+            key,
+            format!(
+                "the scene would hold {} primitives, more than the limit of {MAX_PRIMITIVES}",
+                *total
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn add_object(
+    t: &Table,
+    id: u32,
+    mats: &HashMap<String, u32>,
+    geo: &mut Geometry,
+    total: &mut u64,
+) -> R<String> {
+    let kind = t.req_string("type")?;
+    let mat = material_ref(t, "material", mats, 0)?;
+    match kind {
+        "box" => {
+            let (min, max) = (t.req_vec3("min")?, t.req_vec3("max")?);
+            if min.cmpge(max).any() {
+                return Err(t.error("max", "every coordinate of max must exceed min"));
+            }
+            budget(t, "type", total, 1)?;
+            geo.push_part(id, mat, [Primitive::Cuboid { min, max }]);
+        }
+        "sphere" => {
+            let center = t.req_vec3("center")?;
+            let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
+            budget(t, "type", total, 1)?;
+            geo.push_part(id, mat, [Primitive::Sphere { center, radius }]);
+        }
+        "rod" => {
+            let (a, b) = (t.req_vec3("from")?, t.req_vec3("to")?);
+            let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
+            budget(t, "type", total, 1)?;
+            geo.push_part(id, mat, [Primitive::Capsule { a, b, radius }]);
+        }
+        "mesh" => {
+            let vn = t
+                .get("vertices")
+                .ok_or_else(|| t.error("vertices", "missing: give [[x, y, z], ...]"))?;
+            let verts = match &vn.val {
+                super::Val::Array(items) => items
+                    .iter()
+                    .map(|e| {
+                        t.numbers_of(e, "vertices", Some(3))
+                            .map(|v| DVec3::new(v[0], v[1], v[2]))
+                    })
+                    .collect::<R<Vec<_>>>()?,
+                _ => return Err(t.error_at(vn, "vertices", "expected an array of [x, y, z]")),
+            };
+            let inn = t
+                .get("indices")
+                .ok_or_else(|| t.error("indices", "missing: give [[i, j, k], ...]"))?;
+            let tris = match &inn.val {
+                super::Val::Array(items) => items
+                    .iter()
+                    .map(|e| {
+                        let v = t.numbers_of(e, "indices", Some(3))?;
+                        let mut idx = [0usize; 3];
+                        for (k, x) in v.iter().enumerate() {
+                            if x.fract() != 0.0 || *x < 0.0 || *x as usize >= verts.len() {
+                                return Err(t.error_at(
+                                    e,
+                                    "indices",
+                                    format!(
+                                        "index {x} is not a vertex (there are {})",
+                                        verts.len()
+                                    ),
+                                ));
+                            }
+                            idx[k] = *x as usize;
+                        }
+                        Ok(Primitive::Triangle {
+                            v: idx.map(|i| verts[i]),
+                        })
+                    })
+                    .collect::<R<Vec<_>>>()?,
+                _ => return Err(t.error_at(inn, "indices", "expected an array of [i, j, k]")),
+            };
+            if tris.is_empty() {
+                return Err(t.error_at(inn, "indices", "the mesh has no triangles"));
+            }
+            budget(t, "type", total, tris.len() as u64)?;
+            geo.push_part(id, mat, tris);
+        }
+        "lattice" => {
+            let counts = t
+                .uints("counts", 3, 1, 1_000_000)?
+                .ok_or_else(|| t.error("counts", "missing: give the node counts [nx, ny, nz]"))?;
+            let spacing = t.positive_scalar_or_array("spacing", 3, Some(1.0))?;
+            let l = Lattice {
+                counts: [counts[0] as u32, counts[1] as u32, counts[2] as u32],
+                spacing: DVec3::from_slice(&spacing),
+                origin: t.vec3("origin")?.unwrap_or(DVec3::ZERO),
+                rod_radius: t.f64_where("rod_radius", Some(0.05), |v| v >= 0.0, "0 or more")?,
+                sphere_radius: t.f64_where(
+                    "sphere_radius",
+                    Some(0.15),
+                    |v| v >= 0.0,
+                    "0 or more",
+                )?,
+            };
+            if l.rod_radius == 0.0 && l.sphere_radius == 0.0 {
+                return Err(t.error(
+                    "rod_radius",
+                    "rod_radius and sphere_radius are both 0: the lattice would be empty",
+                ));
+            }
+            budget(
+                t,
+                "counts",
+                total,
+                l.sphere_count().saturating_add(l.rod_count()),
+            )?;
+            let sm = material_ref(t, "sphere_material", mats, mat)?;
+            let rm = material_ref(t, "rod_material", mats, mat)?;
+            geo.prims
+                .reserve((l.sphere_count() + l.rod_count()) as usize);
+            geo.push_part(id, sm, l.spheres());
+            geo.push_part(id, rm, l.rods());
+        }
+        "bar_array" => {
+            let counts = t
+                .uints("counts", 2, 1, 100_000)?
+                .ok_or_else(|| t.error("counts", "missing: give the bar counts [n1, n2]"))?;
+            let spacing = t.positive_scalar_or_array("spacing", 2, Some(2.0))?;
+            let bar_size = t.positive_scalar_or_array("bar_size", 2, Some(0.5))?;
+            let axis = match t.string("axis")?.unwrap_or("z") {
+                "x" => 0,
+                "y" => 1,
+                "z" => 2,
+                other => {
+                    let n = t.get("axis").expect("read above");
+                    return Err(t.error_at(
+                        n,
+                        "axis",
+                        format!("unknown axis `{other}` (x, y or z)"),
+                    ));
+                }
+            };
+            let b = BarArray {
+                counts: [counts[0] as u32, counts[1] as u32],
+                spacing: [spacing[0], spacing[1]],
+                bar_size: [bar_size[0], bar_size[1]],
+                length: t.f64_where("length", Some(2.0), |v| v > 0.0, "greater than 0")?,
+                axis,
+                center: t.vec3("center")?.unwrap_or(DVec3::ZERO),
+            };
+            budget(t, "counts", total, counts[0] * counts[1])?;
+            geo.push_part(id, mat, b.bars());
+        }
+        other => {
+            let n = t.get("type").expect("read above");
+            return Err(t.error_at(
+                n,
+                "type",
+                format!(
+                    "unknown object type `{other}` (box, sphere, rod, mesh, lattice, bar_array)"
+                ),
+            ));
+        }
+    }
+    Ok(kind.to_string())
+}

@@ -1,0 +1,17 @@
+//! The scene: its description (camera, image, materials, lights, velocity groups), the TOML
+//! loader with errors that name file, line and key, `--set` overrides, and procedural objects.
+
+mod doc;
+mod error;
+mod load;
+mod model;
+mod procedural;
+mod reader;
+
+pub use doc::{Doc, Node, Origin, Val};
+pub use error::SceneError;
+pub use load::{load_file, load_str};
+pub use model::{
+    Camera, Group, ImageSettings, Light, Material, ObjectInfo, Projection, RenderSettings, Scene,
+};
+pub use procedural::{bar_array, lattice, BarArray, Lattice};

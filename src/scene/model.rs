@@ -1,0 +1,127 @@
+use crate::geometry::Geometry;
+use crate::spacetime::{Event, Velocity};
+use glam::DVec3;
+use std::sync::Arc;
+
+/// How camera-frame directions map to pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Pinhole with a vertical field of view (radians).
+    Pinhole { fov_y: f64 },
+    /// Parallel rays from an image plane that is simultaneous in the camera frame (Scott & Viner).
+    Orthographic { view_height: f64 },
+    /// The whole sky: longitude across, latitude down, the look direction at the centre.
+    Equirectangular,
+}
+
+/// The camera: at `position` at world time `time` (the imaging event), with its axes given in its
+/// own rest frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    pub position: DVec3,
+    pub time: f64,
+    pub forward: DVec3,
+    pub right: DVec3,
+    pub up: DVec3,
+    pub projection: Projection,
+    pub velocity: Velocity,
+}
+
+impl Camera {
+    pub fn imaging_event(&self) -> Event {
+        Event::new(self.time, self.position)
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageSettings {
+    pub width: u32,
+    pub height: u32,
+    pub samples: u32,
+    pub background: DVec3,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Reflection/refraction bounces after the primary hit.
+    pub max_depth: u32,
+    pub ambient: DVec3,
+}
+
+/// A rest-frame surface description: Phong plus Whitted mirror and dielectric terms.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub color: DVec3,
+    pub specular: DVec3,
+    pub shininess: f64,
+    pub reflect: f64,
+    pub transmit: f64,
+    pub ior: f64,
+    pub emission: Option<DVec3>,
+}
+
+impl Material {
+    pub fn default_white() -> Material {
+        Material {
+            name: "default".into(),
+            color: DVec3::splat(0.8),
+            specular: DVec3::ZERO,
+            shininess: 32.0,
+            reflect: 0.0,
+            transmit: 0.0,
+            ior: 1.5,
+            emission: None,
+        }
+    }
+}
+
+/// An isotropic point light at rest in the frame moving at `velocity`, at `position` in that
+/// frame's coordinates (whose origin passes through the world origin at world time 0).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    pub position: DVec3,
+    pub radiance: DVec3,
+    pub velocity: Velocity,
+    pub inverse_square: bool,
+}
+
+/// Objects sharing one uniform velocity; geometry in their rest frame.
+#[derive(Clone, Debug)]
+pub struct Group {
+    pub name: String,
+    pub velocity: Velocity,
+    pub geometry: Arc<Geometry>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectInfo {
+    pub name: Option<String>,
+    pub kind: String,
+    pub group: usize,
+}
+
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub camera: Camera,
+    pub image: ImageSettings,
+    pub render: RenderSettings,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    pub groups: Vec<Group>,
+    /// Every `[[group.object]]` in file order; `object_id` in the output is index + 1.
+    pub objects: Vec<ObjectInfo>,
+}
+
+impl Scene {
+    pub fn primitive_count(&self) -> usize {
+        self.groups.iter().map(|g| g.geometry.prims.len()).sum()
+    }
+
+    /// True when some material reflects or refracts (secondary rays are needed).
+    pub fn has_secondary(&self) -> bool {
+        self.materials
+            .iter()
+            .any(|m| m.reflect > 0.0 || m.transmit > 0.0)
+    }
+}

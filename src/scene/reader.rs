@@ -1,0 +1,346 @@
+//! Typed reading of one table of the scene tree, with errors that name file, line and key, and
+//! a check that every key was understood.
+
+use super::doc::{Doc, Node, Val};
+use super::SceneError;
+use glam::DVec3;
+use std::cell::RefCell;
+
+pub struct Table<'a> {
+    doc: &'a Doc,
+    node: &'a Node,
+    /// Dotted path of this table, e.g. `group.cube` (for messages).
+    pub path: String,
+    used: RefCell<Vec<bool>>,
+}
+
+pub type R<T> = Result<T, SceneError>;
+
+impl<'a> Table<'a> {
+    pub fn new(doc: &'a Doc, node: &'a Node, path: String) -> R<Table<'a>> {
+        let Some(entries) = node.entries() else {
+            return Err(SceneError::new(
+                doc.locate(&node.origin),
+                path,
+                format!("expected a table, found {}", node.kind()),
+            ));
+        };
+        Ok(Table {
+            doc,
+            node,
+            path,
+            used: RefCell::new(vec![false; entries.len()]),
+        })
+    }
+
+    pub fn root(doc: &'a Doc) -> R<Table<'a>> {
+        Table::new(doc, &doc.root, String::new())
+    }
+
+    fn entries(&self) -> &'a [(String, Node)] {
+        self.node.entries().unwrap_or(&[])
+    }
+
+    pub fn key_path(&self, key: &str) -> String {
+        if self.path.is_empty() {
+            key.to_string()
+        } else {
+            format!("{}.{key}", self.path)
+        }
+    }
+
+    pub fn has(&self, key: &str) -> bool {
+        self.entries().iter().any(|(k, _)| k == key)
+    }
+
+    /// The node of a key, marking it understood.
+    pub fn get(&self, key: &str) -> Option<&'a Node> {
+        let i = self.entries().iter().position(|(k, _)| k == key)?;
+        self.used.borrow_mut()[i] = true;
+        Some(&self.entries()[i].1)
+    }
+
+    /// An error about this table as a whole (a missing key, a conflict).
+    pub fn error(&self, key: &str, msg: impl Into<String>) -> SceneError {
+        SceneError::new(self.doc.locate(&self.node.origin), self.key_path(key), msg)
+    }
+
+    /// An error about one value.
+    pub fn error_at(&self, node: &Node, key: &str, msg: impl Into<String>) -> SceneError {
+        SceneError::new(self.doc.locate(&node.origin), self.key_path(key), msg)
+    }
+
+    pub fn f64(&self, key: &str) -> R<Option<f64>> {
+        self.get(key).map(|n| self.num(n, key)).transpose()
+    }
+
+    fn num(&self, n: &Node, key: &str) -> R<f64> {
+        let v = match n.val {
+            Val::Float(f) => f,
+            Val::Int(i) => i as f64,
+            _ => {
+                return Err(self.error_at(n, key, format!("expected a number, found {}", n.kind())))
+            }
+        };
+        if !v.is_finite() {
+            return Err(self.error_at(n, key, format!("expected a finite number, found {v}")));
+        }
+        Ok(v)
+    }
+
+    pub fn f64_or(&self, key: &str, default: f64) -> R<f64> {
+        Ok(self.f64(key)?.unwrap_or(default))
+    }
+
+    /// A number checked by `ok`, whose failure text says what is expected.
+    pub fn f64_where(
+        &self,
+        key: &str,
+        default: Option<f64>,
+        ok: fn(f64) -> bool,
+        expect: &str,
+    ) -> R<f64> {
+        match self.get(key) {
+            Some(n) => {
+                let v = self.num(n, key)?;
+                if ok(v) {
+                    Ok(v)
+                } else {
+                    Err(self.error_at(n, key, format!("must be {expect} (got {v})")))
+                }
+            }
+            None => {
+                default.ok_or_else(|| self.error(key, format!("missing: give a number ({expect})")))
+            }
+        }
+    }
+
+    pub fn uint(&self, key: &str, default: Option<u64>, min: u64, max: u64) -> R<u64> {
+        match self.get(key) {
+            Some(n) => self.uint_of(n, key, min, max),
+            None => default.ok_or_else(|| {
+                self.error(
+                    key,
+                    format!("missing: give a whole number from {min} to {max}"),
+                )
+            }),
+        }
+    }
+
+    fn uint_of(&self, n: &Node, key: &str, min: u64, max: u64) -> R<u64> {
+        match n.val {
+            Val::Int(i) if i >= min as i64 && (i as u64) <= max => Ok(i as u64),
+            Val::Int(i) => Err(self.error_at(
+                n,
+                key,
+                format!("must be a whole number from {min} to {max} (got {i})"),
+            )),
+            _ => Err(self.error_at(
+                n,
+                key,
+                format!("expected a whole number, found {}", n.kind()),
+            )),
+        }
+    }
+
+    pub fn string(&self, key: &str) -> R<Option<&'a str>> {
+        match self.get(key) {
+            Some(Node {
+                val: Val::Str(s), ..
+            }) => Ok(Some(s.as_str())),
+            Some(n) => Err(self.error_at(n, key, format!("expected a string, found {}", n.kind()))),
+            None => Ok(None),
+        }
+    }
+
+    pub fn req_string(&self, key: &str) -> R<&'a str> {
+        self.string(key)?
+            .ok_or_else(|| self.error(key, "missing: give a string"))
+    }
+
+    /// An array of numbers of exactly `len` elements.
+    pub fn numbers(&self, key: &str, len: usize) -> R<Option<Vec<f64>>> {
+        let Some(n) = self.get(key) else {
+            return Ok(None);
+        };
+        self.numbers_of(n, key, Some(len)).map(Some)
+    }
+
+    pub fn numbers_of(&self, n: &Node, key: &str, len: Option<usize>) -> R<Vec<f64>> {
+        let Val::Array(items) = &n.val else {
+            let want = len
+                .map(|l| format!("an array of {l} numbers"))
+                .unwrap_or("an array of numbers".into());
+            return Err(self.error_at(n, key, format!("expected {want}, found {}", n.kind())));
+        };
+        if let Some(l) = len {
+            if items.len() != l {
+                return Err(self.error_at(
+                    n,
+                    key,
+                    format!("expected {l} numbers, found {}", items.len()),
+                ));
+            }
+        }
+        items.iter().map(|e| self.num(e, key)).collect()
+    }
+
+    pub fn vec3(&self, key: &str) -> R<Option<DVec3>> {
+        Ok(self.numbers(key, 3)?.map(|v| DVec3::new(v[0], v[1], v[2])))
+    }
+
+    pub fn req_vec3(&self, key: &str) -> R<DVec3> {
+        self.vec3(key)?
+            .ok_or_else(|| self.error(key, "missing: give [x, y, z]"))
+    }
+
+    /// A colour: `[r, g, b]` or one number for grey; every channel ≥ 0.
+    pub fn color(&self, key: &str) -> R<Option<DVec3>> {
+        let Some(n) = self.get(key) else {
+            return Ok(None);
+        };
+        let c = match n.val {
+            Val::Array(_) => {
+                let v = self.numbers_of(n, key, Some(3))?;
+                DVec3::new(v[0], v[1], v[2])
+            }
+            _ => DVec3::splat(self.num(n, key)?),
+        };
+        if c.min_element() < 0.0 {
+            return Err(self.error_at(n, key, "colour channels must not be negative"));
+        }
+        Ok(Some(c))
+    }
+
+    /// A number or an array of `len` numbers, each checked to be > 0.
+    pub fn positive_scalar_or_array(
+        &self,
+        key: &str,
+        len: usize,
+        default: Option<f64>,
+    ) -> R<Vec<f64>> {
+        let v = match self.get(key) {
+            None => match default {
+                Some(d) => vec![d; len],
+                None => return Err(self.error(key, "missing")),
+            },
+            Some(n) => match n.val {
+                Val::Array(_) => self.numbers_of(n, key, Some(len))?,
+                _ => vec![self.num(n, key)?; len],
+            },
+        };
+        if v.iter().any(|&x| x <= 0.0) {
+            let n = self.get(key).unwrap_or(self.node);
+            return Err(self.error_at(n, key, "must be greater than 0"));
+        }
+        Ok(v)
+    }
+
+    /// Whole numbers, exactly `len` of them, each in [min, max].
+    pub fn uints(&self, key: &str, len: usize, min: u64, max: u64) -> R<Option<Vec<u64>>> {
+        let Some(n) = self.get(key) else {
+            return Ok(None);
+        };
+        let Val::Array(items) = &n.val else {
+            return Err(self.error_at(
+                n,
+                key,
+                format!(
+                    "expected an array of {len} whole numbers, found {}",
+                    n.kind()
+                ),
+            ));
+        };
+        if items.len() != len {
+            return Err(self.error_at(
+                n,
+                key,
+                format!("expected {len} whole numbers, found {}", items.len()),
+            ));
+        }
+        items
+            .iter()
+            .map(|e| self.uint_of(e, key, min, max))
+            .collect::<R<Vec<_>>>()
+            .map(Some)
+    }
+
+    /// A sub-table.
+    pub fn table(&self, key: &str) -> R<Option<Table<'a>>> {
+        self.get(key)
+            .map(|n| Table::new(self.doc, n, self.key_path(key)))
+            .transpose()
+    }
+
+    /// An array of tables (`[[key]]`); each entry's path uses its `name` when it has one.
+    pub fn tables(&self, key: &str) -> R<Vec<Table<'a>>> {
+        let Some(n) = self.get(key) else {
+            return Ok(Vec::new());
+        };
+        let Val::Array(items) = &n.val else {
+            return Err(self.error_at(
+                n,
+                key,
+                format!(
+                    "expected [[{}]] entries, found {}",
+                    self.key_path(key),
+                    n.kind()
+                ),
+            ));
+        };
+        items
+            .iter()
+            .enumerate()
+            .map(|(i, item)| {
+                let label = item
+                    .entries()
+                    .and_then(|e| e.iter().find(|(k, _)| k == "name"))
+                    .and_then(|(_, v)| match &v.val {
+                        Val::Str(s) => Some(s.clone()),
+                        _ => None,
+                    })
+                    .unwrap_or_else(|| i.to_string());
+                Table::new(self.doc, item, format!("{}.{label}", self.key_path(key)))
+            })
+            .collect()
+    }
+
+    /// Every key must have been read: report the first that was not, with a suggestion.
+    pub fn finish(&self, known: &[&str]) -> R<()> {
+        let used = self.used.borrow();
+        for (i, (k, n)) in self.entries().iter().enumerate() {
+            if !used[i] {
+                let hint = closest(k, known)
+                    .map(|s| format!("; did you mean `{s}`?"))
+                    .unwrap_or_else(|| format!("; known keys here: {}", known.join(", ")));
+                return Err(self.error_at(n, k, format!("unknown key{hint}")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The known key nearest in edit distance, if it is near enough to be a typo.
+fn closest<'k>(key: &str, known: &[&'k str]) -> Option<&'k str> {
+    known
+        .iter()
+        .map(|k| (edit_distance(key, k), *k))
+        .filter(|(d, k)| *d <= 2.max(k.len() / 3))
+        .min()
+        .map(|(_, k)| k)
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}

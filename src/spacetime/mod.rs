@@ -1,0 +1,15 @@
+//! Special-relativistic kinematics in f64: events, velocities stored by rapidity, Lorentz boosts
+//! in any direction, past-directed null rays and the Doppler factor.
+//!
+//! Conventions (DESIGN.md, PHYSICS.md §0): c = 1; a boost `Boost::to_rest(v)` is the passive
+//! transformation from the world frame W into the frame that moves at `v` relative to W.
+
+mod boost;
+mod event;
+mod null_ray;
+mod velocity;
+
+pub use boost::Boost;
+pub use event::Event;
+pub use null_ray::NullRay;
+pub use velocity::{Velocity, VelocityError};

@@ -1,0 +1,29 @@
+use super::{Boost, Event};
+use glam::DVec3;
+
+/// A past-directed null ray `E(λ) = origin + λ (−1, dir)`, λ ≥ 0: λ is the lookback time in the
+/// frame the ray is written in, and `dir` (unit) is the looking direction, opposite to the
+/// direction the light travels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NullRay {
+    pub origin: Event,
+    pub dir: DVec3,
+}
+
+impl NullRay {
+    pub fn new(origin: Event, dir: DVec3) -> Self {
+        Self { origin, dir }
+    }
+
+    pub fn at(&self, lambda: f64) -> Event {
+        Event::new(self.origin.t - lambda, self.origin.x + lambda * self.dir)
+    }
+
+    /// This ray written in another frame: origin and direction boosted, with the lookback time
+    /// rescaled so the new ray's λ is again that frame's lookback time. Returns the ray and the
+    /// factor `s` with `λ_new = s λ_old`.
+    pub fn boosted(&self, b: &Boost) -> (NullRay, f64) {
+        let (dir, s) = b.view_dir(self.dir);
+        (NullRay::new(b.event(self.origin), dir), s)
+    }
+}

@@ -1,0 +1,159 @@
+use glam::DVec3;
+use std::fmt;
+
+/// A velocity relative to some frame, stored by its unit direction and rapidity φ (PHYSICS.md §8):
+/// β = tanh φ, γ = cosh φ, γβ = sinh φ, e^{±φ} are all derived in f64 without cancellation, so
+/// speeds like 1 − 1e-12 keep full precision when given as rapidity or as 1 − β.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Velocity {
+    dir: DVec3,
+    rapidity: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum VelocityError {
+    NotFinite,
+    NotBelowLight(f64),
+    Negative(&'static str, f64),
+    ZeroDirection,
+    OneMinusBetaRange(f64),
+}
+
+impl fmt::Display for VelocityError {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match self {
+            VelocityError::NotFinite => write!(f, "the speed must be a finite number"),
+            VelocityError::NotBelowLight(b) => write!(
+                f,
+                "speed {b} is not below 1 (the speed of light); for speeds near 1 give `rapidity` or `one_minus_beta` with a `direction`"
+            ),
+            VelocityError::Negative(what, v) => write!(f, "{what} must not be negative (got {v}); reverse `direction` instead"),
+            VelocityError::ZeroDirection => write!(f, "`direction` must not be the zero vector"),
+            VelocityError::OneMinusBetaRange(e) => {
+                write!(f, "one_minus_beta must lie in (0, 1] (got {e})")
+            }
+        }
+    }
+}
+
+impl Velocity {
+    pub const ZERO: Velocity = Velocity {
+        dir: DVec3::ZERO,
+        rapidity: 0.0,
+    };
+
+    /// From a β vector (units of c). |β| must be below 1.
+    pub fn from_beta_vec(beta: DVec3) -> Result<Self, VelocityError> {
+        if !beta.is_finite() {
+            return Err(VelocityError::NotFinite);
+        }
+        let b = beta.length();
+        if b >= 1.0 {
+            return Err(VelocityError::NotBelowLight(b));
+        }
+        if b == 0.0 {
+            return Ok(Self::ZERO);
+        }
+        Ok(Self {
+            dir: beta / b,
+            rapidity: b.atanh(),
+        })
+    }
+
+    fn unit(direction: DVec3) -> Result<DVec3, VelocityError> {
+        if !direction.is_finite() {
+            return Err(VelocityError::NotFinite);
+        }
+        let l = direction.length();
+        if l == 0.0 {
+            return Err(VelocityError::ZeroDirection);
+        }
+        Ok(direction / l)
+    }
+
+    /// From a direction (any length) and a speed β in [0, 1).
+    pub fn from_beta(direction: DVec3, beta: f64) -> Result<Self, VelocityError> {
+        if !beta.is_finite() {
+            return Err(VelocityError::NotFinite);
+        }
+        if beta < 0.0 {
+            return Err(VelocityError::Negative("beta", beta));
+        }
+        if beta >= 1.0 {
+            return Err(VelocityError::NotBelowLight(beta));
+        }
+        Self::from_rapidity(direction, beta.atanh())
+    }
+
+    /// From a direction and a rapidity φ ≥ 0.
+    pub fn from_rapidity(direction: DVec3, rapidity: f64) -> Result<Self, VelocityError> {
+        if !rapidity.is_finite() {
+            return Err(VelocityError::NotFinite);
+        }
+        if rapidity < 0.0 {
+            return Err(VelocityError::Negative("rapidity", rapidity));
+        }
+        if rapidity == 0.0 {
+            return Ok(Self::ZERO);
+        }
+        Ok(Self {
+            dir: Self::unit(direction)?,
+            rapidity,
+        })
+    }
+
+    /// From a direction and ε = 1 − β in (0, 1]: φ = ½ ln((2 − ε)/ε), exact for tiny ε.
+    pub fn from_one_minus_beta(direction: DVec3, eps: f64) -> Result<Self, VelocityError> {
+        if !eps.is_finite() {
+            return Err(VelocityError::NotFinite);
+        }
+        if eps <= 0.0 || eps > 1.0 {
+            return Err(VelocityError::OneMinusBetaRange(eps));
+        }
+        let phi = 0.5 * ((2.0 - eps).ln() - eps.ln());
+        Self::from_rapidity(direction, phi)
+    }
+
+    pub fn is_zero(&self) -> bool {
+        self.rapidity == 0.0
+    }
+    /// Unit direction (zero for a velocity of zero).
+    pub fn direction(&self) -> DVec3 {
+        self.dir
+    }
+    pub fn rapidity(&self) -> f64 {
+        self.rapidity
+    }
+    pub fn beta(&self) -> f64 {
+        self.rapidity.tanh()
+    }
+    pub fn beta_vec(&self) -> DVec3 {
+        self.dir * self.beta()
+    }
+    pub fn gamma(&self) -> f64 {
+        self.rapidity.cosh()
+    }
+    pub fn gamma_beta(&self) -> f64 {
+        self.rapidity.sinh()
+    }
+    /// γ − 1 = 2 sinh²(φ/2), exact for small speeds.
+    pub fn gamma_minus_one(&self) -> f64 {
+        let s = (0.5 * self.rapidity).sinh();
+        2.0 * s * s
+    }
+    /// 1 − β = 2 / (e^{2φ} + 1), exact near the speed of light.
+    pub fn one_minus_beta(&self) -> f64 {
+        2.0 / ((2.0 * self.rapidity).exp() + 1.0)
+    }
+    /// The same speed in the opposite direction.
+    pub fn reversed(&self) -> Velocity {
+        Velocity {
+            dir: -self.dir,
+            rapidity: self.rapidity,
+        }
+    }
+    /// True when both denote the same velocity (bitwise on the stored parameters).
+    pub fn same_as(&self, other: &Velocity) -> bool {
+        (self.is_zero() && other.is_zero()) || self == other
+    }
+}
