@@ -5,5 +5,20 @@ mod common;
 conformance_suite!(
     bvh,
     rest_embree::accel::backend_by_name("bvh").unwrap(),
-    Tolerance { t_rel: 1e-9, mismatch: 0.0 }
+    Tolerance {
+        t_rel: 1e-9,
+        mismatch: 0.0
+    }
+);
+
+// Embree intersects in f32 (about each group's centre) and the hit is refined in f64 on the
+// primitive it found, so t is as exact as the BVH's; grazing rays may still disagree.
+#[cfg(feature = "embree")]
+conformance_suite!(
+    embree,
+    rest_embree::accel::backend_by_name("embree").unwrap(),
+    Tolerance {
+        t_rel: 1e-9,
+        mismatch: 0.002
+    }
 );

@@ -40,7 +40,11 @@ fn face_width(frame: &rest_embree::render::Frame, normal: [f32; 3]) -> usize {
     (0..W)
         .filter(|&x| {
             let p = frame.get(x, y);
-            p.object_id == 1 && p.normal.iter().zip(normal).all(|(a, b)| (a - b).abs() < 1e-3)
+            p.object_id == 1
+                && p.normal
+                    .iter()
+                    .zip(normal)
+                    .all(|(a, b)| (a - b).abs() < 1e-3)
         })
         .count()
 }
@@ -57,7 +61,12 @@ fn cube_widths_match_section_2_4() {
             let near = row["near_face_width_px"].as_f64().unwrap();
             let rear = row["rear_face_width_px"].as_f64().unwrap();
             // The near face width is exactly f·sqrt(1 − β²)/h.
-            assert_rel(near, 1000.0 * (1.0 - beta * beta).sqrt() / h, 1e-9, "table self-check");
+            assert_rel(
+                near,
+                1000.0 * (1.0 - beta * beta).sqrt() / h,
+                1e-9,
+                "table self-check",
+            );
             let frame = render_with(&scene(&cube_scene(h, beta, rear_x)), backend);
             let got_near = face_width(&frame, [0.0, -1.0, 0.0]) as f64;
             let got_rear = face_width(&frame, [-1.0, 0.0, 0.0]) as f64;
@@ -83,7 +92,10 @@ fn the_shipped_calibration_scene_shows_the_contraction() {
     for backend in backends() {
         for beta in [0.0f64, 0.1, 0.5, 0.9, 0.99] {
             let sets = [
-                ("--set".to_string(), format!("group.cube.velocity=[{beta}, 0, 0]")),
+                (
+                    "--set".to_string(),
+                    format!("group.cube.velocity=[{beta}, 0, 0]"),
+                ),
                 ("--set".to_string(), "image.samples=1".to_string()),
             ];
             let scene = rest_embree::scene::load_file(path.as_ref(), &sets).unwrap();
@@ -93,7 +105,10 @@ fn the_shipped_calibration_scene_shows_the_contraction() {
                 .filter(|&x| frame.get(x, y).object_id == 1 && frame.get(x, y).normal[1] < -0.5)
                 .count() as f64;
             let expect = 1000.0 * (1.0 - beta * beta).sqrt() / 10.0;
-            assert!((near - expect).abs() <= 1.0, "{backend} beta {beta}: {near} px, expected {expect:.3}");
+            assert!(
+                (near - expect).abs() <= 1.0,
+                "{backend} beta {beta}: {near} px, expected {expect:.3}"
+            );
         }
     }
 }

@@ -61,7 +61,10 @@ impl Drop for Dir {
 }
 
 fn run(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree")).args(args).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args(args)
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(!err.contains("panicked"), "the command panicked: {err}");
     (out.status.success(), err)
@@ -73,18 +76,33 @@ fn fails(name: &str, scene_text: &str, extra: &[&str], needles: &[&str]) {
     let d = Dir::new(name);
     let scene = d.file("scene.toml", scene_text);
     let out = d.0.join("out.png");
-    let mut args = vec!["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()];
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
     args.extend_from_slice(extra);
     let (ok, err) = run(&args);
     assert!(!ok, "{name}: expected failure, stderr: {err}");
     for n in needles {
-        assert!(err.contains(n), "{name}: error should mention `{n}`:\n{err}");
+        assert!(
+            err.contains(n),
+            "{name}: error should mention `{n}`:\n{err}"
+        );
     }
-    assert_eq!(d.entries(), vec!["scene.toml".to_string()], "{name}: no output file, no partial file");
+    assert_eq!(
+        d.entries(),
+        vec!["scene.toml".to_string()],
+        "{name}: no output file, no partial file"
+    );
 }
 
 fn with(line_from: &str, line_to: &str) -> String {
-    assert!(GOOD.contains(line_from), "test bug: `{line_from}` not in the scene");
+    assert!(
+        GOOD.contains(line_from),
+        "test bug: `{line_from}` not in the scene"
+    );
     GOOD.replacen(line_from, line_to, 1)
 }
 
@@ -94,42 +112,87 @@ fn good_scene_writes_png_and_exr_with_the_passes() {
     let scene = d.file("scene.toml", GOOD);
     let png = d.0.join("out.png");
     let exr = d.0.join("out.exr");
-    let (ok, err) = run(&["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+    let (ok, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
     assert!(ok, "{err}");
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[1..4], b"PNG");
-    let (ok, err) = run(&["render", scene.to_str().unwrap(), "-o", exr.to_str().unwrap(), "--samples", "4", "--width", "40"]);
+    let (ok, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--samples",
+        "4",
+        "--width",
+        "40",
+    ]);
     assert!(ok, "{err}");
     let (w, h, ch) = rest_embree::output::read_exr_channels(&exr).unwrap();
     assert_eq!((w, h), (40, 32));
     for name in ["R", "G", "B", "A", "lookback", "doppler", "object_id"] {
-        let c = ch.get(name).unwrap_or_else(|| panic!("channel {name} missing; have {:?}", ch.keys()));
+        let c = ch
+            .get(name)
+            .unwrap_or_else(|| panic!("channel {name} missing; have {:?}", ch.keys()));
         assert!(c.iter().all(|v| v.is_finite()), "channel {name} is finite");
     }
     let ids = &ch["object_id"];
     let lookback = &ch["lookback"];
     let doppler = &ch["doppler"];
-    let hit = ids.iter().position(|&i| i == 1.0).expect("the cube is in view");
+    let hit = ids
+        .iter()
+        .position(|&i| i == 1.0)
+        .expect("the cube is in view");
     // The cube is about 10 light-units away, and it recedes slightly off-axis: redshifted.
-    assert!(lookback[hit] > 9.0 && lookback[hit] < 13.0, "lookback {}", lookback[hit]);
-    assert!(doppler[hit] > 0.3 && doppler[hit] < 1.5, "doppler {}", doppler[hit]);
+    assert!(
+        lookback[hit] > 9.0 && lookback[hit] < 13.0,
+        "lookback {}",
+        lookback[hit]
+    );
+    assert!(
+        doppler[hit] > 0.3 && doppler[hit] < 1.5,
+        "doppler {}",
+        doppler[hit]
+    );
     assert!(ids.contains(&0.0), "background is id 0");
-    assert_eq!(d.entries().len(), 3, "only the scene and two images: {:?}", d.entries());
+    assert_eq!(
+        d.entries().len(),
+        3,
+        "only the scene and two images: {:?}",
+        d.entries()
+    );
 }
 
 #[test]
 fn missing_scene_file() {
     let d = Dir::new("missing");
     let out = d.0.join("out.png");
-    let (ok, err) = run(&["render", "/nonexistent/scene.toml", "-o", out.to_str().unwrap()]);
+    let (ok, err) = run(&[
+        "render",
+        "/nonexistent/scene.toml",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert!(!ok);
-    assert!(err.contains("/nonexistent/scene.toml") && err.contains("cannot read"), "{err}");
+    assert!(
+        err.contains("/nonexistent/scene.toml") && err.contains("cannot read"),
+        "{err}"
+    );
     assert!(d.entries().is_empty());
 }
 
 #[test]
 fn toml_syntax_error_names_the_line() {
-    fails("syntax", &with("fov_y = 30", "fov_y = = 30"), &[], &["scene.toml:4", "not valid TOML"]);
+    fails(
+        "syntax",
+        &with("fov_y = 30", "fov_y = = 30"),
+        &[],
+        &["scene.toml:4", "not valid TOML"],
+    );
 }
 
 #[test]
@@ -138,24 +201,68 @@ fn unknown_key_names_line_key_and_suggests() {
         "unknown",
         &with("velocity = [0.5, 0, 0]", "velocty = [0.5, 0, 0]"),
         &[],
-        &["scene.toml:21", "group.cube.velocty", "did you mean `velocity`"],
+        &[
+            "scene.toml:21",
+            "group.cube.velocty",
+            "did you mean `velocity`",
+        ],
     );
-    fails("unknown-table", &format!("{GOOD}\n[rendr]\nmax_depth = 2\n"), &[], &["scene.toml:28", "rendr", "did you mean `render`"]);
+    fails(
+        "unknown-table",
+        &format!("{GOOD}\n[rendr]\nmax_depth = 2\n"),
+        &[],
+        &["scene.toml:28", "rendr", "did you mean `render`"],
+    );
 }
 
 #[test]
 fn bad_values_name_line_and_key() {
-    fails("type", &with("fov_y = 30", "fov_y = \"wide\""), &[], &["scene.toml:4", "camera.fov_y", "expected a number"]);
-    fails("range", &with("fov_y = 30", "fov_y = 190"), &[], &["scene.toml:4", "camera.fov_y", "between 0 and 180"]);
-    fails("width", &with("width = 48", "width = 0"), &[], &["scene.toml:8", "image.width"]);
-    fails("material", &with("material = \"white\"", "material = \"gold\""), &[], &["scene.toml:26", "no material named `gold`", "white"]);
-    fails("box", &with("max = [0.5, 11, 0.5]", "max = [0.5, 9, 0.5]"), &[], &["group.cube.object", "max"]);
-    fails("vec", &with("look_at = [0, 10, 0]", "look_at = [0, 10]"), &[], &["scene.toml:3", "camera.look_at", "expected 3 numbers"]);
+    fails(
+        "type",
+        &with("fov_y = 30", "fov_y = \"wide\""),
+        &[],
+        &["scene.toml:4", "camera.fov_y", "expected a number"],
+    );
+    fails(
+        "range",
+        &with("fov_y = 30", "fov_y = 190"),
+        &[],
+        &["scene.toml:4", "camera.fov_y", "between 0 and 180"],
+    );
+    fails(
+        "width",
+        &with("width = 48", "width = 0"),
+        &[],
+        &["scene.toml:8", "image.width"],
+    );
+    fails(
+        "material",
+        &with("material = \"white\"", "material = \"gold\""),
+        &[],
+        &["scene.toml:26", "no material named `gold`", "white"],
+    );
+    fails(
+        "box",
+        &with("max = [0.5, 11, 0.5]", "max = [0.5, 9, 0.5]"),
+        &[],
+        &["group.cube.object", "max"],
+    );
+    fails(
+        "vec",
+        &with("look_at = [0, 10, 0]", "look_at = [0, 10]"),
+        &[],
+        &["scene.toml:3", "camera.look_at", "expected 3 numbers"],
+    );
 }
 
 #[test]
 fn speeds_of_light_and_beyond_are_refused() {
-    fails("c", &with("velocity = [0.5, 0, 0]", "velocity = [1.0, 0, 0]"), &[], &["scene.toml:21", "group.cube.velocity", "not below 1"]);
+    fails(
+        "c",
+        &with("velocity = [0.5, 0, 0]", "velocity = [1.0, 0, 0]"),
+        &[],
+        &["scene.toml:21", "group.cube.velocity", "not below 1"],
+    );
     fails(
         "faster",
         &with("velocity = [0.5, 0, 0]", "velocity = [0.8, 0.7, 0]"),
@@ -166,17 +273,27 @@ fn speeds_of_light_and_beyond_are_refused() {
         "set-c",
         GOOD,
         &["--set", "group.cube.velocity=[1.5,0,0]"],
-        &["--set group.cube.velocity=[1.5,0,0]", "group.cube.velocity", "not below 1"],
+        &[
+            "--set group.cube.velocity=[1.5,0,0]",
+            "group.cube.velocity",
+            "not below 1",
+        ],
     );
     fails(
         "beta",
-        &with("velocity = [0.5, 0, 0]", "direction = [1, 0, 0]\nbeta = 1.0"),
+        &with(
+            "velocity = [0.5, 0, 0]",
+            "direction = [1, 0, 0]\nbeta = 1.0",
+        ),
         &[],
         &["group.cube.beta", "not below 1"],
     );
     fails(
         "omb",
-        &with("velocity = [0.5, 0, 0]", "direction = [1, 0, 0]\none_minus_beta = 0"),
+        &with(
+            "velocity = [0.5, 0, 0]",
+            "direction = [1, 0, 0]\none_minus_beta = 0",
+        ),
         &[],
         &["group.cube.one_minus_beta", "(0, 1]"],
     );
@@ -186,23 +303,74 @@ fn speeds_of_light_and_beyond_are_refused() {
 fn empty_scenes_are_refused() {
     let no_objects = GOOD.split("[[group.object]]").next().unwrap().to_string();
     fails("empty", &no_objects, &[], &["scene is empty"]);
-    let no_groups = GOOD.split("[[group]]").next().unwrap().replace("group = \"cube\"\n", "");
+    let no_groups = GOOD
+        .split("[[group]]")
+        .next()
+        .unwrap()
+        .replace("group = \"cube\"\n", "");
     fails("nogroups", &no_groups, &[], &["scene is empty"]);
-    fails("nocamera", "[image]\nwidth = 4\n", &[], &["camera", "missing"]);
+    fails(
+        "nocamera",
+        "[image]\nwidth = 4\n",
+        &[],
+        &["camera", "missing"],
+    );
 }
 
 #[test]
 fn bad_flags_are_named() {
-    fails("backend", GOOD, &["--backend", "optix"], &["--backend", "unknown backend 'optix'"]);
-    fails("set-name", GOOD, &["--set", "group.ship.velocity=[0.1,0,0]"], &["--set group.ship.velocity", "no [[group]] entry named `ship`", "cube"]);
-    fails("set-syntax", GOOD, &["--set", "camera.time"], &["--set camera.time", "KEY=VALUE"]);
-    fails("set-value", GOOD, &["--set", "camera.time=[1,"], &["--set camera.time=[1,", "not a TOML value"]);
-    fails("set-unknown", GOOD, &["--set", "camera.tme=3"], &["--set camera.tme=3", "camera.tme", "did you mean `time`"]);
-    fails("width0", GOOD, &["--width", "0"], &["--width 0", "image.width"]);
+    fails(
+        "backend",
+        GOOD,
+        &["--backend", "optix"],
+        &["--backend", "unknown backend 'optix'"],
+    );
+    fails(
+        "set-name",
+        GOOD,
+        &["--set", "group.ship.velocity=[0.1,0,0]"],
+        &[
+            "--set group.ship.velocity",
+            "no [[group]] entry named `ship`",
+            "cube",
+        ],
+    );
+    fails(
+        "set-syntax",
+        GOOD,
+        &["--set", "camera.time"],
+        &["--set camera.time", "KEY=VALUE"],
+    );
+    fails(
+        "set-value",
+        GOOD,
+        &["--set", "camera.time=[1,"],
+        &["--set camera.time=[1,", "not a TOML value"],
+    );
+    fails(
+        "set-unknown",
+        GOOD,
+        &["--set", "camera.tme=3"],
+        &["--set camera.tme=3", "camera.tme", "did you mean `time`"],
+    );
+    fails(
+        "width0",
+        GOOD,
+        &["--width", "0"],
+        &["--width 0", "image.width"],
+    );
     let d = Dir::new("ext");
     let scene = d.file("scene.toml", GOOD);
-    let (ok, err) = run(&["render", scene.to_str().unwrap(), "-o", d.0.join("out.jpg").to_str().unwrap()]);
-    assert!(!ok && err.contains("-o") && err.contains(".exr or .png"), "{err}");
+    let (ok, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        d.0.join("out.jpg").to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("-o") && err.contains(".exr or .png"),
+        "{err}"
+    );
     assert_eq!(d.entries(), vec!["scene.toml".to_string()]);
 }
 

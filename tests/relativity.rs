@@ -52,7 +52,12 @@ fn scene_text(camera: &str, group_velocity: DVec3, light: &str) -> String {
 }
 
 fn mismatch_share(a: &Frame, b: &Frame) -> f64 {
-    let n = a.pixels.iter().zip(&b.pixels).filter(|(p, q)| p.object_id != q.object_id).count();
+    let n = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .filter(|(p, q)| p.object_id != q.object_id)
+        .count();
     n as f64 / a.pixels.len() as f64
 }
 
@@ -62,7 +67,10 @@ fn objects_moving_at_v_equal_camera_moving_at_minus_v() {
     let (t0, x0) = (14.0, DVec3::new(0.5, -3.0, 0.7));
     // Scene A: world = the camera's frame; the group moves at v; the light moves with the group.
     let a_text = scene_text(
-        &format!("position = [{}, {}, {}]\ntime = {t0}\ndirection = [0.1, 1, 0.05]", x0.x, x0.y, x0.z),
+        &format!(
+            "position = [{}, {}, {}]\ntime = {t0}\ndirection = [0.1, 1, 0.05]",
+            x0.x, x0.y, x0.z
+        ),
         v,
         "position = [3, 2, 8]\ngroup = \"g\"",
     );
@@ -80,9 +88,16 @@ fn objects_moving_at_v_equal_camera_moving_at_minus_v() {
         let a = render_with(&scene(&a_text), backend);
         let b = render_with(&scene(&b_text), backend);
         let hit = a.pixels.iter().filter(|p| p.object_id != 0).count();
-        assert!(hit > a.pixels.len() / 25, "the objects must fill part of the image ({hit} px)");
+        assert!(
+            hit > a.pixels.len() / 25,
+            "the objects must fill part of the image ({hit} px)"
+        );
         let share = mismatch_share(&a, &b);
-        assert!(share < 0.002, "{backend}: {:.3}% of pixels see another object", share * 100.0);
+        assert!(
+            share < 0.002,
+            "{backend}: {:.3}% of pixels see another object",
+            share * 100.0
+        );
         let mut worst_color = 0.0f32;
         let mut worst_doppler = 0.0f32;
         for (p, q) in a.pixels.iter().zip(&b.pixels) {
@@ -93,8 +108,14 @@ fn objects_moving_at_v_equal_camera_moving_at_minus_v() {
                 }
             }
         }
-        assert!(worst_doppler < 1e-5, "{backend}: Doppler differs by {worst_doppler}");
-        assert!(worst_color < 2e-3, "{backend}: colour differs by {worst_color}");
+        assert!(
+            worst_doppler < 1e-5,
+            "{backend}: Doppler differs by {worst_doppler}"
+        );
+        assert!(
+            worst_color < 2e-3,
+            "{backend}: colour differs by {worst_color}"
+        );
     }
 }
 
@@ -114,7 +135,9 @@ fn beta_zero_is_the_classical_picture() {
     let classical: Vec<u32> = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .map(|(x, y)| {
-            let d = (f * cam.forward + (x as f64 + 0.5 - w as f64 / 2.0) * cam.right + (h as f64 / 2.0 - y as f64 - 0.5) * cam.up)
+            let d = (f * cam.forward
+                + (x as f64 + 0.5 - w as f64 / 2.0) * cam.right
+                + (h as f64 / 2.0 - y as f64 - 0.5) * cam.up)
                 .normalize();
             let mut best = (f64::INFINITY, 0u32);
             for (i, p) in geo.prims.iter().enumerate() {
@@ -127,7 +150,12 @@ fn beta_zero_is_the_classical_picture() {
         .collect();
     for backend in backends() {
         let frame = render_with(&s, backend);
-        let differ = frame.pixels.iter().zip(&classical).filter(|(p, c)| p.object_id != **c).count();
+        let differ = frame
+            .pixels
+            .iter()
+            .zip(&classical)
+            .filter(|(p, c)| p.object_id != **c)
+            .count();
         assert!(
             differ as f64 <= 0.001 * frame.pixels.len() as f64,
             "{backend}: {differ} pixels differ from the classical picture"
@@ -147,7 +175,11 @@ fn beta_zero_is_the_classical_picture() {
 
 #[test]
 fn rendering_is_reproducible_with_samples() {
-    let text = scene_text("position = [0, -3, 0]\ndirection = [0, 1, 0]", DVec3::new(0.8, 0.0, 0.0), "position = [3, 2, 8]");
+    let text = scene_text(
+        "position = [0, -3, 0]\ndirection = [0, 1, 0]",
+        DVec3::new(0.8, 0.0, 0.0),
+        "position = [3, 2, 8]",
+    );
     let s = scene(&text.replace("height = 120", "height = 120\nsamples = 5"));
     for backend in backends() {
         let a = render_with(&s, backend);
@@ -155,6 +187,9 @@ fn rendering_is_reproducible_with_samples() {
         assert_eq!(a, b, "identical input, identical output");
         let covered: f32 = a.pixels.iter().map(|p| p.alpha).sum();
         assert!(covered > 0.0);
-        assert!(a.pixels.iter().any(|p| p.alpha > 0.0 && p.alpha < 1.0), "anti-aliased edges have partial alpha");
+        assert!(
+            a.pixels.iter().any(|p| p.alpha > 0.0 && p.alpha < 1.0),
+            "anti-aliased edges have partial alpha"
+        );
     }
 }

@@ -19,13 +19,26 @@ fn boost_then_inverse_is_identity_and_interval_is_preserved() {
     for _ in 0..5000 {
         let v = random_velocity(&mut r);
         let b = Boost::to_rest(&v);
-        let e = Event::new(r.range(-10.0, 10.0), DVec3::new(r.range(-10.0, 10.0), r.range(-10.0, 10.0), r.range(-10.0, 10.0)));
+        let e = Event::new(
+            r.range(-10.0, 10.0),
+            DVec3::new(
+                r.range(-10.0, 10.0),
+                r.range(-10.0, 10.0),
+                r.range(-10.0, 10.0),
+            ),
+        );
         let e2 = b.inverse().event(b.event(e));
         let scale = v.gamma().powi(2) * 40.0;
-        assert!((e2.t - e.t).abs() < 1e-14 * scale && (e2.x - e.x).length() < 1e-14 * scale, "{e:?} -> {e2:?} for {v:?}");
+        assert!(
+            (e2.t - e.t).abs() < 1e-14 * scale && (e2.x - e.x).length() < 1e-14 * scale,
+            "{e:?} -> {e2:?} for {v:?}"
+        );
         let e1 = b.event(e);
         let mag = (e1.t.abs() + e1.x.length()).powi(2);
-        assert!((e1.interval() - e.interval()).abs() <= 1e-14 * mag.max(1.0), "interval not preserved");
+        assert!(
+            (e1.interval() - e.interval()).abs() <= 1e-14 * mag.max(1.0),
+            "interval not preserved"
+        );
     }
 }
 
@@ -40,17 +53,40 @@ fn null_stays_null_and_view_dir_is_unit() {
         assert_rel(d.length(), s, 1e-13, "|d'| = s (null)");
         // Same as the plain 4-vector boost: s = γ(1 + β·a).
         let expect = v.gamma() * (1.0 + v.beta_vec().dot(a));
-        assert!((s - expect).abs() <= 1e-12 * v.gamma() * 2.0, "s {s} vs {expect}");
+        assert!(
+            (s - expect).abs() <= 1e-12 * v.gamma() * 2.0,
+            "s {s} vs {expect}"
+        );
     }
 }
 
 #[test]
 fn aberration_table_1_1() {
     let table = [
-        (0.1, [0.0, 27.248028, 55.150095, 84.260830, 114.901062, 146.998369, 178.894465, 180.0]),
-        (0.5, [0.0, 17.587954, 36.869898, 60.000000, 90.000000, 130.207819, 178.268037, 180.0]),
-        (0.9, [0.0, 7.035292, 15.090185, 25.841933, 43.341758, 81.139693, 175.643091, 180.0]),
-        (0.99, [0.0, 2.176338, 4.687304, 8.109614, 13.999691, 29.637130, 165.963531, 180.0]),
+        (
+            0.1,
+            [
+                0.0, 27.248028, 55.150095, 84.260830, 114.901062, 146.998369, 178.894465, 180.0,
+            ],
+        ),
+        (
+            0.5,
+            [
+                0.0, 17.587954, 36.869898, 60.000000, 90.000000, 130.207819, 178.268037, 180.0,
+            ],
+        ),
+        (
+            0.9,
+            [
+                0.0, 7.035292, 15.090185, 25.841933, 43.341758, 81.139693, 175.643091, 180.0,
+            ],
+        ),
+        (
+            0.99,
+            [
+                0.0, 2.176338, 4.687304, 8.109614, 13.999691, 29.637130, 165.963531, 180.0,
+            ],
+        ),
     ];
     let thetas: [f64; 8] = [0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 179.0, 180.0];
     for (beta, expect) in table {
@@ -73,7 +109,12 @@ fn aberration_table_1_1() {
         for (th, want) in [0.0f64, 45.0, 90.0, 135.0, 180.0].iter().zip(expect) {
             let t = th.to_radians();
             let (a, _) = b.view_dir(DVec3::new(t.cos(), t.sin(), 0.0));
-            assert_close(a.y.atan2(a.x).to_degrees(), want, 2e-5, &format!("inverse beta {beta} theta' {th}"));
+            assert_close(
+                a.y.atan2(a.x).to_degrees(),
+                want,
+                2e-5,
+                &format!("inverse beta {beta} theta' {th}"),
+            );
         }
     }
 }
@@ -81,8 +122,18 @@ fn aberration_table_1_1() {
 #[test]
 fn vector_forms_1_2() {
     let cases = [
-        (DVec3::new(0.6, 0.0, 0.0), DVec3::Y, DVec3::new(0.6, 0.8, 0.0), 0.8),
-        (DVec3::new(0.3, 0.4, 0.0), DVec3::Z, DVec3::new(0.3, 0.4, 0.866025403784), 0.866025403784),
+        (
+            DVec3::new(0.6, 0.0, 0.0),
+            DVec3::Y,
+            DVec3::new(0.6, 0.8, 0.0),
+            0.8,
+        ),
+        (
+            DVec3::new(0.3, 0.4, 0.0),
+            DVec3::Z,
+            DVec3::new(0.3, 0.4, 0.866025403784),
+            0.866025403784,
+        ),
         (
             DVec3::new(0.0, 0.0, -0.9),
             DVec3::ONE / 3f64.sqrt(),
@@ -121,10 +172,30 @@ fn compose(boosts: &[Boost], e: Event) -> Event {
 #[test]
 fn wigner_rotation_1_4() {
     let table = [
-        (DVec3::new(0.6, 0.0, 0.0), DVec3::new(0.0, 0.8, 0.0), DVec3::new(0.6, 0.64, 0.0), 18.9246444161),
-        (DVec3::new(0.9, 0.0, 0.0), DVec3::new(0.0, 0.9, 0.0), DVec3::new(0.9, 0.392300904919, 0.0), 42.8961988683),
-        (DVec3::new(0.99, 0.0, 0.0), DVec3::new(0.0, 0.99, 0.0), DVec3::new(0.99, 0.139656686199, 0.0), 73.9408376112),
-        (DVec3::new(0.5, 0.0, 0.0), DVec3::new(0.3, 0.4, 0.0), DVec3::new(0.695652173913, 0.301226227403, 0.0), 6.3036534614),
+        (
+            DVec3::new(0.6, 0.0, 0.0),
+            DVec3::new(0.0, 0.8, 0.0),
+            DVec3::new(0.6, 0.64, 0.0),
+            18.9246444161,
+        ),
+        (
+            DVec3::new(0.9, 0.0, 0.0),
+            DVec3::new(0.0, 0.9, 0.0),
+            DVec3::new(0.9, 0.392300904919, 0.0),
+            42.8961988683,
+        ),
+        (
+            DVec3::new(0.99, 0.0, 0.0),
+            DVec3::new(0.0, 0.99, 0.0),
+            DVec3::new(0.99, 0.139656686199, 0.0),
+            73.9408376112,
+        ),
+        (
+            DVec3::new(0.5, 0.0, 0.0),
+            DVec3::new(0.3, 0.4, 0.0),
+            DVec3::new(0.695652173913, 0.301226227403, 0.0),
+            6.3036534614,
+        ),
         (
             DVec3::new(0.3, 0.2, 0.1),
             DVec3::new(-0.2, 0.5, 0.4),
@@ -138,7 +209,10 @@ fn wigner_rotation_1_4() {
         // The S2 origin at S2-time 1, written in S0: (γ_w, γ_w w).
         let o = compose(&[l2.inverse(), l1.inverse()], Event::new(1.0, DVec3::ZERO));
         let w = o.x / o.t;
-        assert!((w - w_expect).length() < 1e-11, "w = {w}, expected {w_expect}");
+        assert!(
+            (w - w_expect).length() < 1e-11,
+            "w = {w}, expected {w_expect}"
+        );
         // R = Λ(β2) Λ(β1) Λ(w)^-1 is a pure rotation by ω about β1 × β2.
         let lw = Boost::to_rest(&Velocity::from_beta_vec(w).unwrap());
         let axis = b1.cross(b2).normalize();
@@ -153,10 +227,30 @@ fn wigner_rotation_1_4() {
 #[test]
 fn doppler_table_5_1() {
     let table = [
-        (0.1, [1.10554, 1.08933, 1.04736, 0.99499, 0.94761, 0.91569, 0.90453]),
-        (0.5, [1.73205, 1.52742, 1.15470, 0.86603, 0.69282, 0.60434, 0.57735]),
-        (0.9, [4.35890, 1.97613, 0.79253, 0.43589, 0.30061, 0.24496, 0.22942]),
-        (0.99, [14.10674, 0.98901, 0.27934, 0.14107, 0.09436, 0.07595, 0.07089]),
+        (
+            0.1,
+            [
+                1.10554, 1.08933, 1.04736, 0.99499, 0.94761, 0.91569, 0.90453,
+            ],
+        ),
+        (
+            0.5,
+            [
+                1.73205, 1.52742, 1.15470, 0.86603, 0.69282, 0.60434, 0.57735,
+            ],
+        ),
+        (
+            0.9,
+            [
+                4.35890, 1.97613, 0.79253, 0.43589, 0.30061, 0.24496, 0.22942,
+            ],
+        ),
+        (
+            0.99,
+            [
+                14.10674, 0.98901, 0.27934, 0.14107, 0.09436, 0.07595, 0.07089,
+            ],
+        ),
     ];
     for (beta, ds) in table {
         for (k, want) in ds.iter().enumerate() {
@@ -165,7 +259,12 @@ fn doppler_table_5_1() {
             let a = -DVec3::new(tk.cos(), tk.sin(), 0.0);
             let (_, s) = Boost::to_rest(&vx(beta)).null_dir(a);
             // The table is rounded to 5 decimals.
-            assert_close(1.0 / s, *want, 6e-6, &format!("D at beta {beta}, theta_k {}", 30 * k));
+            assert_close(
+                1.0 / s,
+                *want,
+                6e-6,
+                &format!("D at beta {beta}, theta_k {}", 30 * k),
+            );
         }
     }
 }
@@ -174,16 +273,33 @@ fn doppler_table_5_1() {
 fn speed_forms_agree_and_stay_exact_near_light_8() {
     // γ for ε = 1 − β = 1e-12 is 707106.781186724 (PHYSICS.md §8.1).
     let v = Velocity::from_one_minus_beta(DVec3::X, 1e-12).unwrap();
-    assert_rel(v.gamma(), 707106.781186724, 1e-13, "gamma from one_minus_beta");
+    assert_rel(
+        v.gamma(),
+        707106.781186724,
+        1e-13,
+        "gamma from one_minus_beta",
+    );
     assert_rel(v.one_minus_beta(), 1e-12, 1e-12, "1 - beta round trip");
     let r = Velocity::from_rapidity(DVec3::X, v.rapidity()).unwrap();
     assert_eq!(r, v);
     let b = Velocity::from_beta(DVec3::X, 0.6).unwrap();
     assert_rel(b.gamma(), 1.25, 1e-15, "gamma(0.6)");
-    assert_rel(Velocity::from_one_minus_beta(DVec3::X, 0.4).unwrap().gamma(), 1.25, 1e-15, "gamma via eps");
+    assert_rel(
+        Velocity::from_one_minus_beta(DVec3::X, 0.4)
+            .unwrap()
+            .gamma(),
+        1.25,
+        1e-15,
+        "gamma via eps",
+    );
     // Head-on Doppler e^φ and boosting a near-light-like event (t = x = 1000).
     let e = Boost::to_rest(&v).event(Event::new(1000.0, DVec3::new(1000.0, 0.0, 0.0)));
-    assert_rel(e.t, 7.071067811867e-4, 1e-11, "t' of a near-light-like event");
+    assert_rel(
+        e.t,
+        7.071067811867e-4,
+        1e-11,
+        "t' of a near-light-like event",
+    );
     let (_, s) = Boost::to_rest(&v).null_dir(-DVec3::X);
     assert_rel(1.0 / s, (v.rapidity()).exp(), 1e-14, "head-on Doppler");
     // Aberration near 180°: true angle 168.578813725° (naive formula gives 168.583223°). The
@@ -191,7 +307,12 @@ fn speed_forms_agree_and_stay_exact_near_light_8() {
     // 1.414e-7 exactly the true answer is 168.5805270°).
     let th = std::f64::consts::PI - 2f64.sqrt() * 1e-7;
     let (a, _) = Boost::to_rest(&v).view_dir(DVec3::new(th.cos(), th.sin(), 0.0));
-    assert_close(a.y.atan2(a.x).to_degrees(), 168.578813725, 1e-6, "aberration near 180");
+    assert_close(
+        a.y.atan2(a.x).to_degrees(),
+        168.578813725,
+        1e-6,
+        "aberration near 180",
+    );
     // Speeds of 1 and beyond are refused, not rounded.
     assert!(Velocity::from_beta(DVec3::X, 1.0).is_err());
     assert!(Velocity::from_beta_vec(DVec3::new(0.8, 0.7, 0.0)).is_err());

@@ -149,9 +149,7 @@ impl Bvh {
         let mut stack = [0u32; 64];
         let mut sp = 0usize;
         let root = &self.nodes[0];
-        if root.bounds.clip(ray.origin, inv, ray.tmin, tmax).is_none() {
-            return None;
-        }
+        root.bounds.clip(ray.origin, inv, ray.tmin, tmax)?;
         let mut node = 0u32;
         loop {
             let n = &self.nodes[node as usize];

@@ -6,8 +6,12 @@
 //! groups compare directly (DESIGN.md, "the one trick").
 
 mod bvh;
+#[cfg(feature = "embree")]
+mod embree;
 
 pub use bvh::{Bvh, BvhBackend};
+#[cfg(feature = "embree")]
+pub use embree::EmbreeBackend;
 
 use crate::geometry::{Aabb, Geometry};
 use glam::DVec3;
@@ -54,7 +58,11 @@ pub trait Backend: Send + Sync {
 
 /// The names `--backend` accepts in this build, default first.
 pub fn backend_names() -> Vec<&'static str> {
-    vec!["bvh"]
+    if cfg!(feature = "embree") {
+        vec!["embree", "bvh"]
+    } else {
+        vec!["bvh"]
+    }
 }
 
 pub fn default_backend_name() -> &'static str {
@@ -65,6 +73,9 @@ pub fn default_backend_name() -> &'static str {
 pub fn backend_by_name(name: &str) -> Result<Box<dyn Backend>, String> {
     match name {
         "bvh" => Ok(Box::new(BvhBackend)),
+        #[cfg(feature = "embree")]
+        "embree" => Ok(Box::new(EmbreeBackend::new())),
+        #[cfg(not(feature = "embree"))]
         "embree" => Err(
             "backend 'embree' is not in this build: rebuild with `--features embree` (needs libembree-dev and libclang-dev)"
                 .to_string(),

@@ -15,8 +15,10 @@ pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), String> {
             )
         })
         .collect();
-    let mut attrs = LayerAttributes::default();
-    attrs.software_name = Some(Text::from("rest-embree"));
+    let attrs = LayerAttributes {
+        software_name: Some(Text::from("rest-embree")),
+        ..Default::default()
+    };
     let layer = Layer::new(
         size,
         attrs,
@@ -29,10 +31,11 @@ pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), String> {
         .map_err(|e| e.to_string())
 }
 
-/// Every channel of the first layer of an EXR file, by name, as f32 in row-major order.
-pub fn read_channels(
-    path: &Path,
-) -> std::result::Result<(usize, usize, HashMap<String, Vec<f32>>), String> {
+/// Width, height and every channel by name (f32, row-major) of an EXR file's first layer.
+pub type Channels = (usize, usize, HashMap<String, Vec<f32>>);
+
+/// Every channel of the first layer of an EXR file.
+pub fn read_channels(path: &Path) -> std::result::Result<Channels, String> {
     let image = read()
         .no_deep_data()
         .largest_resolution_level()

@@ -99,12 +99,9 @@ impl World {
             batch.clear();
             meta.clear();
             for (i, r) in rays.iter().enumerate() {
-                match self.rest_ray(g, r, tmin, best[i]) {
-                    Some(rr) => {
-                        batch.push(rr.ray);
-                        meta.push((i, rr.shift, rr.s));
-                    }
-                    None => {}
+                if let Some(rr) = self.rest_ray(g, r, tmin, best[i]) {
+                    batch.push(rr.ray);
+                    meta.push((i, rr.shift, rr.s));
                 }
             }
             if batch.is_empty() {

@@ -231,20 +231,36 @@ fn camera(t: &Table) -> R<Camera> {
     let up = right.cross(forward);
     // Both projections' keys are read whichever is chosen, so a scene can switch projection
     // with --set and keep its file valid.
-    let fov_y = t.f64_where("fov_y", Some(40.0), |v| v > 0.0 && v < 180.0, "between 0 and 180 degrees")?;
+    let fov_y = t.f64_where(
+        "fov_y",
+        Some(40.0),
+        |v| v > 0.0 && v < 180.0,
+        "between 0 and 180 degrees",
+    )?;
     let view_height = t.f64("view_height")?;
     if let Some(h) = view_height.filter(|&h| h <= 0.0) {
         return Err(t.error("view_height", format!("must be greater than 0 (got {h})")));
     }
     let projection = match t.string("projection")?.unwrap_or("pinhole") {
-        "pinhole" | "perspective" => Projection::Pinhole { fov_y: fov_y.to_radians() },
+        "pinhole" | "perspective" => Projection::Pinhole {
+            fov_y: fov_y.to_radians(),
+        },
         "orthographic" => Projection::Orthographic {
-            view_height: view_height.ok_or_else(|| t.error("view_height", "missing: an orthographic camera needs view_height (world units)"))?,
+            view_height: view_height.ok_or_else(|| {
+                t.error(
+                    "view_height",
+                    "missing: an orthographic camera needs view_height (world units)",
+                )
+            })?,
         },
         "equirectangular" => Projection::Equirectangular,
         other => {
             let n = t.get("projection").expect("read above");
-            return Err(t.error_at(n, "projection", format!("unknown projection `{other}` (pinhole, orthographic, equirectangular)")));
+            return Err(t.error_at(
+                n,
+                "projection",
+                format!("unknown projection `{other}` (pinhole, orthographic, equirectangular)"),
+            ));
         }
     };
     let time = t.f64_or("time", 0.0)?;

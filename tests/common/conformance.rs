@@ -44,58 +44,181 @@ fn occ(a: &dyn Accelerator, r: Ray) -> bool {
 
 fn expect_t(a: &dyn Accelerator, r: Ray, t: f64, tol: &Tolerance, what: &str) {
     let h = one(a, r).unwrap_or_else(|| panic!("{what}: expected a hit at t = {t}, got none"));
-    assert!((h.t - t).abs() <= tol.t_rel * t.abs().max(1.0), "{what}: t = {}, expected {t}", h.t);
+    assert!(
+        (h.t - t).abs() <= tol.t_rel * t.abs().max(1.0),
+        "{what}: t = {}, expected {t}",
+        h.t
+    );
 }
 
 pub fn analytic_hits(backend: &dyn Backend, tol: &Tolerance) {
-    let sphere = build(backend, vec![Primitive::Sphere { center: DVec3::new(0.0, 0.0, 10.0), radius: 1.0 }]);
-    expect_t(&*sphere, ray(DVec3::ZERO, DVec3::Z), 9.0, tol, "sphere, unit direction");
+    let sphere = build(
+        backend,
+        vec![Primitive::Sphere {
+            center: DVec3::new(0.0, 0.0, 10.0),
+            radius: 1.0,
+        }],
+    );
+    expect_t(
+        &*sphere,
+        ray(DVec3::ZERO, DVec3::Z),
+        9.0,
+        tol,
+        "sphere, unit direction",
+    );
     // Unnormalised directions: t is in units of the direction's length (lookback time).
-    expect_t(&*sphere, ray(DVec3::ZERO, 2.0 * DVec3::Z), 4.5, tol, "sphere, direction of length 2");
-    expect_t(&*sphere, ray(DVec3::new(0.0, 0.0, 10.0), DVec3::Z), 1.0, tol, "sphere from inside");
-    assert!(one(&*sphere, ray(DVec3::new(1.01, 0.0, 0.0), DVec3::Z)).is_none(), "sphere: ray passing by");
-    assert!(one(&*sphere, ray(DVec3::ZERO, -DVec3::Z)).is_none(), "sphere behind the ray");
+    expect_t(
+        &*sphere,
+        ray(DVec3::ZERO, 2.0 * DVec3::Z),
+        4.5,
+        tol,
+        "sphere, direction of length 2",
+    );
+    expect_t(
+        &*sphere,
+        ray(DVec3::new(0.0, 0.0, 10.0), DVec3::Z),
+        1.0,
+        tol,
+        "sphere from inside",
+    );
+    assert!(
+        one(&*sphere, ray(DVec3::new(1.01, 0.0, 0.0), DVec3::Z)).is_none(),
+        "sphere: ray passing by"
+    );
+    assert!(
+        one(&*sphere, ray(DVec3::ZERO, -DVec3::Z)).is_none(),
+        "sphere behind the ray"
+    );
 
     let rod = build(
         backend,
-        vec![Primitive::Capsule { a: DVec3::new(-1.0, 0.0, 5.0), b: DVec3::new(1.0, 0.0, 5.0), radius: 0.5 }],
+        vec![Primitive::Capsule {
+            a: DVec3::new(-1.0, 0.0, 5.0),
+            b: DVec3::new(1.0, 0.0, 5.0),
+            radius: 0.5,
+        }],
     );
     expect_t(&*rod, ray(DVec3::ZERO, DVec3::Z), 4.5, tol, "rod side");
     let cap = 5.0 - (0.25f64 - 0.04).sqrt();
-    expect_t(&*rod, ray(DVec3::new(1.2, 0.0, 0.0), DVec3::Z), cap, tol, "rod round cap");
-    assert!(one(&*rod, ray(DVec3::new(1.6, 0.0, 0.0), DVec3::Z)).is_none(), "rod: beyond the cap");
+    expect_t(
+        &*rod,
+        ray(DVec3::new(1.2, 0.0, 0.0), DVec3::Z),
+        cap,
+        tol,
+        "rod round cap",
+    );
+    assert!(
+        one(&*rod, ray(DVec3::new(1.6, 0.0, 0.0), DVec3::Z)).is_none(),
+        "rod: beyond the cap"
+    );
+    expect_t(
+        &*rod,
+        ray(DVec3::new(0.2, 0.0, 5.0), DVec3::Z),
+        0.5,
+        tol,
+        "rod from inside",
+    );
 
     let cube = build(
         backend,
-        vec![Primitive::Cuboid { min: DVec3::new(-1.0, -1.0, 4.0), max: DVec3::new(1.0, 1.0, 6.0) }],
+        vec![Primitive::Cuboid {
+            min: DVec3::new(-1.0, -1.0, 4.0),
+            max: DVec3::new(1.0, 1.0, 6.0),
+        }],
     );
-    expect_t(&*cube, ray(DVec3::new(0.3, -0.2, 0.0), DVec3::Z), 4.0, tol, "box front face");
-    expect_t(&*cube, ray(DVec3::new(5.0, 0.5, 5.0), -DVec3::X), 4.0, tol, "box side face");
-    expect_t(&*cube, ray(DVec3::new(0.0, 0.0, 5.0), DVec3::Z), 1.0, tol, "box from inside");
+    expect_t(
+        &*cube,
+        ray(DVec3::new(0.3, -0.2, 0.0), DVec3::Z),
+        4.0,
+        tol,
+        "box front face",
+    );
+    expect_t(
+        &*cube,
+        ray(DVec3::new(5.0, 0.5, 5.0), -DVec3::X),
+        4.0,
+        tol,
+        "box side face",
+    );
+    expect_t(
+        &*cube,
+        ray(DVec3::new(0.0, 0.0, 5.0), DVec3::Z),
+        1.0,
+        tol,
+        "box from inside",
+    );
 
     let tri = build(
         backend,
-        vec![Primitive::Triangle { v: [DVec3::new(-1.0, -1.0, 3.0), DVec3::new(1.0, -1.0, 3.0), DVec3::new(0.0, 1.0, 3.0)] }],
+        vec![Primitive::Triangle {
+            v: [
+                DVec3::new(-1.0, -1.0, 3.0),
+                DVec3::new(1.0, -1.0, 3.0),
+                DVec3::new(0.0, 1.0, 3.0),
+            ],
+        }],
     );
     expect_t(&*tri, ray(DVec3::ZERO, DVec3::Z), 3.0, tol, "triangle");
-    expect_t(&*tri, ray(DVec3::new(0.0, 0.0, 6.0), -DVec3::Z), 3.0, tol, "triangle, back side");
-    assert!(one(&*tri, ray(DVec3::new(0.9, 0.9, 0.0), DVec3::Z)).is_none(), "triangle: outside the edge");
+    expect_t(
+        &*tri,
+        ray(DVec3::new(0.0, 0.0, 6.0), -DVec3::Z),
+        3.0,
+        tol,
+        "triangle, back side",
+    );
+    assert!(
+        one(&*tri, ray(DVec3::new(0.9, 0.9, 0.0), DVec3::Z)).is_none(),
+        "triangle: outside the edge"
+    );
 }
 
 pub fn interval_and_mask_rules(backend: &dyn Backend, _tol: &Tolerance) {
-    let a = build(backend, vec![Primitive::Cuboid { min: DVec3::new(-1.0, -1.0, 4.0), max: DVec3::new(1.0, 1.0, 6.0) }]);
+    let a = build(
+        backend,
+        vec![Primitive::Cuboid {
+            min: DVec3::new(-1.0, -1.0, 4.0),
+            max: DVec3::new(1.0, 1.0, 6.0),
+        }],
+    );
     let base = ray(DVec3::ZERO, DVec3::Z);
-    assert!(one(&*a, Ray { tmax: 3.9, ..base }).is_none(), "tmax before the hit");
-    assert!(!occ(&*a, Ray { tmax: 3.9, ..base }), "occlusion: tmax before the hit");
-    assert!(occ(&*a, Ray { tmax: 4.1, ..base }), "occlusion: tmax past the hit");
+    assert!(
+        one(&*a, Ray { tmax: 3.9, ..base }).is_none(),
+        "tmax before the hit"
+    );
+    assert!(
+        !occ(&*a, Ray { tmax: 3.9, ..base }),
+        "occlusion: tmax before the hit"
+    );
+    assert!(
+        occ(&*a, Ray { tmax: 4.1, ..base }),
+        "occlusion: tmax past the hit"
+    );
     let far = one(&*a, Ray { tmin: 4.5, ..base }).expect("tmin past the entry finds the exit");
     assert!((far.t - 6.0).abs() < 1e-3, "exit at 6, got {}", far.t);
-    assert!(one(&*a, Ray { tmin: 7.0, ..base }).is_none(), "tmin past everything");
+    assert!(
+        one(&*a, Ray { tmin: 7.0, ..base }).is_none(),
+        "tmin past everything"
+    );
     // A masked ray (tmin > tmax) is skipped and reported as no hit, even next to active ones.
-    let rays = [Ray { tmin: 1.0, tmax: 0.0, ..base }, base, Ray { tmin: 1.0, tmax: 0.0, ..base }];
+    let rays = [
+        Ray {
+            tmin: 1.0,
+            tmax: 0.0,
+            ..base
+        },
+        base,
+        Ray {
+            tmin: 1.0,
+            tmax: 0.0,
+            ..base
+        },
+    ];
     let mut hits = [Some(Hit { t: -1.0, prim: 99 }); 3];
     a.intersect(&rays, &mut hits);
-    assert!(hits[0].is_none() && hits[2].is_none() && hits[1].is_some(), "{hits:?}");
+    assert!(
+        hits[0].is_none() && hits[2].is_none() && hits[1].is_some(),
+        "{hits:?}"
+    );
     let mut o = [true; 3];
     a.occluded(&rays, &mut o);
     assert_eq!(o, [false, true, false]);
@@ -104,15 +227,35 @@ pub fn interval_and_mask_rules(backend: &dyn Backend, _tol: &Tolerance) {
 fn random_scene(r: &mut Rng, n: usize) -> Vec<Primitive> {
     (0..n)
         .map(|i| {
-            let c = DVec3::new(r.range(-10.0, 10.0), r.range(-10.0, 10.0), r.range(-10.0, 10.0));
+            let c = DVec3::new(
+                r.range(-10.0, 10.0),
+                r.range(-10.0, 10.0),
+                r.range(-10.0, 10.0),
+            );
             match i % 4 {
-                0 => Primitive::Sphere { center: c, radius: r.range(0.05, 0.6) },
-                1 => Primitive::Capsule { a: c, b: c + r.unit() * r.range(0.2, 2.0), radius: r.range(0.03, 0.3) },
+                0 => Primitive::Sphere {
+                    center: c,
+                    radius: r.range(0.05, 0.6),
+                },
+                1 => Primitive::Capsule {
+                    a: c,
+                    b: c + r.unit() * r.range(0.2, 2.0),
+                    radius: r.range(0.03, 0.3),
+                },
                 2 => {
                     let h = DVec3::new(r.range(0.05, 0.5), r.range(0.05, 0.5), r.range(0.05, 0.5));
-                    Primitive::Cuboid { min: c - h, max: c + h }
+                    Primitive::Cuboid {
+                        min: c - h,
+                        max: c + h,
+                    }
                 }
-                _ => Primitive::Triangle { v: [c, c + r.unit() * r.range(0.3, 1.5), c + r.unit() * r.range(0.3, 1.5)] },
+                _ => Primitive::Triangle {
+                    v: [
+                        c,
+                        c + r.unit() * r.range(0.3, 1.5),
+                        c + r.unit() * r.range(0.3, 1.5),
+                    ],
+                },
             }
         })
         .collect()
@@ -135,7 +278,11 @@ pub fn agrees_with_brute_force(backend: &dyn Backend, tol: &Tolerance) {
     let a = build(backend, prims.clone());
     let rays: Vec<Ray> = (0..4000)
         .map(|_| {
-            let o = DVec3::new(r.range(-20.0, 20.0), r.range(-20.0, 20.0), r.range(-20.0, 20.0));
+            let o = DVec3::new(
+                r.range(-20.0, 20.0),
+                r.range(-20.0, 20.0),
+                r.range(-20.0, 20.0),
+            );
             let target = DVec3::new(r.range(-8.0, 8.0), r.range(-8.0, 8.0), r.range(-8.0, 8.0));
             // Lengths other than 1, as the boosted rays have.
             ray(o, (target - o).normalize() * r.range(0.1, 5.0))
@@ -154,7 +301,8 @@ pub fn agrees_with_brute_force(backend: &dyn Backend, tol: &Tolerance) {
             (Some(h), Some((t, p))) => {
                 if (h.t - t).abs() > tol.t_rel * t.abs().max(1.0) {
                     // A different primitive at nearly the same t is a tie, not an error.
-                    let other = prims[h.prim as usize].intersect(rr.origin, rr.dir, 0.0, f64::INFINITY);
+                    let other =
+                        prims[h.prim as usize].intersect(rr.origin, rr.dir, 0.0, f64::INFINITY);
                     assert!(
                         other.is_some_and(|o| (o - h.t).abs() <= tol.t_rel * t.max(1.0)),
                         "ray {k}: t = {} on prim {}, brute force t = {t} on prim {p}",
@@ -171,9 +319,16 @@ pub fn agrees_with_brute_force(backend: &dyn Backend, tol: &Tolerance) {
             mismatches += 1;
         }
     }
-    assert!(hit_count > 1000, "the random scene must be hit often enough to test anything ({hit_count})");
+    assert!(
+        hit_count > 1000,
+        "the random scene must be hit often enough to test anything ({hit_count})"
+    );
     let share = mismatches as f64 / rays.len() as f64;
-    assert!(share <= tol.mismatch, "{mismatches} of {} rays disagree with brute force", rays.len());
+    assert!(
+        share <= tol.mismatch,
+        "{mismatches} of {} rays disagree with brute force",
+        rays.len()
+    );
 }
 
 pub fn batches_match_single_rays(backend: &dyn Backend, _tol: &Tolerance) {
@@ -196,7 +351,9 @@ pub fn batches_match_single_rays(backend: &dyn Backend, _tol: &Tolerance) {
 }
 
 pub fn empty_geometry(backend: &dyn Backend, _tol: &Tolerance) {
-    let a = backend.build(Arc::new(Geometry::default())).expect("empty geometry builds");
+    let a = backend
+        .build(Arc::new(Geometry::default()))
+        .expect("empty geometry builds");
     assert!(one(&*a, ray(DVec3::ZERO, DVec3::Z)).is_none());
     assert!(!occ(&*a, ray(DVec3::ZERO, DVec3::Z)));
 }

@@ -23,7 +23,11 @@ impl Rng {
     }
     pub fn unit(&mut self) -> DVec3 {
         loop {
-            let v = DVec3::new(self.range(-1.0, 1.0), self.range(-1.0, 1.0), self.range(-1.0, 1.0));
+            let v = DVec3::new(
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+            );
             let l = v.length();
             if l > 0.1 && l <= 1.0 {
                 return v / l;
@@ -33,11 +37,17 @@ impl Rng {
 }
 
 pub fn assert_close(a: f64, b: f64, tol: f64, what: &str) {
-    assert!((a - b).abs() <= tol, "{what}: got {a}, expected {b} (tolerance {tol})");
+    assert!(
+        (a - b).abs() <= tol,
+        "{what}: got {a}, expected {b} (tolerance {tol})"
+    );
 }
 
 pub fn assert_rel(a: f64, b: f64, rel: f64, what: &str) {
-    assert!(((a - b) / b).abs() <= rel, "{what}: got {a}, expected {b} (relative tolerance {rel})");
+    assert!(
+        ((a - b) / b).abs() <= rel,
+        "{what}: got {a}, expected {b} (relative tolerance {rel})"
+    );
 }
 
 /// The physics cases of PHYSICS.md (a copy of shared/physics/cases.json).

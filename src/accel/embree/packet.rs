@@ -1,0 +1,186 @@
+//! Ray packets and single rays through Embree's C API.
+
+use super::{EmbreeAccel, EmbreeRay};
+use crate::accel::{Hit, Ray};
+use embree_sys::*;
+use std::cell::Cell;
+
+thread_local! {
+    static FTZ_SET: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Flush-to-zero and denormals-are-zero on this thread (Embree's recommendation), once.
+pub fn flush_denormals() {
+    FTZ_SET.with(|done| {
+        if !done.get() {
+            #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+            #[allow(deprecated)]
+            unsafe {
+                #[cfg(target_arch = "x86")]
+                use std::arch::x86::{_mm_getcsr, _mm_setcsr};
+                #[cfg(target_arch = "x86_64")]
+                use std::arch::x86_64::{_mm_getcsr, _mm_setcsr};
+                _mm_setcsr(_mm_getcsr() | 0x8040);
+            }
+            done.set(true);
+        }
+    });
+}
+
+fn context(coherent: bool) -> RTCIntersectContext {
+    let mut ctx = RTCIntersectContext::default();
+    unsafe { rtcInitIntersectContext(&mut ctx) };
+    if coherent {
+        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    }
+    ctx
+}
+
+macro_rules! packet_fns {
+    ($n:literal, $isect:ident, $occl:ident, $RayHitN:ident, $RayN:ident, $rtc_isect:ident, $rtc_occl:ident) => {
+        impl EmbreeAccel {
+            pub(super) fn $isect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+                let mut rh = $RayHitN::default();
+                let mut valid = Valid([0i32; $n]);
+                let mut er = [EmbreeRay::default(); $n];
+                for (i, r) in rays.iter().enumerate() {
+                    er[i] = self.embree_ray(r);
+                    fill_lane(&mut rh.ray, i, &er[i], &mut valid.0);
+                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+                }
+                let mut ctx = context(true);
+                unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, &mut ctx, &mut rh) };
+                for (i, r) in rays.iter().enumerate() {
+                    hits[i] = if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID {
+                        self.to_hit(
+                            r,
+                            &er[i],
+                            rh.ray.tfar[i],
+                            rh.hit.geomID[i],
+                            rh.hit.primID[i],
+                        )
+                    } else {
+                        None
+                    };
+                }
+            }
+
+            pub(super) fn $occl(&self, rays: &[Ray], out: &mut [bool]) {
+                let mut ray = $RayN::default();
+                let mut valid = Valid([0i32; $n]);
+                for (i, r) in rays.iter().enumerate() {
+                    let e = self.embree_ray(r);
+                    fill_lane(&mut ray, i, &e, &mut valid.0);
+                }
+                let mut ctx = context(true);
+                unsafe { $rtc_occl(valid.0.as_ptr(), self.scene.raw, &mut ctx, &mut ray) };
+                for i in 0..rays.len() {
+                    out[i] = valid.0[i] != 0 && ray.tfar[i] == f32::NEG_INFINITY;
+                }
+            }
+        }
+
+        impl Lane for $RayN {
+            fn set(&mut self, i: usize, e: &EmbreeRay) {
+                self.org_x[i] = e.org[0];
+                self.org_y[i] = e.org[1];
+                self.org_z[i] = e.org[2];
+                self.dir_x[i] = e.dir[0];
+                self.dir_y[i] = e.dir[1];
+                self.dir_z[i] = e.dir[2];
+                self.tnear[i] = e.tnear;
+                self.tfar[i] = e.tfar;
+                self.mask[i] = u32::MAX;
+                self.time[i] = 0.0;
+                self.flags[i] = 0;
+            }
+        }
+    };
+}
+
+/// The valid mask of a packet: Embree reads it with aligned vector loads, so it needs the
+/// packet's alignment (64 bytes covers 8- and 16-wide).
+#[repr(C, align(64))]
+struct Valid<const N: usize>([i32; N]);
+
+trait Lane {
+    fn set(&mut self, i: usize, e: &EmbreeRay);
+}
+
+/// Put a ray in lane i; inactive rays (masked by the caller, e.g. missing the group's bounds)
+/// stay out of the valid mask.
+fn fill_lane<R: Lane>(ray: &mut R, i: usize, e: &EmbreeRay, valid: &mut [i32]) {
+    if e.active {
+        ray.set(i, e);
+        valid[i] = -1;
+    }
+}
+
+packet_fns!(
+    16,
+    intersect16,
+    occluded16,
+    RTCRayHit16,
+    RTCRay16,
+    rtcIntersect16,
+    rtcOccluded16
+);
+packet_fns!(
+    8,
+    intersect8,
+    occluded8,
+    RTCRayHit8,
+    RTCRay8,
+    rtcIntersect8,
+    rtcOccluded8
+);
+
+fn single(e: &EmbreeRay) -> RTCRay {
+    RTCRay {
+        org_x: e.org[0],
+        org_y: e.org[1],
+        org_z: e.org[2],
+        tnear: e.tnear,
+        dir_x: e.dir[0],
+        dir_y: e.dir[1],
+        dir_z: e.dir[2],
+        time: 0.0,
+        tfar: e.tfar,
+        mask: u32::MAX,
+        id: 0,
+        flags: 0,
+    }
+}
+
+impl EmbreeAccel {
+    pub(super) fn intersect1(&self, r: &Ray) -> Option<Hit> {
+        let e = self.embree_ray(r);
+        if !e.active {
+            return None;
+        }
+        let mut rh = RTCRayHit {
+            ray: single(&e),
+            hit: RTCHit {
+                geomID: RTC_INVALID_GEOMETRY_ID,
+                ..Default::default()
+            },
+        };
+        let mut ctx = context(false);
+        unsafe { rtcIntersect1(self.scene.raw, &mut ctx, &mut rh) };
+        if rh.hit.geomID == RTC_INVALID_GEOMETRY_ID {
+            return None;
+        }
+        self.to_hit(r, &e, rh.ray.tfar, rh.hit.geomID, rh.hit.primID)
+    }
+
+    pub(super) fn occluded1(&self, r: &Ray) -> bool {
+        let e = self.embree_ray(r);
+        if !e.active {
+            return false;
+        }
+        let mut ray = single(&e);
+        let mut ctx = context(false);
+        unsafe { rtcOccluded1(self.scene.raw, &mut ctx, &mut ray) };
+        ray.tfar == f32::NEG_INFINITY
+    }
+}
