@@ -155,7 +155,8 @@ fn boost_matrix_1_3() {
     let beta = DVec3::new(0.3, -0.4, 0.5);
     let v = Velocity::from_beta_vec(beta).unwrap();
     let e = Boost::to_rest(&v).event(Event::new(2.0, 2.0 * beta));
-    assert_close(e.t, 1.41421356237, 1e-10, "t'");
+    // 2/γ = 1.41421356 for this β (PHYSICS.md §1.3).
+    assert_close(e.t, std::f64::consts::SQRT_2, 1e-10, "t'");
     assert!(e.x.length() < 1e-14, "worldline maps to x' = 0");
     // Λ(β)^-1 = Λ(−β).
     let w = Event::new(0.7, DVec3::new(-1.0, 2.0, 0.3));
