@@ -7,6 +7,7 @@
 
 pub mod accel;
 pub mod cli;
+pub mod compare;
 pub mod geometry;
 pub mod output;
 pub mod render;

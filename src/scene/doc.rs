@@ -184,7 +184,15 @@ impl Doc {
 
     /// Apply one override `KEY=VALUE`, KEY dotted; entries of arrays of tables are addressed by
     /// their `name` (or by index). `shown` is how errors name the flag, e.g. `--set camera.time=3`.
-    pub fn apply_set(&mut self, shown: &str, assignment: &str) -> Result<(), SceneError> {
+    ///
+    /// `superseded(path, key)` names the keys of the same table that the new key replaces (other
+    /// forms of one setting, e.g. `beta` replaces `velocity`); they are removed.
+    pub fn apply_set(
+        &mut self,
+        shown: &str,
+        assignment: &str,
+        superseded: fn(&[&str], &str) -> &'static [&'static str],
+    ) -> Result<(), SceneError> {
         let shown = shown.to_string();
         let bad = |key: &str, msg: String| SceneError::new(shown.clone(), key, msg);
         let (key, text) = assignment
@@ -216,6 +224,8 @@ impl Doc {
                             Some(p) => entries[p].1 = value,
                             None => entries.push((seg.to_string(), value)),
                         }
+                        let gone = superseded(&segs[..i], seg);
+                        entries.retain(|(k, _)| !gone.contains(&k.as_str()));
                         return Ok(());
                     }
                     let p = match pos {

@@ -39,9 +39,26 @@ pub fn load_str(
 ) -> Result<Scene, SceneError> {
     let mut doc = Doc::parse(file, text)?;
     for (shown, set) in overrides {
-        doc.apply_set(shown, set)?;
+        doc.apply_set(shown, set, superseded)?;
     }
     build(&doc)
+}
+
+/// The keys an override replaces in its table: the other ways of giving the same setting, so
+/// `--set group.cube.one_minus_beta=1e-9` works on a file that says `velocity = [...]`.
+fn superseded(table: &[&str], key: &str) -> &'static [&'static str] {
+    let in_group = table.first() == Some(&"group") && table.len() == 2;
+    let in_camera = table == ["camera"];
+    match key {
+        "velocity" if in_group => &["beta", "rapidity", "one_minus_beta", "direction"],
+        "velocity" => &["beta", "rapidity", "one_minus_beta", "velocity_direction"],
+        "beta" => &["velocity", "rapidity", "one_minus_beta"],
+        "rapidity" => &["velocity", "beta", "one_minus_beta"],
+        "one_minus_beta" => &["velocity", "beta", "rapidity"],
+        "direction" if in_camera => &["look_at"],
+        "look_at" if in_camera => &["direction"],
+        _ => &[],
+    }
 }
 
 fn build(doc: &Doc) -> R<Scene> {

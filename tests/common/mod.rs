@@ -79,3 +79,75 @@ pub fn backends() -> Vec<&'static str> {
 pub fn fov_for_focal(f: f64, height: u32) -> f64 {
     2.0 * (0.5 * height as f64 / f).atan().to_degrees()
 }
+
+/// Image width and height of the calibration renders: odd, so the centre row and column pass
+/// through u = 0 and v = 0 exactly.
+pub const CUBE_W: u32 = 601;
+pub const CUBE_H: u32 = 41;
+
+/// The §2.4 set-up: a unit cube with its rear face at rest-frame x = `rear_x` and near face in
+/// the plane y = h, moving along +x at `speed` (a TOML fragment such as `velocity = [0.5, 0, 0]`);
+/// the camera at `position` at time `time`, looking along +y with f = 1000 px.
+pub fn cube_scene(h: f64, speed: &str, rear_x: f64, time: f64, position: [f64; 3]) -> String {
+    format!(
+        r#"
+[camera]
+position = [{px:?}, {py:?}, {pz:?}]
+direction = [0, 1, 0]
+fov_y = {fov}
+time = {time:?}
+[image]
+width = {CUBE_W}
+height = {CUBE_H}
+[[group]]
+name = "cube"
+{speed}
+[[group.object]]
+type = "box"
+min = [{rear_x:?}, {h:?}, -0.5]
+max = [{front_x:?}, {h1:?}, 0.5]
+"#,
+        px = position[0],
+        py = position[1],
+        pz = position[2],
+        fov = fov_for_focal(1000.0, CUBE_H),
+        front_x = rear_x + 1.0,
+        h1 = h + 1.0
+    )
+}
+
+/// Pixels of the centre row whose primary hit is on the cube face with this rest-frame normal.
+pub fn face_width(frame: &Frame, normal: [f32; 3]) -> usize {
+    let y = frame.height / 2;
+    (0..frame.width)
+        .filter(|&x| {
+            let p = frame.get(x, y);
+            p.object_id == 1
+                && p.normal
+                    .iter()
+                    .zip(normal)
+                    .all(|(a, b)| (a - b).abs() < 1e-3)
+        })
+        .count()
+}
+
+/// No pixel of any pass is NaN or infinite.
+pub fn assert_all_finite(frame: &Frame, what: &str) {
+    for p in &frame.pixels {
+        let vals = [
+            p.color[0],
+            p.color[1],
+            p.color[2],
+            p.alpha,
+            p.lookback,
+            p.doppler,
+            p.normal[0],
+            p.normal[1],
+            p.normal[2],
+        ];
+        assert!(
+            vals.iter().all(|v| v.is_finite()),
+            "{what}: non-finite pixel {p:?}"
+        );
+    }
+}
