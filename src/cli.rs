@@ -1,6 +1,6 @@
 //! The command line: `rest-embree render SCENE -o OUT.{exr,png} [options]`.
 
-use crate::{accel, output, render, scene};
+use crate::{accel, bench, output, render, scene};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -20,8 +20,40 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene file to an EXR (linear, with passes) or PNG (sRGB) image.
     Render(RenderArgs),
+    /// Measure each backend's speed and error on the same scenes (default: the paper's lattice).
+    Bench(BenchArgs),
     /// List the intersection backends of this build.
     Backends,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct BenchArgs {
+    /// A scene file to measure; without one, the paper's lattice at beta 0, 0.5, 0.9, 0.99.
+    pub scene: Option<PathBuf>,
+    /// Backends to measure (repeatable; default: every backend of this build).
+    #[arg(long = "backend")]
+    pub backends: Vec<String>,
+    /// Image width (default 512).
+    #[arg(long, default_value_t = 512)]
+    pub width: u32,
+    /// Image height (default 512).
+    #[arg(long, default_value_t = 512)]
+    pub height: u32,
+    /// Samples per pixel (default 1).
+    #[arg(long, default_value_t = 1)]
+    pub samples: u32,
+    /// Override any scene value, as for render.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Primary-ray passes per backend; the fastest counts.
+    #[arg(long, default_value_t = 3)]
+    pub repeat: usize,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Also write the rows as CSV to this file.
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
 }
 
 #[derive(clap::Args, Debug)]
@@ -89,14 +121,73 @@ pub fn run(cli: Cli) -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Command::Render(args) => match run_render(&args) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {e}");
-                ExitCode::FAILURE
-            }
-        },
+        Command::Render(args) => report(run_render(&args)),
+        Command::Bench(args) => report(run_bench(&args)),
     }
+}
+
+fn report(r: Result<(), String>) -> ExitCode {
+    match r {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn set_threads(threads: Option<usize>) -> Result<(), String> {
+    if let Some(n) = threads {
+        if n == 0 {
+            return Err("--threads: must be at least 1".into());
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| format!("--threads: {e}"))?;
+    }
+    Ok(())
+}
+
+fn run_bench(args: &BenchArgs) -> Result<(), String> {
+    set_threads(args.threads)?;
+    let backends = if args.backends.is_empty() {
+        accel::backend_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    } else {
+        args.backends.clone()
+    };
+    for b in &backends {
+        accel::backend_by_name(b).map_err(|e| format!("--backend: {e}"))?;
+    }
+    let mut sets = vec![
+        format!("image.width={}", args.width),
+        format!("image.height={}", args.height),
+        format!("image.samples={}", args.samples),
+    ];
+    sets.extend(args.set.iter().cloned());
+    let cases = match &args.scene {
+        None => bench::default_cases(&sets).map_err(|e| e.to_string())?,
+        Some(path) => {
+            let overrides: Vec<(String, String)> = sets
+                .iter()
+                .map(|s| (format!("--set {s}"), s.clone()))
+                .collect();
+            vec![bench::Case {
+                name: path.display().to_string(),
+                scene: scene::load_file(path, &overrides).map_err(|e| e.to_string())?,
+            }]
+        }
+    };
+    let rows = bench::run(&cases, &backends, args.repeat)?;
+    println!("threads: {}", rayon::current_num_threads());
+    print!("{}", bench::table(&rows));
+    if let Some(p) = &args.csv {
+        std::fs::write(p, bench::csv(&rows)).map_err(|e| format!("--csv {}: {e}", p.display()))?;
+    }
+    Ok(())
 }
 
 fn run_render(args: &RenderArgs) -> Result<(), String> {
@@ -107,15 +198,7 @@ fn run_render(args: &RenderArgs) -> Result<(), String> {
         .clone()
         .unwrap_or_else(|| accel::default_backend_name().to_string());
     let backend = accel::backend_by_name(&backend_name).map_err(|e| format!("--backend: {e}"))?;
-    if let Some(n) = args.threads {
-        if n == 0 {
-            return Err("--threads: must be at least 1".into());
-        }
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .map_err(|e| format!("--threads: {e}"))?;
-    }
+    set_threads(args.threads)?;
     let scene = scene::load_file(&args.scene, &args.overrides()).map_err(|e| e.to_string())?;
     let (frame, stats) = render::render(&scene, backend.as_ref())?;
     if stats.nonfinite_pixels > 0 {

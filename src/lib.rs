@@ -6,6 +6,7 @@
 //! (EXR, PNG). [`cli`] is the command line.
 
 pub mod accel;
+pub mod bench;
 pub mod cli;
 pub mod compare;
 pub mod geometry;

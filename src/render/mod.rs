@@ -6,6 +6,7 @@ mod camera;
 mod frame;
 mod sampler;
 mod shade;
+mod tile;
 mod world;
 
 pub use camera::CameraRays;
@@ -41,17 +42,31 @@ pub fn render(scene: &Scene, backend: &dyn Backend) -> Result<(Frame, RenderStat
     Ok((frame, stats))
 }
 
+fn tiles(scene: &Scene) -> Vec<(u32, u32)> {
+    let (w, h) = (scene.image.width, scene.image.height);
+    let tiles_x = w.div_ceil(TILE);
+    (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..tiles_x).map(move |tx| (tx * TILE, ty * TILE)))
+        .collect()
+}
+
+/// Trace every primary ray of the image through the world without shading (the benchmark's
+/// measure of intersection throughput); returns (rays, hits).
+pub fn trace_primary(scene: &Scene, world: &World) -> (u64, u64) {
+    let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
+    tiles(scene)
+        .par_iter()
+        .map(|&(x0, y0)| tile::trace_tile(scene, world, &cam, x0, y0))
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+}
+
 /// Render with acceleration structures already built.
 pub fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
     let (w, h) = (scene.image.width, scene.image.height);
     let cam = CameraRays::new(&scene.camera, w, h);
-    let tiles_x = w.div_ceil(TILE);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
-        .flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty)))
-        .collect();
-    let results: Vec<_> = tiles
+    let results: Vec<_> = tiles(scene)
         .par_iter()
-        .map(|&(tx, ty)| shade::render_tile(scene, world, &cam, tx * TILE, ty * TILE))
+        .map(|&(x0, y0)| tile::render_tile(scene, world, &cam, x0, y0))
         .collect();
     let mut frame = Frame::new(w, h);
     let mut stats = RenderStats::default();

@@ -2,105 +2,10 @@
 //! on their own worldlines, mirror reflection, and refraction with Fresnel. Every secondary ray
 //! is again a past-directed null ray, spawned in the surface's frame and boosted back.
 
-use super::camera::CameraRays;
-use super::frame::PixelValue;
-use super::sampler::sample_offset;
 use super::world::{SurfaceHit, World};
-use super::TILE;
 use crate::scene::{Light, Scene};
 use crate::spacetime::{Boost, Event, NullRay};
 use glam::DVec3;
-
-pub struct TilePixel {
-    pub x: u32,
-    pub y: u32,
-    pub value: PixelValue,
-}
-
-pub struct TileResult {
-    pub pixels: Vec<TilePixel>,
-    pub primary_rays: u64,
-    pub nonfinite: u64,
-}
-
-pub fn render_tile(scene: &Scene, world: &World, cam: &CameraRays, x0: u32, y0: u32) -> TileResult {
-    let (w, h) = (scene.image.width, scene.image.height);
-    let xs = x0..(x0 + TILE).min(w);
-    let ys = y0..(y0 + TILE).min(h);
-    let coords: Vec<(u32, u32)> = ys.flat_map(|y| xs.clone().map(move |x| (x, y))).collect();
-    let n = scene.image.samples;
-    let shader = Shader::new(scene, world);
-    let mut sum = vec![DVec3::ZERO; coords.len()];
-    let mut covered = vec![0u32; coords.len()];
-    let mut aov: Vec<Option<(NullRay, SurfaceHit)>> = vec![None; coords.len()];
-    let mut rays = Vec::with_capacity(coords.len());
-    let mut hits = vec![None; coords.len()];
-    let mut primary = 0u64;
-    // With one sample the pixel centre serves both colour and passes; with more, an extra
-    // centre ray gives crisp passes (ids, lookback) that compositors expect.
-    let aov_pass = n > 1;
-    let aov_sample = if aov_pass { n } else { 0 };
-    for s in 0..n + u32::from(aov_pass) {
-        let centre = s == n;
-        rays.clear();
-        for &(x, y) in &coords {
-            let (ox, oy) = if centre {
-                (0.5, 0.5)
-            } else {
-                sample_offset(x, y, s, n)
-            };
-            rays.push(cam.ray(x as f64 + ox, y as f64 + oy));
-        }
-        primary += rays.len() as u64;
-        world.closest_hits(&rays, 0.0, &mut hits);
-        for (k, (r, hit)) in rays.iter().zip(&hits).enumerate() {
-            if !centre {
-                sum[k] += match hit {
-                    Some(hh) => {
-                        covered[k] += 1;
-                        shader.shade(r, hh, 0)
-                    }
-                    None => scene.image.background,
-                };
-            }
-            if s == aov_sample {
-                aov[k] = hit.map(|hh| (*r, hh));
-            }
-        }
-    }
-    let mut nonfinite = 0;
-    let pixels = coords
-        .iter()
-        .enumerate()
-        .map(|(k, &(x, y))| {
-            let mut c = sum[k] / n as f64;
-            if !c.is_finite() {
-                nonfinite += 1;
-                c = DVec3::ZERO;
-            }
-            let mut value = PixelValue {
-                color: [c.x as f32, c.y as f32, c.z as f32],
-                alpha: covered[k] as f32 / n as f32,
-                ..Default::default()
-            };
-            if let Some((r, hit)) = aov[k] {
-                let g = &scene.groups[hit.group];
-                let prim = &g.geometry.prims[hit.prim as usize];
-                let nrm = prim.normal(hit.point);
-                value.lookback = hit.lambda as f32;
-                value.doppler = (cam.lookback_factor(r.dir) / hit.s) as f32;
-                value.object_id = g.geometry.part_of(hit.prim).object + 1;
-                value.normal = [nrm.x as f32, nrm.y as f32, nrm.z as f32];
-            }
-            TilePixel { x, y, value }
-        })
-        .collect();
-    TileResult {
-        pixels,
-        primary_rays: primary,
-        nonfinite,
-    }
-}
 
 struct LightRt<'a> {
     light: &'a Light,
