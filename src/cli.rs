@@ -8,7 +8,7 @@ use std::process::ExitCode;
 #[derive(Parser, Debug)]
 #[command(
     name = "rest-embree",
-    version,
+    version = env!("REST_EMBREE_LONG_VERSION"),
     about = "Special-relativistic ray tracer (REST-frame algorithm)"
 )]
 pub struct Cli {

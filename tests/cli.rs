@@ -399,3 +399,26 @@ fn set_addresses_entries_by_name_and_overrides_any_value() {
     let bg = ch["object_id"].iter().position(|&i| i == 0.0).unwrap();
     assert_eq!((ch["R"][bg], ch["G"][bg], ch["B"][bg]), (0.25, 0.5, 1.0));
 }
+
+#[cfg(not(feature = "embree"))]
+#[test]
+fn asking_a_build_without_embree_for_embree_is_a_clear_error() {
+    fails(
+        "no-embree",
+        GOOD,
+        &["--backend", "embree"],
+        &["--backend", "not in this build", "--features embree"],
+    );
+}
+
+#[cfg(feature = "embree")]
+#[test]
+fn embree_is_the_default_backend() {
+    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .arg("backends")
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("embree (default)"), "{text}");
+    assert!(text.contains("bvh"));
+}

@@ -1,0 +1,32 @@
+# The two set-up commands of the README: `make demo` and `make test`. Each installs what it
+# needs first (scripts/setup.sh).
+
+CARGO ?= cargo
+OUT ?= out
+
+.PHONY: setup demo test bench images
+
+setup:
+	@scripts/setup.sh
+
+# Render the paper's lattice (Hsiung & Dunn 1989, Figure 16: beta = 0.9) to PNG and EXR.
+demo: setup
+	$(CARGO) build --release
+	mkdir -p $(OUT)
+	./target/release/rest-embree render scenes/lattice.toml -o $(OUT)/lattice-0.9.png --set 'group.lattice.velocity=[-0.9, 0, 0]'
+	./target/release/rest-embree render scenes/lattice.toml -o $(OUT)/lattice-0.9.exr --set 'group.lattice.velocity=[-0.9, 0, 0]'
+	@echo "demo: wrote $(OUT)/lattice-0.9.png and $(OUT)/lattice-0.9.exr"
+
+# Every test, optimised (Cargo.toml's test profile), with the Embree backend and without it.
+test: setup
+	$(CARGO) test --workspace
+	$(CARGO) test --no-default-features
+
+bench: setup
+	$(CARGO) build --release
+	./target/release/rest-embree bench --threads 2
+
+# The pictures in the README (docs/img).
+images: setup
+	$(CARGO) build --release
+	scripts/readme-images.sh

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Render the README's pictures (docs/img) from the paper scenes. Needs a release build.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+r=./target/release/rest-embree
+o=docs/img
+mkdir -p "$o"
+size=(--width 320 --height 320 --samples 4 --quiet)
+for b in 0 0.5 0.9 0.99; do
+  $r render scenes/calibration_cube.toml -o "$o/cube-$b.png" "${size[@]}" --set "group.cube.velocity=[$b, 0, 0]"
+  $r render scenes/bar_array.toml -o "$o/bars-$b.png" "${size[@]}" --set "group.bars.velocity=[$b, 0, 0]"
+  $r render scenes/lattice.toml -o "$o/lattice-$b.png" "${size[@]}" --set "group.lattice.velocity=[-$b, 0, 0]"
+done
+$r render scenes/lattice.toml -o "$o/lattice-up-0.5.png" "${size[@]}" --set 'group.lattice.velocity=[-0.5, 0, 0]' --set 'camera.direction=[1, 0, 1]'
+$r render scenes/lattice.toml -o "$o/lattice-upright-0.5.png" "${size[@]}" --set 'group.lattice.velocity=[-0.5, 0, 0]' --set 'camera.direction=[1, -1, 1]'
+echo "wrote $(ls "$o" | wc -l) images to $o"

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Install what rest-embree needs on Debian/Ubuntu: Embree 3 and libclang (for the Embree
+# backend's bindings) and a C compiler. Uses sudo when not root; does nothing when all is there.
+set -euo pipefail
+
+packages=(libembree-dev libclang-dev gcc)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
+done
+
+if [ ${#missing[@]} -gt 0 ]; then
+  if [ "$(id -u)" -eq 0 ]; then sudo=(); else sudo=(sudo); fi
+  if ! command -v apt-get >/dev/null 2>&1; then
+    echo "setup: apt-get not found; install Embree 3 and libclang yourself (or build with --no-default-features)" >&2
+    exit 1
+  fi
+  echo "setup: installing ${missing[*]}"
+  "${sudo[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+
+if ! command -v cargo >/dev/null 2>&1; then
+  echo "setup: Rust is not installed. Install Rust 1.80 or newer (https://rustup.rs), then run this again." >&2
+  exit 1
+fi
