@@ -117,6 +117,14 @@ fn build(doc: &Doc) -> R<Scene> {
             });
             o.finish(OBJECT_KEYS)?;
         }
+        for key in OBJECT_KEYS.iter().filter(|k| **k != "name" && t.has(k)) {
+            let n = t.get(key).expect("present");
+            return Err(t.error_at(
+                n,
+                key,
+                format!("`{key}` belongs to an object: address it as group.{name}.object.<object name or index>.{key}"),
+            ));
+        }
         t.finish(&[
             "name",
             "velocity",
