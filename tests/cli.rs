@@ -354,6 +354,16 @@ fn bad_flags_are_named() {
         &["--set camera.tme=3", "camera.tme", "did you mean `time`"],
     );
     fails(
+        "set-object-key",
+        GOOD,
+        &["--set", "group.cube.min=[0,0,0]"],
+        &[
+            "--set group.cube.min",
+            "belongs to an object",
+            "group.cube.object.<object name or index>.min",
+        ],
+    );
+    fails(
         "width0",
         GOOD,
         &["--width", "0"],
