@@ -13,7 +13,7 @@ pub use bvh::{Bvh, BvhBackend};
 #[cfg(feature = "embree")]
 pub use embree::EmbreeBackend;
 
-use crate::geometry::{Aabb, Geometry};
+use crate::geometry::Geometry;
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -85,9 +85,4 @@ pub fn backend_by_name(name: &str) -> Result<Box<dyn Backend>, String> {
             backend_names().join(", ")
         )),
     }
-}
-
-/// Bounds of a geometry, for culling.
-pub fn bounds_of(g: &Geometry) -> Aabb {
-    g.bounds()
 }

@@ -88,8 +88,12 @@ impl<'a> Shader<'a> {
         let nf = if inside { -n } else { n };
         let event = ray.at(hit.lambda);
         let mut color = scene.render.ambient * mat.color;
+        let from = if self.lights.is_empty() {
+            event
+        } else {
+            self.spawn(hit.group, event, nf, nf).origin
+        };
         for l in &self.lights {
-            let from = self.spawn(hit.group, event, nf, nf).origin;
             // The emission event on the light's worldline that lies on `from`'s past light
             // cone, found in the light's rest frame, where the light is static.
             let at_light = l.to_light.event(from);

@@ -129,10 +129,31 @@ impl World {
         }
     }
 
+    /// The visible hit on one ray (secondary rays), without the batch's bookkeeping.
     pub fn closest_hit(&self, ray: &NullRay, tmin: f64) -> Option<SurfaceHit> {
-        let mut out = [None];
-        self.closest_hits(std::slice::from_ref(ray), tmin, &mut out);
-        out[0]
+        let mut best: Option<SurfaceHit> = None;
+        let mut hit = [None];
+        for (gi, g) in self.groups.iter().enumerate() {
+            let tmax = best.map_or(f64::INFINITY, |b| b.lambda);
+            let Some(rr) = self.rest_ray(g, ray, tmin, tmax) else {
+                continue;
+            };
+            g.accel.intersect(std::slice::from_ref(&rr.ray), &mut hit);
+            if let Some(h) = hit[0] {
+                let lambda = rr.shift + h.t;
+                if lambda < tmax {
+                    best = Some(SurfaceHit {
+                        group: gi,
+                        prim: h.prim,
+                        lambda,
+                        point: rr.ray.origin + h.t * rr.ray.dir,
+                        dir: rr.ray.dir,
+                        s: rr.s,
+                    });
+                }
+            }
+        }
+        best
     }
 
     /// Whether anything lies on the ray between lookback `tmin` and `tmax`.

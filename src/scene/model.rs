@@ -117,11 +117,4 @@ impl Scene {
     pub fn primitive_count(&self) -> usize {
         self.groups.iter().map(|g| g.geometry.prims.len()).sum()
     }
-
-    /// True when some material reflects or refracts (secondary rays are needed).
-    pub fn has_secondary(&self) -> bool {
-        self.materials
-            .iter()
-            .any(|m| m.reflect > 0.0 || m.transmit > 0.0)
-    }
 }
