@@ -117,7 +117,7 @@ fn build(doc: &Doc) -> R<Scene> {
             });
             o.finish(OBJECT_KEYS)?;
         }
-        for key in OBJECT_KEYS.iter().filter(|k| **k != "name" && t.has(k)) {
+        if let Some(key) = OBJECT_KEYS.iter().find(|k| **k != "name" && t.has(k)) {
             let n = t.get(key).expect("present");
             return Err(t.error_at(
                 n,
