@@ -104,8 +104,8 @@ pub fn run(cases: &[Case], backends: &[String], repeat: usize) -> Result<Vec<Row
             rows.push(Row {
                 case: case.name.clone(),
                 backend: name.clone(),
-                width: case.scene.image.width,
-                height: case.scene.image.height,
+                width: case.scene.image.frame_size().0,
+                height: case.scene.image.frame_size().1,
                 primitives: case.scene.primitive_count(),
                 build_s,
                 primary_rays,

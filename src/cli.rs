@@ -213,8 +213,8 @@ fn run_render(args: &RenderArgs) -> Result<(), String> {
         eprintln!(
             "{}: {}x{}, {} spp, {} primitives in {} groups, backend {backend_name}: build {:.3} s, render {:.3} s ({:.2} M primary rays/s)",
             args.output.display(),
-            scene.image.width,
-            scene.image.height,
+            scene.image.frame_size().0,
+            scene.image.frame_size().1,
             scene.image.samples,
             scene.primitive_count(),
             scene.groups.len(),

@@ -11,6 +11,9 @@ pub struct PixelValue {
     pub object_id: u32,
     /// Rest-frame outward normal of the primary hit's surface (0 for background).
     pub normal: [f32; 3],
+    /// World-frame position of the primary hit's emission event: where the surface point was
+    /// when it sent the light (its apparent position; 0 for background).
+    pub position: [f32; 3],
 }
 
 /// The rendered image and its extra passes, row 0 at the top.
@@ -51,6 +54,9 @@ impl Frame {
             "N.X" => |p| p.normal[0],
             "N.Y" => |p| p.normal[1],
             "N.Z" => |p| p.normal[2],
+            "P.X" => |p| p.position[0],
+            "P.Y" => |p| p.position[1],
+            "P.Z" => |p| p.position[2],
             _ => return None,
         };
         Some(self.pixels.iter().map(f).collect())
@@ -58,7 +64,7 @@ impl Frame {
 }
 
 /// Channel names written to EXR, in this order.
-pub const CHANNELS: [&str; 10] = [
+pub const CHANNELS: [&str; 13] = [
     "R",
     "G",
     "B",
@@ -69,4 +75,7 @@ pub const CHANNELS: [&str; 10] = [
     "N.X",
     "N.Y",
     "N.Z",
+    "P.X",
+    "P.Y",
+    "P.Z",
 ];

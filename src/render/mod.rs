@@ -43,7 +43,7 @@ pub fn render(scene: &Scene, backend: &dyn Backend) -> Result<(Frame, RenderStat
 }
 
 fn tiles(scene: &Scene) -> Vec<(u32, u32)> {
-    let (w, h) = (scene.image.width, scene.image.height);
+    let (w, h) = scene.image.frame_size();
     let tiles_x = w.div_ceil(TILE);
     (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..tiles_x).map(move |tx| (tx * TILE, ty * TILE)))
@@ -62,8 +62,8 @@ pub fn trace_primary(scene: &Scene, world: &World) -> (u64, u64) {
 
 /// Render with acceleration structures already built.
 pub fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
-    let (w, h) = (scene.image.width, scene.image.height);
-    let cam = CameraRays::new(&scene.camera, w, h);
+    let (w, h) = scene.image.frame_size();
+    let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
     let results: Vec<_> = tiles(scene)
         .par_iter()
         .map(|&(x0, y0)| tile::render_tile(scene, world, &cam, x0, y0))

@@ -26,15 +26,18 @@ pub fn tile_pixels(x0: u32, y0: u32, w: u32, h: u32) -> Vec<(u32, u32)> {
     v
 }
 
-/// The primary rays of `coords`: sample `(s, n)` of each pixel, or the pixel centre for None.
+/// The primary rays of `coords` (frame pixels; `offset` places the frame in the full image):
+/// sample `(s, n)` of each pixel, or the pixel centre for None.
 pub fn primary_rays(
     cam: &CameraRays,
     coords: &[(u32, u32)],
+    offset: (u32, u32),
     sample: Option<(u32, u32)>,
     rays: &mut Vec<NullRay>,
 ) {
     rays.clear();
-    for &(x, y) in coords {
+    for &(fx, fy) in coords {
+        let (x, y) = (fx + offset.0, fy + offset.1);
         let (ox, oy) = match sample {
             Some((s, n)) => sample_offset(x, y, s, n),
             None => (0.5, 0.5),
@@ -45,13 +48,20 @@ pub fn primary_rays(
 
 /// Trace (without shading) every sample's primary rays of one tile; returns rays and hits.
 pub fn trace_tile(scene: &Scene, world: &World, cam: &CameraRays, x0: u32, y0: u32) -> (u64, u64) {
-    let coords = tile_pixels(x0, y0, scene.image.width, scene.image.height);
+    let (w, h) = scene.image.frame_size();
+    let coords = tile_pixels(x0, y0, w, h);
     let n = scene.image.samples;
     let mut rays = Vec::with_capacity(coords.len());
     let mut hits = vec![None; coords.len()];
     let mut found = 0;
     for s in 0..n {
-        primary_rays(cam, &coords, Some((s, n)), &mut rays);
+        primary_rays(
+            cam,
+            &coords,
+            scene.image.frame_offset(),
+            Some((s, n)),
+            &mut rays,
+        );
         world.closest_hits(&rays, 0.0, &mut hits);
         found += hits.iter().filter(|h| h.is_some()).count() as u64;
     }
@@ -71,7 +81,7 @@ pub struct TileResult {
 }
 
 pub fn render_tile(scene: &Scene, world: &World, cam: &CameraRays, x0: u32, y0: u32) -> TileResult {
-    let (w, h) = (scene.image.width, scene.image.height);
+    let (w, h) = scene.image.frame_size();
     let coords = tile_pixels(x0, y0, w, h);
     let n = scene.image.samples;
     let shader = Shader::new(scene, world);
@@ -87,15 +97,8 @@ pub fn render_tile(scene: &Scene, world: &World, cam: &CameraRays, x0: u32, y0: 
     let aov_sample = if aov_pass { n } else { 0 };
     for s in 0..n + u32::from(aov_pass) {
         let centre = s == n;
-        rays.clear();
-        for &(x, y) in &coords {
-            let (ox, oy) = if centre {
-                (0.5, 0.5)
-            } else {
-                sample_offset(x, y, s, n)
-            };
-            rays.push(cam.ray(x as f64 + ox, y as f64 + oy));
-        }
+        let sample = if centre { None } else { Some((s, n)) };
+        primary_rays(cam, &coords, scene.image.frame_offset(), sample, &mut rays);
         primary += rays.len() as u64;
         world.closest_hits(&rays, 0.0, &mut hits);
         for (k, (r, hit)) in rays.iter().zip(&hits).enumerate() {
@@ -136,6 +139,8 @@ pub fn render_tile(scene: &Scene, world: &World, cam: &CameraRays, x0: u32, y0: 
                 value.doppler = (cam.lookback_factor(r.dir) / hit.s) as f32;
                 value.object_id = g.geometry.part_of(hit.prim).object + 1;
                 value.normal = [nrm.x as f32, nrm.y as f32, nrm.z as f32];
+                let p = r.at(hit.lambda).x;
+                value.position = [p.x as f32, p.y as f32, p.z as f32];
             }
             TilePixel { x, y, value }
         })

@@ -74,6 +74,7 @@ fn build(doc: &Doc) -> R<Scene> {
             height: 512,
             samples: 1,
             background: DVec3::ZERO,
+            crop: None,
         },
     };
     let render = match root.table("render")? {
@@ -317,13 +318,36 @@ fn camera(t: &Table) -> R<Camera> {
 }
 
 fn image(t: &Table) -> R<ImageSettings> {
+    let width = t.uint("width", Some(512), 1, 1 << 20)? as u32;
+    let height = t.uint("height", Some(512), 1, 1 << 20)? as u32;
+    let crop = t
+        .uints("crop", 4, 0, 1 << 20)?
+        .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32, c[3] as u32]);
+    if let Some([x, y, w, h]) = crop {
+        if w == 0 || h == 0 || x + w > width || y + h > height {
+            let n = t.get("crop").expect("read above");
+            return Err(t.error_at(
+                n,
+                "crop",
+                format!("the window [{x}, {y}, {w}, {h}] must be non-empty and inside the {width}x{height} image"),
+            ));
+        }
+    }
     let s = ImageSettings {
-        width: t.uint("width", Some(512), 1, 32768)? as u32,
-        height: t.uint("height", Some(512), 1, 32768)? as u32,
+        width,
+        height,
         samples: t.uint("samples", Some(1), 1, 4096)? as u32,
         background: t.color("background")?.unwrap_or(DVec3::ZERO),
+        crop,
     };
-    t.finish(&["width", "height", "samples", "background"])?;
+    let (fw, fh) = s.frame_size();
+    if fw as u64 * fh as u64 > 1 << 28 {
+        return Err(t.error(
+            "width",
+            format!("a {fw}x{fh} frame is too large (at most 2^28 pixels; render it in crops)"),
+        ));
+    }
+    t.finish(&["width", "height", "samples", "background", "crop"])?;
     Ok(s)
 }
 

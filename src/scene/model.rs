@@ -39,6 +39,21 @@ pub struct ImageSettings {
     pub height: u32,
     pub samples: u32,
     pub background: DVec3,
+    /// Render only this window `[x, y, width, height]` of the full image (pixels).
+    pub crop: Option<[u32; 4]>,
+}
+
+impl ImageSettings {
+    /// Size of the rendered frame: the crop window, or the whole image.
+    pub fn frame_size(&self) -> (u32, u32) {
+        self.crop
+            .map_or((self.width, self.height), |c| (c[2], c[3]))
+    }
+
+    /// Full-image coordinates of the frame's pixel (0, 0).
+    pub fn frame_offset(&self) -> (u32, u32) {
+        self.crop.map_or((0, 0), |c| (c[0], c[1]))
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
