@@ -319,3 +319,56 @@ fn speed_forms_agree_and_stay_exact_near_light_8() {
     assert!(Velocity::from_beta_vec(DVec3::new(0.8, 0.7, 0.0)).is_err());
     assert!(Velocity::from_one_minus_beta(DVec3::X, 0.0).is_err());
 }
+
+#[test]
+fn retarded_position_2_1_both_branches() {
+    use rest_embree::spacetime::{retarded_delay, retarded_position};
+    let mut r = Rng(9);
+    for _ in 0..3000 {
+        let v = Velocity::from_rapidity(r.unit(), r.range(0.0, 4.0)).unwrap();
+        let r0 = r.unit() * r.range(0.1, 100.0);
+        let d = retarded_delay(r0, &v);
+        // Bisection on |r0 − βΔ| = Δ (the definition), independent of the closed form.
+        let (mut lo, mut hi) = (0.0f64, 1e3 * v.gamma().powi(2) * r0.length());
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if (r0 - v.beta_vec() * mid).length() > mid {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        assert_rel(d, 0.5 * (lo + hi), 1e-12, "retarded delay vs bisection");
+        let app = retarded_position(r0, &v);
+        assert_rel(app.length(), d, 1e-12, "the apparent point is Δ away");
+    }
+    // Both branches at a speed near 1: approaching (β·r0 < 0) and receding (β·r0 > 0).
+    let v = Velocity::from_one_minus_beta(DVec3::X, 1e-12).unwrap();
+    let g2 = v.gamma().powi(2);
+    // At −x and moving +x the point approaches: its light left long ago, Δ = d/(1−β) ≈ 2γ².
+    let approaching = retarded_delay(DVec3::new(-1.0, 0.0, 0.0), &v);
+    assert_rel(
+        approaching,
+        1.0 / v.one_minus_beta(),
+        1e-12,
+        "approaching: Δ = d/(1−β)",
+    );
+    assert!(approaching > g2, "approaching delay ~ 2γ² = {}", 2.0 * g2);
+    // At +x it recedes: Δ = d/(1+β) ≈ 1/2.
+    let receding = retarded_delay(DVec3::new(1.0, 0.0, 0.0), &v);
+    assert_rel(
+        receding,
+        1.0 / (1.0 + v.beta()),
+        1e-15,
+        "receding: Δ = d/(1+β)",
+    );
+    // The rest-frame form x_app = γ(X − β sqrt(X² + ρ²)) agrees (PHYSICS.md §2.1).
+    let v = Velocity::from_beta(DVec3::X, 0.9).unwrap();
+    for (x0, rho) in [(5.0, 10.0), (-5.0, 10.0), (0.0, 3.0), (40.0, 1.0)] {
+        let app = retarded_position(DVec3::new(x0, rho, 0.0), &v);
+        let big_x = v.gamma() * x0;
+        let want = v.gamma() * (big_x - v.beta() * (big_x * big_x + rho * rho).sqrt());
+        assert_close(app.x, want, 1e-12 * want.abs().max(1.0), "rest-frame form");
+        assert_eq!(app.y, rho, "the perpendicular offset is unchanged");
+    }
+}

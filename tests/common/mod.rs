@@ -151,3 +151,28 @@ pub fn assert_all_finite(frame: &Frame, what: &str) {
         );
     }
 }
+
+/// Check a measurement against its known answer and print it as a row of docs/ACCURACY.md
+/// (`scripts/accuracy-table.sh` collects these lines from a `--nocapture` run).
+pub fn report(case: &str, backend: &str, expected: f64, measured: f64, tolerance: f64, unit: &str) {
+    let err = (measured - expected).abs();
+    println!(
+        "ACCURACY|{case}|{backend}|{expected:.6}|{measured:.6}|{err:.2e}|{tolerance:.2e}|{unit}"
+    );
+    assert!(
+        err <= tolerance,
+        "{case} ({backend}): measured {measured}, expected {expected}, error {err:.3e} > {tolerance:.1e} {unit}"
+    );
+}
+
+/// Sub-pixel extent of a covered run on one row or column of alpha values: the left edge of the
+/// first covered pixel is moved in by its uncovered share, the right edge of the last out by its
+/// covered share. Returns (start, end) in frame pixels.
+pub fn alpha_extent(alpha: &[f32]) -> Option<(f64, f64)> {
+    let first = alpha.iter().position(|&a| a > 0.0)?;
+    let last = alpha.iter().rposition(|&a| a > 0.0)?;
+    Some((
+        first as f64 + 1.0 - alpha[first] as f64,
+        last as f64 + alpha[last] as f64,
+    ))
+}
