@@ -14,6 +14,9 @@ pub struct PixelValue {
     /// World-frame position of the primary hit's emission event: where the surface point was
     /// when it sent the light (its apparent position; 0 for background).
     pub position: [f32; 3],
+    /// The primary hit's point in its group's rest frame (a reference position that follows
+    /// the object, for texturing in compositing; 0 for background).
+    pub rest_position: [f32; 3],
 }
 
 /// The rendered image and its extra passes, row 0 at the top.
@@ -57,6 +60,9 @@ impl Frame {
             "P.X" => |p| p.position[0],
             "P.Y" => |p| p.position[1],
             "P.Z" => |p| p.position[2],
+            "Pref.X" => |p| p.rest_position[0],
+            "Pref.Y" => |p| p.rest_position[1],
+            "Pref.Z" => |p| p.rest_position[2],
             _ => return None,
         };
         Some(self.pixels.iter().map(f).collect())
@@ -64,7 +70,7 @@ impl Frame {
 }
 
 /// Channel names written to EXR, in this order.
-pub const CHANNELS: [&str; 13] = [
+pub const CHANNELS: [&str; 16] = [
     "R",
     "G",
     "B",
@@ -78,4 +84,7 @@ pub const CHANNELS: [&str; 13] = [
     "P.X",
     "P.Y",
     "P.Z",
+    "Pref.X",
+    "Pref.Y",
+    "Pref.Z",
 ];

@@ -141,6 +141,8 @@ pub fn render_tile(scene: &Scene, world: &World, cam: &CameraRays, x0: u32, y0: 
                 value.normal = [nrm.x as f32, nrm.y as f32, nrm.z as f32];
                 let p = r.at(hit.lambda).x;
                 value.position = [p.x as f32, p.y as f32, p.z as f32];
+                let q = hit.point;
+                value.rest_position = [q.x as f32, q.y as f32, q.z as f32];
             }
             TilePixel { x, y, value }
         })
