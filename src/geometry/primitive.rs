@@ -63,6 +63,14 @@ impl Geometry {
     pub fn is_empty(&self) -> bool {
         self.prims.is_empty()
     }
+
+    /// The same geometry moved by `d`.
+    pub fn translated(&self, d: DVec3) -> Geometry {
+        Geometry {
+            prims: self.prims.iter().map(|p| p.translated(d)).collect(),
+            parts: self.parts.clone(),
+        }
+    }
 }
 
 /// Both roots of a·t² + 2b·t + c = 0, ascending.
@@ -97,6 +105,28 @@ fn sphere_hit(c: DVec3, r: f64, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Opt
 }
 
 impl Primitive {
+    /// The same primitive moved by `d`.
+    pub fn translated(&self, d: DVec3) -> Primitive {
+        match *self {
+            Primitive::Sphere { center, radius } => Primitive::Sphere {
+                center: center + d,
+                radius,
+            },
+            Primitive::Capsule { a, b, radius } => Primitive::Capsule {
+                a: a + d,
+                b: b + d,
+                radius,
+            },
+            Primitive::Cuboid { min, max } => Primitive::Cuboid {
+                min: min + d,
+                max: max + d,
+            },
+            Primitive::Triangle { v } => Primitive::Triangle {
+                v: v.map(|p| p + d),
+            },
+        }
+    }
+
     pub fn bounds(&self) -> Aabb {
         match *self {
             Primitive::Sphere { center, radius } => {

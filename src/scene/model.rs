@@ -1,5 +1,5 @@
 use crate::geometry::Geometry;
-use crate::spacetime::{Event, Velocity};
+use crate::spacetime::{Boost, Event, Velocity};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -129,6 +129,23 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The whole scene, camera and lights moved by a spacetime translation `shift` (world
+    /// frame). Physics is translation-invariant, so the image must not change; each group's
+    /// rest-frame geometry moves by the spatial part of the shift as that group measures it.
+    pub fn translated(&self, shift: Event) -> Scene {
+        let rest_shift = |v: &Velocity| Boost::to_rest(v).event(shift).x;
+        let mut s = self.clone();
+        s.camera.position += shift.x;
+        s.camera.time += shift.t;
+        for l in &mut s.lights {
+            l.position += rest_shift(&l.velocity);
+        }
+        for g in &mut s.groups {
+            g.geometry = Arc::new(g.geometry.translated(rest_shift(&g.velocity)));
+        }
+        s
+    }
+
     pub fn primitive_count(&self) -> usize {
         self.groups.iter().map(|g| g.geometry.prims.len()).sum()
     }
