@@ -80,9 +80,9 @@ pub fn fov_for_focal(f: f64, height: u32) -> f64 {
     2.0 * (0.5 * height as f64 / f).atan().to_degrees()
 }
 
-/// Image width and height of the calibration renders: odd, so the centre row and column pass
-/// through u = 0 and v = 0 exactly.
-pub const CUBE_W: u32 = 601;
+/// Image size of the calibration renders: an odd height puts the centre row on v = 0; an even
+/// width puts pixel centres on half-integer u, off the faces' edges at whole pixels.
+pub const CUBE_W: u32 = 600;
 pub const CUBE_H: u32 = 41;
 
 /// The §2.4 set-up: a unit cube with its rear face at rest-frame x = `rear_x` and near face in
@@ -156,9 +156,21 @@ pub fn assert_all_finite(frame: &Frame, what: &str) {
 /// (`scripts/accuracy-table.sh` collects these lines from a `--nocapture` run).
 pub fn report(case: &str, backend: &str, expected: f64, measured: f64, tolerance: f64, unit: &str) {
     let err = (measured - expected).abs();
-    println!(
-        "ACCURACY|{case}|{backend}|{expected:.6}|{measured:.6}|{err:.2e}|{tolerance:.2e}|{unit}"
-    );
+    // The test's thread carries its name, and the binary's name its file: the command that
+    // reproduces the row.
+    let test = std::thread::current().name().unwrap_or("?").to_string();
+    let exe = std::env::args().next().unwrap_or_default();
+    let file = std::path::Path::new(&exe)
+        .file_name()
+        .map(|f| {
+            f.to_string_lossy()
+                .split('-')
+                .next()
+                .unwrap_or("?")
+                .to_string()
+        })
+        .unwrap_or_default();
+    println!("ACCURACY|{case}|{backend}|{expected:.6}|{measured:.6}|{err:.2e}|{tolerance:.2e}|{unit}|{file}|{test}");
     assert!(
         err <= tolerance,
         "{case} ({backend}): measured {measured}, expected {expected}, error {err:.3e} > {tolerance:.1e} {unit}"
