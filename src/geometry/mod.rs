@@ -4,7 +4,9 @@
 //! null direction whose length is the Doppler-like factor, so `t` is the world-frame lookback time.
 
 mod aabb;
+mod box_tree;
 mod primitive;
 
 pub use aabb::Aabb;
+pub use box_tree::{BoxTree, TreeNode};
 pub use primitive::{Geometry, Part, Primitive};

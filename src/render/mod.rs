@@ -4,6 +4,7 @@
 
 mod camera;
 mod frame;
+mod group_tree;
 mod sampler;
 mod shade;
 mod tile;
@@ -11,7 +12,8 @@ mod world;
 
 pub use camera::CameraRays;
 pub use frame::{Frame, PixelValue, CHANNELS};
-pub use world::{SurfaceHit, World};
+pub use group_tree::{world_box, GroupTree};
+pub use world::{SurfaceHit, World, WorldOptions, GROUP_TREE_MIN};
 
 use crate::accel::Backend;
 use crate::scene::Scene;

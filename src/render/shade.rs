@@ -75,10 +75,9 @@ impl<'a> Shader<'a> {
 
     pub fn shade(&self, ray: &NullRay, hit: &SurfaceHit, depth: u32) -> DVec3 {
         let scene = self.scene;
-        let group = &scene.groups[hit.group];
         let g = &self.world.groups[hit.group];
-        let prim = &group.geometry.prims[hit.prim as usize];
-        let mat = &scene.materials[group.geometry.part_of(hit.prim).material as usize];
+        let prim = &g.geometry.prims[hit.prim as usize];
+        let mat = &scene.materials[g.geometry.part_of(hit.prim).material as usize];
         if let Some(e) = mat.emission {
             return e;
         }

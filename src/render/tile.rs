@@ -132,7 +132,7 @@ pub fn render_tile(scene: &Scene, world: &World, cam: &CameraRays, x0: u32, y0: 
                 ..Default::default()
             };
             if let Some((r, hit)) = aov[k] {
-                let g = &scene.groups[hit.group];
+                let g = &world.groups[hit.group];
                 let prim = &g.geometry.prims[hit.prim as usize];
                 let nrm = prim.normal(hit.point);
                 value.lookback = hit.lambda as f32;

@@ -1,0 +1,185 @@
+//! A bounding-box tree over any items, built with binned SAH: the skeleton of the BVH backend
+//! and of the world's culling structure over velocity groups.
+
+use super::Aabb;
+use glam::DVec3;
+
+const BINS: usize = 16;
+const MAX_LEAF: usize = 4;
+const TRAVERSAL_COST: f64 = 1.0;
+const INTERSECT_COST: f64 = 1.5;
+
+/// A node: an interior node has `count == 0` and children at `first` and `first + 1`; a leaf
+/// holds `indices[first .. first + count]`.
+#[derive(Clone, Copy, Debug)]
+pub struct TreeNode {
+    pub bounds: Aabb,
+    pub first: u32,
+    pub count: u32,
+}
+
+/// Nodes (root first) and the item order the leaves index into.
+pub struct BoxTree {
+    pub nodes: Vec<TreeNode>,
+    pub indices: Vec<u32>,
+}
+
+struct BuildItem {
+    node: usize,
+    start: usize,
+    end: usize,
+}
+
+impl BoxTree {
+    /// Build over the boxes of `n` items (binned SAH, leaves of up to 4 items).
+    pub fn build(boxes: &[Aabb]) -> BoxTree {
+        let n = boxes.len();
+        let centroids: Vec<DVec3> = boxes.iter().map(|b| b.centroid()).collect();
+        let mut indices: Vec<u32> = (0..n as u32).collect();
+        let mut nodes = Vec::with_capacity(2 * n.div_ceil(MAX_LEAF).max(1));
+        nodes.push(TreeNode {
+            bounds: Aabb::EMPTY,
+            first: 0,
+            count: 0,
+        });
+        let mut stack = vec![BuildItem {
+            node: 0,
+            start: 0,
+            end: n,
+        }];
+        while let Some(item) = stack.pop() {
+            let idx = &mut indices[item.start..item.end];
+            let bounds = idx
+                .iter()
+                .fold(Aabb::EMPTY, |b, &i| b.union(&boxes[i as usize]));
+            let cbounds = idx.iter().fold(Aabb::EMPTY, |mut b, &i| {
+                b.grow(centroids[i as usize]);
+                b
+            });
+            nodes[item.node].bounds = bounds;
+            let count = idx.len();
+            let split = if count <= 1 {
+                None
+            } else {
+                find_split(idx, boxes, &centroids, &bounds, &cbounds)
+            };
+            let mid = match split {
+                Some(m) => Some(m),
+                None if count > MAX_LEAF => Some(count / 2), // degenerate centroids: split evenly
+                None => None,
+            };
+            match mid {
+                Some(mid) => {
+                    if split.is_none() {
+                        let e = cbounds.extent();
+                        let axis = if e.x >= e.y && e.x >= e.z {
+                            0
+                        } else if e.y >= e.z {
+                            1
+                        } else {
+                            2
+                        };
+                        idx.select_nth_unstable_by(mid, |&a, &b| {
+                            centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis])
+                        });
+                    }
+                    let left = nodes.len();
+                    nodes.push(TreeNode {
+                        bounds: Aabb::EMPTY,
+                        first: 0,
+                        count: 0,
+                    });
+                    nodes.push(TreeNode {
+                        bounds: Aabb::EMPTY,
+                        first: 0,
+                        count: 0,
+                    });
+                    nodes[item.node].first = left as u32;
+                    nodes[item.node].count = 0;
+                    stack.push(BuildItem {
+                        node: left + 1,
+                        start: item.start + mid,
+                        end: item.end,
+                    });
+                    stack.push(BuildItem {
+                        node: left,
+                        start: item.start,
+                        end: item.start + mid,
+                    });
+                }
+                None => {
+                    nodes[item.node].first = item.start as u32;
+                    nodes[item.node].count = count as u32;
+                }
+            }
+        }
+        BoxTree { nodes, indices }
+    }
+}
+
+/// Binned SAH: the split position (count of the left side, after partitioning `idx`) or None
+/// when a leaf is cheaper.
+fn find_split(
+    idx: &mut [u32],
+    boxes: &[Aabb],
+    centroids: &[DVec3],
+    bounds: &Aabb,
+    cbounds: &Aabb,
+) -> Option<usize> {
+    let count = idx.len();
+    let ext = cbounds.extent();
+    let mut best: Option<(f64, usize, usize)> = None; // cost, axis, bin
+    for axis in 0..3 {
+        if ext[axis] <= 0.0 {
+            continue;
+        }
+        let scale = BINS as f64 / ext[axis];
+        let bin_of = |c: DVec3| (((c[axis] - cbounds.min[axis]) * scale) as usize).min(BINS - 1);
+        let mut bin_box = [Aabb::EMPTY; BINS];
+        let mut bin_n = [0usize; BINS];
+        for &i in idx.iter() {
+            let b = bin_of(centroids[i as usize]);
+            bin_n[b] += 1;
+            bin_box[b] = bin_box[b].union(&boxes[i as usize]);
+        }
+        let mut right_area = [0.0; BINS];
+        let mut right_n = [0usize; BINS];
+        let (mut acc, mut n) = (Aabb::EMPTY, 0);
+        for b in (1..BINS).rev() {
+            acc = acc.union(&bin_box[b]);
+            n += bin_n[b];
+            right_area[b] = acc.surface_area();
+            right_n[b] = n;
+        }
+        let (mut acc, mut n) = (Aabb::EMPTY, 0);
+        for b in 0..BINS - 1 {
+            acc = acc.union(&bin_box[b]);
+            n += bin_n[b];
+            let rn = right_n[b + 1];
+            if n == 0 || rn == 0 {
+                continue;
+            }
+            let cost = n as f64 * acc.surface_area() + rn as f64 * right_area[b + 1];
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, axis, b));
+            }
+        }
+    }
+    let (cost, axis, bin) = best?;
+    let area = bounds.surface_area().max(f64::MIN_POSITIVE);
+    let split_cost = TRAVERSAL_COST + INTERSECT_COST * cost / area;
+    if count <= MAX_LEAF && split_cost >= INTERSECT_COST * count as f64 {
+        return None;
+    }
+    let scale = BINS as f64 / ext[axis];
+    let mut left = 0;
+    for k in 0..count {
+        let c = centroids[idx[k] as usize];
+        let b = (((c[axis] - cbounds.min[axis]) * scale) as usize).min(BINS - 1);
+        if b <= bin {
+            idx.swap(k, left);
+            left += 1;
+        }
+    }
+    (left > 0 && left < count).then_some(left)
+}

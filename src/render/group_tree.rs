@@ -1,0 +1,182 @@
+//! A culling structure over many velocity groups, so that a ray does not loop over all of them.
+//!
+//! Each node bounds its groups in the world frame by a box at a reference time T and per-axis
+//! velocity bounds [v_lo, v_hi]: at time t the groups lie within
+//! `[lo + min(v_lo·dt, v_hi·dt), hi + max(v_lo·dt, v_hi·dt)]`, dt = t − T. A past null ray
+//! `x(λ) = x_H + λ a, t = t_H − λ` meets those bounds on an interval of λ found by two slab
+//! tests, one for λ ≤ t_H − T (with directions a + v_lo, a + v_hi) and one beyond: each bound is
+//! linear in λ on either side. For one group (v_lo = v_hi) this is the exact Galilean test of the
+//! ray against the group's moving, Lorentz-contracted box. It holds for any past null ray —
+//! primary, reflected or shadow — with no assumption about when it starts.
+
+use crate::geometry::{Aabb, BoxTree};
+use crate::spacetime::{NullRay, Velocity};
+use glam::DVec3;
+
+#[derive(Clone, Copy, Debug)]
+struct KineticNode {
+    lo: DVec3,
+    hi: DVec3,
+    vlo: DVec3,
+    vhi: DVec3,
+    first: u32,
+    count: u32,
+}
+
+pub struct GroupTree {
+    nodes: Vec<KineticNode>,
+    indices: Vec<u32>,
+    t_ref: f64,
+}
+
+/// The world-frame box at world time `t` of rest-frame bounds moving at `v` (whose rest-frame
+/// origin passes the world origin at t = 0): the corners contracted along v, then carried.
+pub fn world_box(rest: &Aabb, v: &Velocity, t: f64) -> Aabb {
+    let (dir, g) = (v.direction(), v.gamma());
+    let mut b = Aabb::EMPTY;
+    for k in 0..8 {
+        let p = DVec3::new(
+            if k & 1 == 0 { rest.min.x } else { rest.max.x },
+            if k & 2 == 0 { rest.min.y } else { rest.max.y },
+            if k & 4 == 0 { rest.min.z } else { rest.max.z },
+        );
+        let contracted = p + (1.0 / g - 1.0) * p.dot(dir) * dir;
+        b.grow(contracted + v.beta_vec() * t);
+    }
+    b
+}
+
+/// Where `c + λ k ≥ 0` holds, intersected into [t0, t1].
+#[inline]
+fn half(c: f64, k: f64, t0: &mut f64, t1: &mut f64) {
+    if k > 0.0 {
+        *t0 = t0.max(-c / k);
+    } else if k < 0.0 {
+        *t1 = t1.min(-c / k);
+    } else if c < 0.0 {
+        *t1 = f64::NEG_INFINITY;
+    }
+}
+
+impl GroupTree {
+    /// `groups`: each group's rest-frame bounds and velocity; `t_ref`: the reference time
+    /// (the view time keeps the numbers small near the imaging event).
+    pub fn build(groups: &[(Aabb, Velocity)], t_ref: f64) -> GroupTree {
+        let boxes: Vec<Aabb> = groups.iter().map(|(b, v)| world_box(b, v, t_ref)).collect();
+        let tree = BoxTree::build(&boxes);
+        let mut nodes: Vec<KineticNode> = tree
+            .nodes
+            .iter()
+            .map(|n| KineticNode {
+                lo: n.bounds.min,
+                hi: n.bounds.max,
+                vlo: DVec3::splat(f64::INFINITY),
+                vhi: DVec3::splat(f64::NEG_INFINITY),
+                first: n.first,
+                count: n.count,
+            })
+            .collect();
+        // Children come after their parents: fill velocity bounds from the leaves up.
+        for i in (0..nodes.len()).rev() {
+            let n = nodes[i];
+            if n.count > 0 {
+                for &g in &tree.indices[n.first as usize..(n.first + n.count) as usize] {
+                    let v = groups[g as usize].1.beta_vec();
+                    nodes[i].vlo = nodes[i].vlo.min(v);
+                    nodes[i].vhi = nodes[i].vhi.max(v);
+                }
+            } else {
+                let (l, r) = (nodes[n.first as usize], nodes[n.first as usize + 1]);
+                nodes[i].vlo = l.vlo.min(r.vlo);
+                nodes[i].vhi = l.vhi.max(r.vhi);
+            }
+        }
+        GroupTree {
+            nodes,
+            indices: tree.indices,
+            t_ref,
+        }
+    }
+
+    /// The first λ in (tmin, tmax) at which the ray may be inside the node's bounds.
+    #[inline]
+    fn entry(&self, n: &KineticNode, ray: &NullRay, tmin: f64, tmax: f64) -> Option<f64> {
+        let tau = ray.origin.t - self.t_ref;
+        let (x, a) = (ray.origin.x, ray.dir);
+        // Segment A: λ ≤ τ (t ≥ T), lower bounds move at v_lo, upper at v_hi; segment B the
+        // other way round.
+        let mut best: Option<f64> = None;
+        for (seg0, seg1, vl, vh) in [
+            (tmin, tmax.min(tau), n.vlo, n.vhi),
+            (tmin.max(tau), tmax, n.vhi, n.vlo),
+        ] {
+            let (mut t0, mut t1) = (seg0, seg1);
+            if t0 > t1 {
+                continue;
+            }
+            for i in 0..3 {
+                half(x[i] - n.lo[i] - vl[i] * tau, a[i] + vl[i], &mut t0, &mut t1);
+                half(
+                    -(x[i] - n.hi[i] - vh[i] * tau),
+                    -(a[i] + vh[i]),
+                    &mut t0,
+                    &mut t1,
+                );
+            }
+            if t0 <= t1 {
+                best = Some(best.map_or(t0, |b: f64| b.min(t0)));
+            }
+        }
+        best
+    }
+
+    /// Visit the groups the ray may meet in (tmin, tmax), nearer subtrees first. `visit(group,
+    /// tmax)` returns the new tmax (the best hit so far); a tmax below tmin stops the walk.
+    pub fn traverse(
+        &self,
+        ray: &NullRay,
+        tmin: f64,
+        tmax: f64,
+        mut visit: impl FnMut(u32, f64) -> f64,
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut tmax = tmax;
+        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        if let Some(e) = self.entry(&self.nodes[0], ray, tmin, tmax) {
+            stack.push((0, e));
+        }
+        while let Some((i, e)) = stack.pop() {
+            if e > tmax {
+                continue;
+            }
+            let n = self.nodes[i as usize];
+            if n.count > 0 {
+                for &g in &self.indices[n.first as usize..(n.first + n.count) as usize] {
+                    tmax = visit(g, tmax);
+                    if tmax < tmin {
+                        return;
+                    }
+                }
+            } else {
+                let (l, r) = (n.first, n.first + 1);
+                let el = self.entry(&self.nodes[l as usize], ray, tmin, tmax);
+                let er = self.entry(&self.nodes[r as usize], ray, tmin, tmax);
+                match (el, er) {
+                    (Some(a), Some(b)) if a <= b => {
+                        stack.push((r, b));
+                        stack.push((l, a));
+                    }
+                    (Some(a), Some(b)) => {
+                        stack.push((l, a));
+                        stack.push((r, b));
+                    }
+                    (Some(a), None) => stack.push((l, a)),
+                    (None, Some(b)) => stack.push((r, b)),
+                    (None, None) => {}
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,197 @@
+//! Many velocity groups: the kinetic group tree finds every group a ray can meet (never fewer),
+//! and renders with and without it, or with equal velocities merged or not, are identical.
+
+mod common;
+use common::*;
+use glam::DVec3;
+use rest_embree::geometry::Aabb;
+use rest_embree::render::{render_world, GroupTree, World, WorldOptions};
+use rest_embree::spacetime::{Boost, Event, NullRay, Velocity};
+
+#[test]
+fn group_tree_visits_every_group_a_ray_meets() {
+    let mut r = Rng(3);
+    let groups: Vec<(Aabb, Velocity)> = (0..500)
+        .map(|_| {
+            let c = DVec3::new(
+                r.range(-50.0, 50.0),
+                r.range(-50.0, 50.0),
+                r.range(-50.0, 50.0),
+            );
+            let h = DVec3::new(r.range(0.1, 2.0), r.range(0.1, 2.0), r.range(0.1, 2.0));
+            let v = Velocity::from_rapidity(r.unit(), r.range(0.0, 3.0)).unwrap();
+            (Aabb::new(c - h, c + h), v)
+        })
+        .collect();
+    let t_ref = 20.0;
+    let tree = GroupTree::build(&groups, t_ref);
+    let mut checked = 0;
+    for _ in 0..12000 {
+        // Rays from arbitrary events, before and after the reference time.
+        let o = Event::new(
+            r.range(-100.0, 100.0),
+            DVec3::new(
+                r.range(-60.0, 60.0),
+                r.range(-60.0, 60.0),
+                r.range(-60.0, 60.0),
+            ),
+        );
+        let ray = NullRay::new(o, r.unit());
+        let tmax = if r.f() < 0.5 {
+            f64::INFINITY
+        } else {
+            r.range(1.0, 200.0)
+        };
+        let mut visited = vec![false; groups.len()];
+        tree.traverse(&ray, 0.0, tmax, |g, t| {
+            visited[g as usize] = true;
+            t
+        });
+        for (i, (b, v)) in groups.iter().enumerate() {
+            // Exact: the ray in the group's rest frame against its rest-frame bounds.
+            let boost = Boost::to_rest(v);
+            let (d, _) = boost.null_dir(ray.dir);
+            if b.clip(boost.event(ray.origin).x, d.recip(), 0.0, tmax)
+                .is_some()
+            {
+                checked += 1;
+                assert!(
+                    visited[i],
+                    "group {i} is met by the ray but the tree skipped it"
+                );
+            }
+        }
+    }
+    assert!(
+        checked > 600,
+        "enough ray-group meetings were checked ({checked})"
+    );
+}
+
+/// `n` small objects, each in its own group with its own velocity (some groups share one),
+/// a light and a mirror, all in front of the camera.
+fn many_groups_scene(n: usize) -> String {
+    let mut r = Rng(11);
+    let mut s = String::from(
+        r#"
+[camera]
+position = [0, -30, 0]
+look_at = [0, 0, 0]
+fov_y = 60
+time = 30
+[image]
+width = 120
+height = 90
+[[material]]
+name = "mirror"
+color = 0.1
+reflect = 0.7
+[[light]]
+position = [0, -20, 30]
+"#,
+    );
+    for i in 0..n {
+        let c = DVec3::new(
+            r.range(-15.0, 15.0),
+            r.range(-10.0, 10.0),
+            r.range(-12.0, 12.0),
+        );
+        // Every fifth group shares the velocity of the one before it.
+        let v = if i % 5 == 4 {
+            DVec3::new(0.3, 0.1, 0.0)
+        } else {
+            r.unit() * r.range(0.0, 0.6)
+        };
+        let v = if i % 5 == 3 {
+            DVec3::new(0.3, 0.1, 0.0)
+        } else {
+            v
+        };
+        s += &format!(
+            "[[group]]\nname = \"g{i}\"\nvelocity = [{:?}, {:?}, {:?}]\n[[group.object]]\n",
+            v.x, v.y, v.z
+        );
+        if i % 3 == 0 {
+            s += &format!(
+                "type = \"sphere\"\ncenter = [{:?}, {:?}, {:?}]\nradius = 0.8\nmaterial = \"mirror\"\n",
+                c.x, c.y, c.z
+            );
+        } else {
+            s += &format!(
+                "type = \"box\"\nmin = [{:?}, {:?}, {:?}]\nmax = [{:?}, {:?}, {:?}]\n",
+                c.x - 0.6,
+                c.y - 0.6,
+                c.z - 0.6,
+                c.x + 0.6,
+                c.y + 0.6,
+                c.z + 0.6
+            );
+        }
+    }
+    s
+}
+
+#[test]
+fn group_tree_and_merging_do_not_change_the_picture() {
+    let s = scene(&many_groups_scene(200));
+    for name in backends() {
+        let backend = rest_embree::accel::backend_by_name(name).unwrap();
+        let plain = World::build_with(
+            &s,
+            backend.as_ref(),
+            WorldOptions {
+                merge_equal_velocities: false,
+                bounds_cull: true,
+                group_tree: false,
+            },
+        )
+        .unwrap();
+        let fast = World::build(&s, backend.as_ref()).unwrap();
+        assert!(fast.uses_group_tree() && !plain.uses_group_tree());
+        assert!(
+            fast.groups.len() < plain.groups.len(),
+            "equal velocities were merged"
+        );
+        let a = render_world(&s, &plain).0;
+        let b = render_world(&s, &fast).0;
+        let hit = a.pixels.iter().filter(|p| p.object_id != 0).count();
+        assert!(hit > 1000, "{name}: the objects are in view ({hit})");
+        // The tree alone changes nothing at all.
+        let tree_only = World::build_with(
+            &s,
+            backend.as_ref(),
+            WorldOptions {
+                merge_equal_velocities: false,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(
+            render_world(&s, &tree_only).0,
+            a,
+            "{name}: the group tree changes no bit"
+        );
+        // Merging moves each scene's bounds, so rays are rebased at other points: rounding only.
+        let ids = a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .filter(|(p, q)| p.object_id != q.object_id)
+            .count();
+        assert_eq!(
+            ids, 0,
+            "{name}: {ids} pixels see another object with merging"
+        );
+        let worst = a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .map(|(p, q)| {
+                (0..3)
+                    .map(|k| (p.color[k] - q.color[k]).abs())
+                    .fold(0.0f32, f32::max)
+            })
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-4, "{name}: merging changes a colour by {worst}");
+    }
+}
