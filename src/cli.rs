@@ -28,32 +28,31 @@ pub enum Command {
 
 #[derive(clap::Args, Debug)]
 pub struct BenchArgs {
-    /// A scene file to measure; without one, the paper's lattice at beta 0, 0.5, 0.9, 0.99.
+    /// Measure this scene file instead of the fixed suite (the paper's lattice at four speeds,
+    /// a 100^3 lattice, 1 to 10,000 velocity groups, merging).
     pub scene: Option<PathBuf>,
-    /// Backends to measure (repeatable; default: every backend of this build).
+    /// Settings to measure on SCENE (repeatable): a backend name, optionally with a skip
+    /// switched off, e.g. 'embree no-cull' (default: every backend of this build).
     #[arg(long = "backend")]
     pub backends: Vec<String>,
-    /// Image width (default 512).
-    #[arg(long, default_value_t = 512)]
-    pub width: u32,
-    /// Image height (default 512).
-    #[arg(long, default_value_t = 512)]
-    pub height: u32,
-    /// Samples per pixel (default 1).
-    #[arg(long, default_value_t = 1)]
-    pub samples: u32,
-    /// Override any scene value, as for render.
+    /// Smaller images and scenes: the whole suite in well under a minute.
+    #[arg(long)]
+    pub quick: bool,
+    /// Only the suite's cases whose name contains this text (repeatable).
+    #[arg(long = "case")]
+    pub cases: Vec<String>,
+    /// Override any value of SCENE, as for render.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// Primary-ray passes per backend; the fastest counts.
+    /// Primary-ray passes per row; the fastest counts.
     #[arg(long, default_value_t = 3)]
     pub repeat: usize,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Also write the rows as CSV to this file.
-    #[arg(long)]
-    pub csv: Option<PathBuf>,
+    /// Where to write bench.md, bench.csv and bench.png.
+    #[arg(long, default_value = "bench-out")]
+    pub out: PathBuf,
 }
 
 #[derive(clap::Args, Debug)]
@@ -151,42 +150,64 @@ fn set_threads(threads: Option<usize>) -> Result<(), String> {
 
 fn run_bench(args: &BenchArgs) -> Result<(), String> {
     set_threads(args.threads)?;
-    let backends = if args.backends.is_empty() {
-        accel::backend_names()
-            .iter()
-            .map(|s| s.to_string())
-            .collect()
-    } else {
-        args.backends.clone()
-    };
-    for b in &backends {
-        accel::backend_by_name(b).map_err(|e| format!("--backend: {e}"))?;
-    }
-    let mut sets = vec![
-        format!("image.width={}", args.width),
-        format!("image.height={}", args.height),
-        format!("image.samples={}", args.samples),
-    ];
-    sets.extend(args.set.iter().cloned());
     let cases = match &args.scene {
-        None => bench::default_cases(&sets).map_err(|e| e.to_string())?,
+        None => {
+            let mut all = bench::cases(args.quick).map_err(|e| e.to_string())?;
+            if !args.cases.is_empty() {
+                all.retain(|c| args.cases.iter().any(|f| c.name.contains(f.as_str())));
+                if all.is_empty() {
+                    return Err("--case: no case of the suite matches".into());
+                }
+            }
+            all
+        }
         Some(path) => {
-            let overrides: Vec<(String, String)> = sets
+            let overrides: Vec<(String, String)> = args
+                .set
                 .iter()
                 .map(|s| (format!("--set {s}"), s.clone()))
                 .collect();
-            vec![bench::Case {
-                name: path.display().to_string(),
-                scene: scene::load_file(path, &overrides).map_err(|e| e.to_string())?,
-            }]
+            let scene = scene::load_file(path, &overrides).map_err(|e| e.to_string())?;
+            let names: Vec<String> = if args.backends.is_empty() {
+                accel::backend_names()
+                    .iter()
+                    .map(|s| s.to_string())
+                    .collect()
+            } else {
+                args.backends.clone()
+            };
+            for n in &names {
+                let backend = n.split_whitespace().next().unwrap_or_default();
+                accel::backend_by_name(backend).map_err(|e| format!("--backend: {e}"))?;
+            }
+            let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+            vec![bench::Case::new(&path.display().to_string(), scene, &refs).with_bare()]
         }
     };
-    let rows = bench::run(&cases, &backends, args.repeat)?;
-    println!("threads: {}", rayon::current_num_threads());
-    print!("{}", bench::table(&rows));
-    if let Some(p) = &args.csv {
-        std::fs::write(p, bench::csv(&rows)).map_err(|e| format!("--csv {}: {e}", p.display()))?;
-    }
+    let rows = bench::run(&cases, args.repeat, |name| eprintln!("bench: {name}"))?;
+    let table = bench::table(&rows);
+    let summary = bench::summary(&rows);
+    println!(
+        "threads: {}\n\n{table}\n{summary}",
+        rayon::current_num_threads()
+    );
+    std::fs::create_dir_all(&args.out).map_err(|e| format!("--out {}: {e}", args.out.display()))?;
+    let md = format!(
+        "Measured with `rest-embree bench{}` on {} threads.\n\n{table}\n{summary}",
+        if args.quick { " --quick" } else { "" },
+        rayon::current_num_threads()
+    );
+    let write = |name: &str, text: &str| {
+        std::fs::write(args.out.join(name), text)
+            .map_err(|e| format!("--out {}: {e}", args.out.display()))
+    };
+    write("bench.md", &md)?;
+    write("bench.csv", &bench::csv(&rows))?;
+    bench::plot_png(&rows, &args.out.join("bench.png"))?;
+    eprintln!(
+        "bench: wrote bench.md, bench.csv and bench.png to {}",
+        args.out.display()
+    );
     Ok(())
 }
 

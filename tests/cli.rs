@@ -432,3 +432,35 @@ fn embree_is_the_default_backend() {
     assert!(text.starts_with("embree (default)"), "{text}");
     assert!(text.contains("bvh"));
 }
+
+#[test]
+fn bench_writes_its_table_csv_and_plot() {
+    let d = Dir::new("bench");
+    let out = d.0.join("b");
+    let (ok, err) = run(&[
+        "bench",
+        "--quick",
+        "--repeat",
+        "1",
+        "--case",
+        "lattice beta=0.9, no lights",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
+    assert!(csv.starts_with("case,setting,spp,"), "{csv}");
+    assert!(csv.lines().count() >= 2, "a row per setting: {csv}");
+    let md = std::fs::read_to_string(out.join("bench.md")).unwrap();
+    assert!(md.contains("| lattice beta=0.9, no lights | bvh |"), "{md}");
+    assert_eq!(&std::fs::read(out.join("bench.png")).unwrap()[1..4], b"PNG");
+    let (ok, err) = run(&[
+        "bench",
+        "--quick",
+        "--case",
+        "no such case",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("--case"), "{err}");
+}

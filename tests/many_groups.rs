@@ -195,3 +195,47 @@ fn group_tree_and_merging_do_not_change_the_picture() {
         assert!(worst < 1e-4, "{name}: merging changes a colour by {worst}");
     }
 }
+
+#[test]
+fn apparent_boxes_hold_every_apparent_position() {
+    use rest_embree::render::apparent_box;
+    use rest_embree::spacetime::retarded_position;
+    let mut r = Rng(5);
+    for _ in 0..400 {
+        let c = DVec3::new(
+            r.range(-30.0, 30.0),
+            r.range(-30.0, 30.0),
+            r.range(-30.0, 30.0),
+        );
+        let h = DVec3::new(r.range(0.1, 3.0), r.range(0.1, 3.0), r.range(0.1, 3.0));
+        let rest = Aabb::new(c - h, c + h);
+        let v = Velocity::from_rapidity(r.unit(), r.range(0.0, 3.0)).unwrap();
+        let event = Event::new(
+            r.range(-20.0, 20.0),
+            DVec3::new(
+                r.range(-40.0, 40.0),
+                r.range(-40.0, 40.0),
+                r.range(-40.0, 40.0),
+            ),
+        );
+        let b = apparent_box(&rest, &v, event);
+        let now = rest_embree::render::world_box(&rest, &v, event.t);
+        // Points of the body (lab-simultaneous at the view time) and where they are seen.
+        for _ in 0..50 {
+            let p = now.min + (now.max - now.min) * DVec3::new(r.f(), r.f(), r.f());
+            // world_box is the AABB of the contracted box; keep points inside the body itself.
+            let back = p - v.beta_vec() * event.t;
+            let g = v.gamma();
+            let rest_p = back + (g - 1.0) * back.dot(v.direction()) * v.direction();
+            if !(rest_p.cmpge(rest.min - 1e-9).all() && rest_p.cmple(rest.max + 1e-9).all()) {
+                continue;
+            }
+            let seen = event.x + retarded_position(p - event.x, &v);
+            let tol = 1e-7 * (1.0 + seen.abs().max_element());
+            assert!(
+                seen.cmpge(b.min - tol).all() && seen.cmple(b.max + tol).all(),
+                "apparent point {seen} outside {b:?}"
+            );
+        }
+    }
+}

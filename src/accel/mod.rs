@@ -11,7 +11,7 @@ mod embree;
 
 pub use bvh::{Bvh, BvhBackend};
 #[cfg(feature = "embree")]
-pub use embree::EmbreeBackend;
+pub use embree::{BareRay, EmbreeAccel, EmbreeBackend};
 
 use crate::geometry::Geometry;
 use glam::DVec3;
@@ -48,6 +48,8 @@ pub trait Accelerator: Send + Sync {
     fn occluded(&self, rays: &[Ray], out: &mut [bool]);
     /// The geometry this accelerator was built over.
     fn geometry(&self) -> &Arc<Geometry>;
+    /// For benchmarks that need the concrete backend.
+    fn as_any(&self) -> &dyn std::any::Any;
 }
 
 /// Builds accelerators; one per kind of backend.
@@ -75,8 +77,15 @@ pub fn backend_by_name(name: &str) -> Result<Box<dyn Backend>, String> {
         "bvh" => Ok(Box::new(BvhBackend)),
         #[cfg(feature = "embree")]
         "embree" => Ok(Box::new(EmbreeBackend::new())),
+        // Fixed packet widths, for comparisons (`embree` picks 16 or 8 from the CPU).
+        #[cfg(feature = "embree")]
+        "embree-16" => Ok(Box::new(EmbreeBackend::with_packet_width(16))),
+        #[cfg(feature = "embree")]
+        "embree-8" => Ok(Box::new(EmbreeBackend::with_packet_width(8))),
+        #[cfg(feature = "embree")]
+        "embree-single" => Ok(Box::new(EmbreeBackend::with_packet_width(1))),
         #[cfg(not(feature = "embree"))]
-        "embree" => Err(
+        "embree" | "embree-16" | "embree-8" | "embree-single" => Err(
             "backend 'embree' is not in this build: rebuild with `--features embree` (needs libembree-dev and libclang-dev)"
                 .to_string(),
         ),

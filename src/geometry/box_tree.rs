@@ -2,6 +2,53 @@
 //! and of the world's culling structure over velocity groups.
 
 use super::Aabb;
+pub use small_stack::SmallStack;
+
+mod small_stack {
+    /// A traversal stack on the stack: trees here are at most 64 deep for any realistic input;
+    /// deeper pushes spill to the heap rather than fail.
+    pub struct SmallStack {
+        buf: [(u32, f64); 64],
+        len: usize,
+        spill: Vec<(u32, f64)>,
+    }
+
+    impl Default for SmallStack {
+        fn default() -> Self {
+            Self::new()
+        }
+    }
+
+    impl SmallStack {
+        pub fn new() -> Self {
+            Self {
+                buf: [(0, 0.0); 64],
+                len: 0,
+                spill: Vec::new(),
+            }
+        }
+        #[inline]
+        pub fn push(&mut self, v: (u32, f64)) {
+            if self.len < self.buf.len() {
+                self.buf[self.len] = v;
+                self.len += 1;
+            } else {
+                self.spill.push(v);
+            }
+        }
+        #[inline]
+        pub fn pop(&mut self) -> Option<(u32, f64)> {
+            if let Some(v) = self.spill.pop() {
+                return Some(v);
+            }
+            if self.len == 0 {
+                return None;
+            }
+            self.len -= 1;
+            Some(self.buf[self.len])
+        }
+    }
+}
 use glam::DVec3;
 
 const BINS: usize = 16;
@@ -182,4 +229,64 @@ fn find_split(
         }
     }
     (left > 0 && left < count).then_some(left)
+}
+
+impl BoxTree {
+    /// Visit the items whose boxes the ray `o + t d` meets in (tmin, tmax), nearer subtrees
+    /// first; `visit(item, tmax)` returns the new tmax, and a tmax below tmin stops the walk.
+    pub fn traverse(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        tmin: f64,
+        tmax: f64,
+        mut visit: impl FnMut(u32, f64) -> f64,
+    ) {
+        if self.nodes.is_empty() || self.indices.is_empty() {
+            return;
+        }
+        let inv = d.recip();
+        let mut tmax = tmax;
+        let mut stack = SmallStack::new();
+        if let Some((e, _)) = self.nodes[0].bounds.clip(o, inv, tmin, tmax) {
+            stack.push((0, e));
+        }
+        while let Some((i, e)) = stack.pop() {
+            if e > tmax {
+                continue;
+            }
+            let n = self.nodes[i as usize];
+            if n.count > 0 {
+                for &item in &self.indices[n.first as usize..(n.first + n.count) as usize] {
+                    tmax = visit(item, tmax);
+                    if tmax < tmin {
+                        return;
+                    }
+                }
+            } else {
+                let (l, r) = (n.first, n.first + 1);
+                let el = self.nodes[l as usize]
+                    .bounds
+                    .clip(o, inv, tmin, tmax)
+                    .map(|x| x.0);
+                let er = self.nodes[r as usize]
+                    .bounds
+                    .clip(o, inv, tmin, tmax)
+                    .map(|x| x.0);
+                match (el, er) {
+                    (Some(a), Some(b)) if a <= b => {
+                        stack.push((r, b));
+                        stack.push((l, a));
+                    }
+                    (Some(a), Some(b)) => {
+                        stack.push((l, a));
+                        stack.push((r, b));
+                    }
+                    (Some(a), None) => stack.push((l, a)),
+                    (None, Some(b)) => stack.push((r, b)),
+                    (None, None) => {}
+                }
+            }
+        }
+    }
 }

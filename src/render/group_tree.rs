@@ -9,7 +9,7 @@
 //! ray against the group's moving, Lorentz-contracted box. It holds for any past null ray —
 //! primary, reflected or shadow — with no assumption about when it starts.
 
-use crate::geometry::{Aabb, BoxTree};
+use crate::geometry::{Aabb, BoxTree, SmallStack};
 use crate::spacetime::{NullRay, Velocity};
 use glam::DVec3;
 
@@ -27,6 +27,80 @@ pub struct GroupTree {
     nodes: Vec<KineticNode>,
     indices: Vec<u32>,
     t_ref: f64,
+}
+
+/// Kinetic trees at several reference times: a ray is cut at the midpoints between them and
+/// each piece asks the tree nearest in time, so a node's bounds grow by at most v_max times
+/// half the slice spacing (plus the ends, beyond which the outermost trees serve).
+pub struct SlicedGroupTree {
+    slices: Vec<GroupTree>,
+}
+
+impl SlicedGroupTree {
+    /// `count` reference times spread evenly over [t_first, t_last].
+    pub fn build(
+        groups: &[(Aabb, Velocity)],
+        t_first: f64,
+        t_last: f64,
+        count: usize,
+    ) -> SlicedGroupTree {
+        let count = count.max(1);
+        use rayon::prelude::*;
+        let slices = (0..count)
+            .into_par_iter()
+            .map(|k| {
+                let f = if count == 1 {
+                    0.5
+                } else {
+                    k as f64 / (count - 1) as f64
+                };
+                GroupTree::build(groups, t_first + f * (t_last - t_first))
+            })
+            .collect();
+        SlicedGroupTree { slices }
+    }
+
+    /// As [`GroupTree::traverse`], piece by piece along the ray (later times first); a group
+    /// met in several pieces may be visited more than once.
+    pub fn traverse(
+        &self,
+        ray: &NullRay,
+        tmin: f64,
+        tmax: f64,
+        mut visit: impl FnMut(u32, f64) -> f64,
+    ) {
+        let mut tmax = tmax;
+        let n = self.slices.len();
+        for (k, tree) in self.slices.iter().enumerate().rev() {
+            // Times closer to this slice's reference than to its neighbours' (λ = t_H − t).
+            let t_hi = if k + 1 < n {
+                0.5 * (tree.t_ref + self.slices[k + 1].t_ref)
+            } else {
+                f64::INFINITY
+            };
+            let t_lo = if k > 0 {
+                0.5 * (tree.t_ref + self.slices[k - 1].t_ref)
+            } else {
+                f64::NEG_INFINITY
+            };
+            let lo = tmin.max(ray.origin.t - t_hi);
+            let hi = tmax.min(ray.origin.t - t_lo);
+            if lo > hi {
+                continue;
+            }
+            let mut stop = false;
+            tree.traverse(ray, lo, hi, |g, _| {
+                // Groups are searched over the whole ray, so pass the best hit so far.
+                let new = visit(g, tmax);
+                stop |= new < tmin;
+                tmax = tmax.min(new);
+                new
+            });
+            if stop || tmax < tmin {
+                return;
+            }
+        }
+    }
 }
 
 /// The world-frame box at world time `t` of rest-frame bounds moving at `v` (whose rest-frame
@@ -143,7 +217,7 @@ impl GroupTree {
             return;
         }
         let mut tmax = tmax;
-        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        let mut stack = SmallStack::new();
         if let Some(e) = self.entry(&self.nodes[0], ray, tmin, tmax) {
             stack.push((0, e));
         }

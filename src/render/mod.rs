@@ -2,6 +2,7 @@
 //! each velocity group's rest frame, the merge of hits by world-frame lookback time, and Whitted
 //! shading in the rest frame of the surface hit.
 
+mod apparent_tree;
 mod camera;
 mod frame;
 mod group_tree;
@@ -10,6 +11,7 @@ mod shade;
 mod tile;
 mod world;
 
+pub use apparent_tree::{apparent_box, ApparentTree};
 pub use camera::CameraRays;
 pub use frame::{Frame, PixelValue, CHANNELS};
 pub use group_tree::{world_box, GroupTree};
@@ -60,6 +62,27 @@ pub fn trace_primary(scene: &Scene, world: &World) -> (u64, u64) {
         .par_iter()
         .map(|&(x0, y0)| tile::trace_tile(scene, world, &cam, x0, y0))
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+}
+
+/// Every pixel-centre primary ray, tile by tile in the order the renderer traces them (for the
+/// benchmark's bare-Embree baseline).
+pub fn primary_rays_by_tile(scene: &Scene) -> Vec<Vec<crate::spacetime::NullRay>> {
+    let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
+    let (w, h) = scene.image.frame_size();
+    tiles(scene)
+        .iter()
+        .map(|&(x0, y0)| {
+            let mut rays = Vec::new();
+            tile::primary_rays(
+                &cam,
+                &tile::tile_pixels(x0, y0, w, h),
+                scene.image.frame_offset(),
+                None,
+                &mut rays,
+            );
+            rays
+        })
+        .collect()
 }
 
 /// Render with acceleration structures already built.

@@ -7,7 +7,8 @@
 //! kinetic tree over the groups (group_tree.rs) finds the few a ray can meet, so a ray that misses
 //! every group costs a handful of box tests.
 
-use super::group_tree::GroupTree;
+use super::apparent_tree::ApparentTree;
+use super::group_tree::SlicedGroupTree;
 use crate::accel::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, Part};
 use crate::scene::Scene;
@@ -17,6 +18,18 @@ use std::sync::Arc;
 
 /// From this many groups on, rays find their groups through the group tree.
 pub const GROUP_TREE_MIN: usize = 8;
+
+/// Kinetic trees per world (reference times), when the group tree is in use.
+const TIME_SLICES: usize = 16;
+
+/// Groups with at most this many primitives are intersected in f64 directly: an acceleration
+/// structure (and a call into it) costs more than the primitives themselves.
+pub const DIRECT_MAX: usize = 4;
+
+/// The largest distance from `p` to a corner of `b`.
+fn corner_distance(b: &Aabb, p: DVec3) -> f64 {
+    (b.min - p).abs().max((b.max - p).abs()).length()
+}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WorldOptions {
@@ -39,14 +52,50 @@ impl Default for WorldOptions {
 }
 
 pub struct GroupRt {
+    /// The imaging event's position in this group's rest frame.
+    pub event_rest: DVec3,
+    /// Intersect the few primitives in f64 directly instead of calling the accelerator.
+    pub direct: bool,
     pub velocity: Velocity,
     pub boost: Boost,
     pub unboost: Boost,
     pub bounds: Aabb,
     pub geometry: Arc<Geometry>,
-    pub accel: Box<dyn Accelerator>,
+    /// None for groups intersected directly.
+    pub accel: Option<Box<dyn Accelerator>>,
     /// Offset for spawning secondary rays off surfaces, in rest-frame length.
     pub epsilon: f64,
+}
+
+impl GroupRt {
+    /// One ray's closest hit in this group.
+    fn intersect1(&self, r: &Ray) -> Option<Hit> {
+        if let Some(accel) = &self.accel {
+            let mut h = [None];
+            accel.intersect(std::slice::from_ref(r), &mut h);
+            return h[0];
+        }
+        let mut best: Option<Hit> = None;
+        for (i, p) in self.geometry.prims.iter().enumerate() {
+            if let Some(t) = p.intersect(r.origin, r.dir, r.tmin, best.map_or(r.tmax, |b| b.t)) {
+                best = Some(Hit { t, prim: i as u32 });
+            }
+        }
+        best
+    }
+
+    /// Whether anything of this group lies on the ray.
+    fn occluded1(&self, r: &Ray) -> bool {
+        if let Some(accel) = &self.accel {
+            let mut o = [false];
+            accel.occluded(std::slice::from_ref(r), &mut o);
+            return o[0];
+        }
+        self.geometry
+            .prims
+            .iter()
+            .any(|p| p.intersect(r.origin, r.dir, r.tmin, r.tmax).is_some())
+    }
 }
 
 /// A primary or secondary hit: which (world) group and primitive, the world-frame lookback λ,
@@ -64,8 +113,12 @@ pub struct SurfaceHit {
 
 pub struct World {
     pub groups: Vec<GroupRt>,
+    /// The imaging event (world frame), where every primary ray starts.
+    event: crate::spacetime::Event,
     pub options: WorldOptions,
-    tree: Option<GroupTree>,
+    /// With many groups: every ray's culling (kinetic), and the primary rays' (apparent boxes).
+    tree: Option<SlicedGroupTree>,
+    primary_tree: Option<ApparentTree>,
 }
 
 /// A ray boosted into a group's rest frame and rebased to the near side of the group's bounds.
@@ -127,14 +180,23 @@ impl World {
                 .iter()
                 .map(|&i| scene.groups[i].name.as_str())
                 .collect();
-            let accel = backend.build(geometry.clone()).map_err(|e| {
-                format!(
-                    "building the {} backend for group `{}`: {e}",
-                    backend.name(),
-                    names.join("`, `")
-                )
-            })?;
+            let direct = geometry.prims.len() <= DIRECT_MAX;
+            let accel = if direct {
+                None
+            } else {
+                Some(backend.build(geometry.clone()).map_err(|e| {
+                    format!(
+                        "building the {} backend for group `{}`: {e}",
+                        backend.name(),
+                        names.join("`, `")
+                    )
+                })?)
+            };
             groups.push(GroupRt {
+                event_rest: Boost::to_rest(&velocity)
+                    .event(scene.camera.imaging_event())
+                    .x,
+                direct,
                 velocity,
                 boost: Boost::to_rest(&velocity),
                 unboost: Boost::from_rest(&velocity),
@@ -144,15 +206,36 @@ impl World {
                 epsilon: 1e-7 * bounds.diagonal().max(1e-3) + 1e-12 * bounds.max_abs(),
             });
         }
-        let tree = (options.group_tree && groups.len() >= GROUP_TREE_MIN).then(|| {
+        let (mut tree, mut primary_tree) = (None, None);
+        if options.group_tree && groups.len() >= GROUP_TREE_MIN {
             let items: Vec<(Aabb, Velocity)> =
                 groups.iter().map(|g| (g.bounds, g.velocity)).collect();
-            GroupTree::build(&items, scene.camera.time)
-        });
+            let event = scene.camera.imaging_event();
+            // Kinetic trees are tight near their reference times: spread them over the window in
+            // which primary rays meet the groups, twice as deep as the farthest emission seen
+            // from the imaging event (secondary rays reach further back).
+            let apparent: Vec<Aabb> = items
+                .iter()
+                .map(|(b, v)| super::apparent_box(b, v, event))
+                .collect();
+            let deepest = apparent
+                .iter()
+                .map(|b| corner_distance(b, event.x))
+                .fold(0.0, f64::max);
+            tree = Some(SlicedGroupTree::build(
+                &items,
+                event.t - 2.0 * deepest,
+                event.t,
+                TIME_SLICES,
+            ));
+            primary_tree = Some(ApparentTree::build(&items, event));
+        }
         Ok(World {
+            event: scene.camera.imaging_event(),
             groups,
             options,
             tree,
+            primary_tree,
         })
     }
 
@@ -164,7 +247,12 @@ impl World {
     /// (tmin, tmax). The origin moves along the ray to where it enters the bounds, so the
     /// backend never sees large coordinates (DESIGN.md).
     fn rest_ray(&self, g: &GroupRt, ray: &NullRay, tmin: f64, tmax: f64) -> Option<RestRay> {
-        let origin = g.boost.event(ray.origin).x;
+        // Every primary ray starts at the imaging event: its rest-frame origin is per group.
+        let origin = if ray.origin == self.event {
+            g.event_rest
+        } else {
+            g.boost.event(ray.origin).x
+        };
         let (dir, s) = g.boost.null_dir(ray.dir);
         let shift = if self.options.bounds_cull {
             g.bounds.clip(origin, dir.recip(), tmin, tmax)?.0
@@ -199,6 +287,12 @@ impl World {
     /// the rays go to each group's backend together (packets); with many, one by one through
     /// the group tree.
     pub fn closest_hits(&self, rays: &[NullRay], tmin: f64, out: &mut [Option<SurfaceHit>]) {
+        if let Some(p) = &self.primary_tree {
+            if rays.iter().all(|r| p.serves(r)) {
+                self.closest_hits_packets(p, rays, tmin, out);
+                return;
+            }
+        }
         if self.tree.is_some() {
             for (r, o) in rays.iter().zip(out.iter_mut()) {
                 *o = self.closest_hit(r, tmin);
@@ -223,7 +317,14 @@ impl World {
             if batch.is_empty() {
                 continue;
             }
-            g.accel.intersect(&batch, &mut hits[..batch.len()]);
+            match &g.accel {
+                Some(accel) => accel.intersect(&batch, &mut hits[..batch.len()]),
+                None => {
+                    for (b, h) in batch.iter().zip(hits.iter_mut()) {
+                        *h = g.intersect1(b);
+                    }
+                }
+            }
             for (k, h) in hits[..batch.len()].iter().enumerate() {
                 if let Some(h) = h {
                     let (i, ref rr) = meta[k];
@@ -237,6 +338,35 @@ impl World {
         }
     }
 
+    /// Primary rays among many groups: packets through the apparent tree.
+    fn closest_hits_packets(
+        &self,
+        tree: &ApparentTree,
+        rays: &[NullRay],
+        tmin: f64,
+        out: &mut [Option<SurfaceHit>],
+    ) {
+        use super::apparent_tree::PACKET;
+        for (rs, os) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+            let dirs: Vec<DVec3> = rs.iter().map(|r| r.dir).collect();
+            let mut tmax = [f64::INFINITY; PACKET];
+            os.iter_mut().for_each(|o| *o = None);
+            tree.traverse_packet(&dirs, tmin, &mut tmax[..rs.len()], |gi, i, t| {
+                let g = &self.groups[gi as usize];
+                if let Some(rr) = self.rest_ray(g, &rs[i], tmin, t) {
+                    if let Some(h) = g.intersect1(&rr.ray) {
+                        let sh = Self::surface_hit(gi as usize, &rr, h);
+                        if sh.lambda < t {
+                            os[i] = Some(sh);
+                            return sh.lambda;
+                        }
+                    }
+                }
+                t
+            });
+        }
+    }
+
     /// The visible hit on one ray (secondary rays, and every ray when there are many groups).
     pub fn closest_hit(&self, ray: &NullRay, tmin: f64) -> Option<SurfaceHit> {
         let mut best: Option<SurfaceHit> = None;
@@ -244,7 +374,7 @@ impl World {
         let mut visit = |gi: usize, tmax: f64| -> f64 {
             let g = &self.groups[gi];
             if let Some(rr) = self.rest_ray(g, ray, tmin, tmax) {
-                g.accel.intersect(std::slice::from_ref(&rr.ray), &mut hit);
+                hit[0] = g.intersect1(&rr.ray);
                 if let Some(h) = hit[0] {
                     let sh = Self::surface_hit(gi, &rr, h);
                     if sh.lambda < tmax {
@@ -255,11 +385,14 @@ impl World {
             }
             tmax
         };
-        match &self.tree {
-            Some(tree) => {
+        match (&self.primary_tree, &self.tree) {
+            (Some(p), _) if p.serves(ray) => {
+                p.traverse(ray, tmin, f64::INFINITY, |g, tmax| visit(g as usize, tmax))
+            }
+            (_, Some(tree)) => {
                 tree.traverse(ray, tmin, f64::INFINITY, |g, tmax| visit(g as usize, tmax))
             }
-            None => {
+            _ => {
                 let mut tmax = f64::INFINITY;
                 for gi in 0..self.groups.len() {
                     tmax = visit(gi, tmax);
@@ -271,16 +404,10 @@ impl World {
 
     /// Whether anything lies on the ray between lookback `tmin` and `tmax`.
     pub fn occluded(&self, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
-        let mut o = [false];
-        let mut test = |gi: usize| -> bool {
+        let test = |gi: usize| -> bool {
             let g = &self.groups[gi];
-            match self.rest_ray(g, ray, tmin, tmax) {
-                Some(rr) => {
-                    g.accel.occluded(std::slice::from_ref(&rr.ray), &mut o);
-                    o[0]
-                }
-                None => false,
-            }
+            self.rest_ray(g, ray, tmin, tmax)
+                .is_some_and(|rr| g.occluded1(&rr.ray))
         };
         match &self.tree {
             Some(tree) => {

@@ -8,9 +8,12 @@
 //! back, and the hit is refined in f64 on the primitive Embree found, so the lookback times that
 //! decide the merge between groups are as exact as the f64 BVH's.
 
+mod bare;
 mod device;
 mod packet;
 mod scene;
+
+pub use bare::BareRay;
 
 use super::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::Geometry;
@@ -19,18 +22,30 @@ use std::sync::{Arc, OnceLock};
 
 pub struct EmbreeBackend {
     device: OnceLock<Result<Arc<Device>, String>>,
+    /// Packet width for batches: None picks 16 or 8 from the CPU; 1 sends single rays.
+    packet_width: Option<usize>,
 }
 
 impl EmbreeBackend {
     pub fn new() -> Self {
         Self {
             device: OnceLock::new(),
+            packet_width: None,
+        }
+    }
+
+    /// A backend that always uses this packet width (16, 8, or 1 for single rays).
+    pub fn with_packet_width(width: usize) -> Self {
+        Self {
+            device: OnceLock::new(),
+            packet_width: Some(width),
         }
     }
 
     fn device(&self) -> Result<Arc<Device>, String> {
+        // Embree's build threads follow the render's (--threads sets rayon's global pool).
         self.device
-            .get_or_init(|| Device::new(0).map(Arc::new))
+            .get_or_init(|| Device::new(rayon::current_num_threads()).map(Arc::new))
             .clone()
     }
 }
@@ -48,7 +63,7 @@ impl Backend for EmbreeBackend {
 
     fn build(&self, geometry: Arc<Geometry>) -> Result<Box<dyn Accelerator>, String> {
         let device = self.device()?;
-        let width = device.packet_width;
+        let width = self.packet_width.unwrap_or(device.packet_width);
         let scene = scene::Scene::build(device, &geometry)?;
         let diag = geometry.bounds().diagonal();
         Ok(Box::new(EmbreeAccel {
@@ -125,8 +140,10 @@ impl EmbreeAccel {
 impl Accelerator for EmbreeAccel {
     fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         packet::flush_denormals();
-        if rays.len() == 1 {
-            hits[0] = self.intersect1(&rays[0]);
+        if rays.len() == 1 || self.width == 1 {
+            for (r, h) in rays.iter().zip(hits.iter_mut()) {
+                *h = self.intersect1(r);
+            }
             return;
         }
         for (rs, hs) in rays.chunks(self.width).zip(hits.chunks_mut(self.width)) {
@@ -140,8 +157,10 @@ impl Accelerator for EmbreeAccel {
 
     fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
         packet::flush_denormals();
-        if rays.len() == 1 {
-            out[0] = self.occluded1(&rays[0]);
+        if rays.len() == 1 || self.width == 1 {
+            for (r, o) in rays.iter().zip(out.iter_mut()) {
+                *o = self.occluded1(r);
+            }
             return;
         }
         for (rs, os) in rays.chunks(self.width).zip(out.chunks_mut(self.width)) {
@@ -155,5 +174,9 @@ impl Accelerator for EmbreeAccel {
 
     fn geometry(&self) -> &Arc<Geometry> {
         &self.geometry
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }

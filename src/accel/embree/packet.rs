@@ -10,7 +10,7 @@ thread_local! {
 }
 
 /// Flush-to-zero and denormals-are-zero on this thread (Embree's recommendation), once.
-pub fn flush_denormals() {
+pub(super) fn flush_denormals() {
     FTZ_SET.with(|done| {
         if !done.get() {
             #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]

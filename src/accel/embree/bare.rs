@@ -1,0 +1,110 @@
+//! Bare Embree, for the benchmark's baseline: prepared f32 rays traced in the same packets,
+//! with nothing else (no boosts, no rebasing, no f64 refinement, no hit bookkeeping), so the
+//! cost of the relativistic layer is a ratio measured in the same run.
+
+use super::packet::flush_denormals;
+use super::EmbreeAccel;
+use embree_sys::*;
+use glam::DVec3;
+
+/// A ray already in a scene's rest frame, in f32, relative to the scene's centre.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BareRay {
+    pub org: [f32; 3],
+    pub dir: [f32; 3],
+}
+
+#[repr(C, align(64))]
+struct Valid([i32; 16]);
+
+impl EmbreeAccel {
+    /// A bare ray from a rest-frame origin and (unit) direction.
+    pub fn bare_ray(&self, origin: DVec3, dir: DVec3) -> BareRay {
+        let o = origin - self.scene.center;
+        BareRay {
+            org: [o.x as f32, o.y as f32, o.z as f32],
+            dir: [dir.x as f32, dir.y as f32, dir.z as f32],
+        }
+    }
+
+    /// Trace with bare Embree in this accelerator's packet width; returns the hit count.
+    pub fn trace_bare(&self, rays: &[BareRay]) -> usize {
+        flush_denormals();
+        let mut ctx = RTCIntersectContext::default();
+        unsafe { rtcInitIntersectContext(&mut ctx) };
+        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        let mut hits = 0;
+        let w = self.width.clamp(1, 16);
+        for chunk in rays.chunks(w) {
+            if w == 16 {
+                let mut rh = RTCRayHit16::default();
+                let mut valid = Valid([0; 16]);
+                for (i, r) in chunk.iter().enumerate() {
+                    set(&mut rh.ray, i, r);
+                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+                    valid.0[i] = -1;
+                }
+                unsafe { rtcIntersect16(valid.0.as_ptr(), self.scene.raw, &mut ctx, &mut rh) };
+                hits += (0..chunk.len())
+                    .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
+                    .count();
+            } else if w == 8 {
+                let mut rh = RTCRayHit8::default();
+                let mut valid = Valid([0; 16]);
+                for (i, r) in chunk.iter().enumerate() {
+                    set8(&mut rh.ray, i, r);
+                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+                    valid.0[i] = -1;
+                }
+                unsafe { rtcIntersect8(valid.0.as_ptr(), self.scene.raw, &mut ctx, &mut rh) };
+                hits += (0..chunk.len())
+                    .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
+                    .count();
+            } else {
+                for r in chunk {
+                    let mut rh = RTCRayHit {
+                        ray: RTCRay {
+                            org_x: r.org[0],
+                            org_y: r.org[1],
+                            org_z: r.org[2],
+                            tnear: 0.0,
+                            dir_x: r.dir[0],
+                            dir_y: r.dir[1],
+                            dir_z: r.dir[2],
+                            time: 0.0,
+                            tfar: f32::INFINITY,
+                            mask: u32::MAX,
+                            id: 0,
+                            flags: 0,
+                        },
+                        hit: RTCHit {
+                            geomID: RTC_INVALID_GEOMETRY_ID,
+                            ..Default::default()
+                        },
+                    };
+                    unsafe { rtcIntersect1(self.scene.raw, &mut ctx, &mut rh) };
+                    hits += usize::from(rh.hit.geomID != RTC_INVALID_GEOMETRY_ID);
+                }
+            }
+        }
+        hits
+    }
+}
+
+macro_rules! setter {
+    ($name:ident, $T:ty) => {
+        fn $name(ray: &mut $T, i: usize, r: &BareRay) {
+            ray.org_x[i] = r.org[0];
+            ray.org_y[i] = r.org[1];
+            ray.org_z[i] = r.org[2];
+            ray.dir_x[i] = r.dir[0];
+            ray.dir_y[i] = r.dir[1];
+            ray.dir_z[i] = r.dir[2];
+            ray.tnear[i] = 0.0;
+            ray.tfar[i] = f32::INFINITY;
+            ray.mask[i] = u32::MAX;
+        }
+    };
+}
+setter!(set, RTCRay16);
+setter!(set8, RTCRay8);

@@ -1,0 +1,391 @@
+//! `rest-embree bench`: run time against error, for each backend and setting, on a fixed set of
+//! cases (the paper's lattice at several speeds, a large lattice, many velocity groups), in one
+//! run on one machine.
+//!
+//! Each row measures the build, the primary-ray throughput (tracing only, the renderer's own
+//! tiles and packets, fastest of `repeat`), a full render, the peak memory, and the error of the
+//! render against f64 BVH references: the same samples per pixel (backend error) and 16 samples
+//! (sampling error). Single-group cases also trace the same rest-frame rays with bare Embree
+//! (no boosts, rebasing, refinement or bookkeeping), so the relativistic layer's overhead is a
+//! ratio measured in the same run.
+
+mod memory;
+mod plot;
+mod suite;
+
+pub use suite::{bars_as_groups, cases, many_groups, paper, PAPER_SCENES};
+
+use crate::accel::backend_by_name;
+use crate::compare::{compare, Comparison};
+use crate::render::{
+    primary_rays_by_tile, render_world, trace_primary, Frame, World, WorldOptions,
+};
+use crate::scene::Scene;
+use rayon::prelude::*;
+use std::fmt::Write as _;
+use std::time::Instant;
+
+pub struct Case {
+    pub name: String,
+    pub scene: Scene,
+    pub settings: Vec<String>,
+    /// Extra samples-per-pixel rows for the plain `embree` and `bvh` settings.
+    pub extra_spp: Vec<u32>,
+    /// Also trace the same rays with bare Embree (single-group scenes).
+    pub bare: bool,
+    /// Compare with a 16-spp f64 render (costly for the large cases).
+    pub hi_reference: bool,
+}
+
+impl Case {
+    pub fn new(name: &str, scene: Scene, settings: &[&str]) -> Case {
+        Case {
+            name: name.to_string(),
+            scene,
+            settings: settings.iter().map(|s| s.to_string()).collect(),
+            extra_spp: Vec::new(),
+            bare: false,
+            hi_reference: true,
+        }
+    }
+    pub fn with_bare(mut self) -> Case {
+        self.bare = true;
+        self
+    }
+    pub fn with_spp(mut self, spp: &[u32]) -> Case {
+        self.extra_spp = spp.to_vec();
+        self
+    }
+    pub fn without_hi_reference(mut self) -> Case {
+        self.hi_reference = false;
+        self
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Row {
+    pub case: String,
+    pub setting: String,
+    pub spp: u32,
+    pub width: u32,
+    pub height: u32,
+    pub primitives: usize,
+    pub groups: usize,
+    pub build_s: f64,
+    pub primary_rays: u64,
+    pub primary_s: f64,
+    pub render_s: f64,
+    pub peak_mib: Option<f64>,
+    /// Against the f64 BVH at the same samples per pixel.
+    pub vs_same: Option<Comparison>,
+    /// Against the f64 BVH at 16 samples per pixel.
+    pub vs_hi: Option<Comparison>,
+}
+
+impl Row {
+    pub fn mrays_per_s(&self) -> f64 {
+        self.primary_rays as f64 / self.primary_s.max(1e-12) / 1e6
+    }
+}
+
+/// A setting is a backend name, optionally with one skip switched off.
+fn parse_setting(setting: &str) -> (&str, WorldOptions) {
+    let mut o = WorldOptions::default();
+    let mut parts = setting.split_whitespace();
+    let backend = parts.next().unwrap_or("embree");
+    for p in parts {
+        match p {
+            "no-cull" => o.bounds_cull = false,
+            "no-tree" => o.group_tree = false,
+            "no-merge" => o.merge_equal_velocities = false,
+            _ => {}
+        }
+    }
+    (backend, o)
+}
+
+fn with_spp(scene: &Scene, spp: u32) -> Scene {
+    let mut s = scene.clone();
+    s.image.samples = spp;
+    s
+}
+
+fn reference(scene: &Scene, spp: u32) -> Result<Frame, String> {
+    let s = with_spp(scene, spp);
+    let bvh = backend_by_name("bvh")?;
+    Ok(render_world(&s, &World::build(&s, bvh.as_ref())?).0)
+}
+
+fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, Frame), String> {
+    let (backend_name, options) = parse_setting(setting);
+    let backend = backend_by_name(backend_name)?;
+    let scene = with_spp(&case.scene, spp);
+    memory::reset_peak();
+    let t = Instant::now();
+    let world = World::build_with(&scene, backend.as_ref(), options)?;
+    let build_s = t.elapsed().as_secs_f64();
+    let (mut primary_s, mut primary_rays) = (f64::INFINITY, 0);
+    for _ in 0..repeat.max(1) {
+        let t = Instant::now();
+        primary_rays = trace_primary(&scene, &world).0;
+        primary_s = primary_s.min(t.elapsed().as_secs_f64());
+    }
+    let t = Instant::now();
+    let (frame, _) = render_world(&scene, &world);
+    let render_s = t.elapsed().as_secs_f64();
+    let (w, h) = scene.image.frame_size();
+    Ok((
+        Row {
+            case: case.name.clone(),
+            setting: setting.to_string(),
+            spp,
+            width: w,
+            height: h,
+            primitives: scene.primitive_count(),
+            groups: scene.groups.len(),
+            build_s,
+            primary_rays,
+            primary_s,
+            render_s,
+            peak_mib: memory::peak_mib(),
+            vs_same: None,
+            vs_hi: None,
+        },
+        frame,
+    ))
+}
+
+/// Bare Embree on the rest-frame primary rays of the scene's one group: (rays, best seconds).
+#[cfg(feature = "embree")]
+fn bare_embree(case: &Case, repeat: usize) -> Result<Option<(u64, f64)>, String> {
+    use crate::accel::EmbreeAccel;
+    use crate::spacetime::Boost;
+    let backend = backend_by_name("embree")?;
+    let world = World::build(&case.scene, backend.as_ref())?;
+    if world.groups.len() != 1 {
+        return Ok(None);
+    }
+    let g = &world.groups[0];
+    let Some(accel) = g
+        .accel
+        .as_ref()
+        .and_then(|a| a.as_any().downcast_ref::<EmbreeAccel>())
+    else {
+        return Ok(None);
+    };
+    let boost: Boost = g.boost;
+    let tiles: Vec<Vec<crate::accel::BareRay>> = primary_rays_by_tile(&case.scene)
+        .iter()
+        .map(|rays| {
+            rays.iter()
+                .map(|r| accel.bare_ray(boost.event(r.origin).x, boost.view_dir(r.dir).0))
+                .collect()
+        })
+        .collect();
+    let n: u64 = tiles.iter().map(|t| t.len() as u64).sum();
+    let mut best = f64::INFINITY;
+    for _ in 0..repeat.max(1) {
+        let t = Instant::now();
+        let _hits: usize = tiles.par_iter().map(|t| accel.trace_bare(t)).sum();
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    Ok(Some((n, best)))
+}
+
+#[cfg(not(feature = "embree"))]
+fn bare_embree(_: &Case, _: usize) -> Result<Option<(u64, f64)>, String> {
+    Ok(None)
+}
+
+/// Run the cases; settings whose backend is not in this build are left out.
+pub fn run(
+    cases: &[Case],
+    repeat: usize,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<Row>, String> {
+    let mut rows = Vec::new();
+    for case in cases {
+        progress(&case.name);
+        let mut refs: Vec<(u32, Frame)> = Vec::new();
+        let hi = if case.hi_reference {
+            Some(reference(&case.scene, 16)?)
+        } else {
+            None
+        };
+        for setting in &case.settings {
+            if backend_by_name(parse_setting(setting).0).is_err() {
+                continue;
+            }
+            let plain = setting == "embree" || setting == "bvh";
+            let spps: Vec<u32> = std::iter::once(1)
+                .chain(case.extra_spp.iter().copied().filter(|_| plain))
+                .collect();
+            for spp in spps {
+                let (mut row, frame) = measure(case, setting, spp, repeat)?;
+                if !refs.iter().any(|(s, _)| *s == spp) {
+                    refs.push((spp, reference(&case.scene, spp)?));
+                }
+                let same = &refs.iter().find(|(s, _)| *s == spp).expect("just added").1;
+                row.vs_same = Some(compare(&frame, same));
+                row.vs_hi = hi.as_ref().map(|h| compare(&frame, h));
+                rows.push(row);
+            }
+        }
+        if case.bare {
+            if let Some((n, secs)) = bare_embree(case, repeat)? {
+                let (w, h) = case.scene.image.frame_size();
+                rows.push(Row {
+                    case: case.name.clone(),
+                    setting: "embree bare (no relativity)".into(),
+                    spp: 1,
+                    width: w,
+                    height: h,
+                    primitives: case.scene.primitive_count(),
+                    groups: case.scene.groups.len(),
+                    build_s: 0.0,
+                    primary_rays: n,
+                    primary_s: secs,
+                    render_s: f64::NAN,
+                    peak_mib: None,
+                    vs_same: None,
+                    vs_hi: None,
+                });
+            }
+        }
+    }
+    Ok(rows)
+}
+
+fn opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
+    v.filter(|x| x.is_finite())
+        .map(f)
+        .unwrap_or_else(|| "—".into())
+}
+
+/// The rows as a Markdown table, with the derived ratios the issue asks for.
+pub fn table(rows: &[Row]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "| case | setting | spp | image | prims | groups | build s | primary Mrays/s | render s | peak MiB | differing px vs f64 (same spp) | RMS vs f64 16 spp |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {}x{} | {} | {} | {:.3} | {:.2} | {} | {} | {} | {} |",
+            r.case,
+            r.setting,
+            r.spp,
+            r.width,
+            r.height,
+            r.primitives,
+            r.groups,
+            r.build_s,
+            r.mrays_per_s(),
+            opt(Some(r.render_s), |x| format!("{x:.3}")),
+            opt(r.peak_mib, |x| format!("{x:.0}")),
+            opt(
+                r.vs_same.as_ref().map(|c| c.differing_share()),
+                |x| format!("{:.3}%", 100.0 * x)
+            ),
+            opt(r.vs_hi.as_ref().map(|c| c.rms), |x| format!("{x:.2e}")),
+        );
+    }
+    s
+}
+
+/// The headline ratios, computed from the rows.
+pub fn summary(rows: &[Row]) -> String {
+    let mut s = String::new();
+    let find = |case: &str, setting: &str| {
+        rows.iter()
+            .find(|r| r.case == case && r.setting == setting && r.spp == 1)
+    };
+    let cases: Vec<&str> = {
+        let mut v: Vec<&str> = rows.iter().map(|r| r.case.as_str()).collect();
+        v.dedup();
+        v
+    };
+    for c in &cases {
+        if let (Some(e), Some(b)) = (find(c, "embree"), find(c, "embree bare (no relativity)")) {
+            let _ = writeln!(s, "- {c}: embree through the relativistic layer / bare Embree on the same rays = {:.2}", e.mrays_per_s() / b.mrays_per_s());
+        }
+        if let (Some(e), Some(b)) = (find(c, "embree"), find(c, "bvh")) {
+            let _ = writeln!(
+                s,
+                "- {c}: embree / bvh primary throughput = {:.2}x (render time {:.2}x)",
+                e.mrays_per_s() / b.mrays_per_s(),
+                b.render_s / e.render_s
+            );
+        }
+    }
+    let one = rows
+        .iter()
+        .find(|r| r.case.ends_with("in 1 group") && r.setting == "embree");
+    for r in rows
+        .iter()
+        .filter(|r| r.case.contains(" groups") && r.setting == "embree" && !r.case.contains("bars"))
+    {
+        if let Some(o) = one {
+            let _ = writeln!(
+                s,
+                "- {}: render time {:.3} s = {:.2}x that of the same boxes in one group ({:.3} s)",
+                r.case,
+                r.render_s,
+                r.render_s / o.render_s,
+                o.render_s
+            );
+        }
+    }
+    for r in rows.iter().filter(|r| r.case.contains("^3")) {
+        let _ = writeln!(
+            s,
+            "- {} ({}): build {:.2} s + render {:.2} s = {:.2} s wall, peak {} MiB",
+            r.case,
+            r.setting,
+            r.build_s,
+            r.render_s,
+            r.build_s + r.render_s,
+            opt(r.peak_mib, |x| format!("{x:.0}"))
+        );
+    }
+    s
+}
+
+pub fn csv(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "case,setting,spp,width,height,primitives,groups,build_s,primary_rays,primary_s,mrays_per_s,render_s,peak_mib,differing_share_same_spp,rms_same_spp,differing_share_16spp,rms_16spp\n",
+    );
+    for r in rows {
+        let c = |x: Option<f64>| {
+            x.filter(|v| v.is_finite())
+                .map(|v| format!("{v:.6e}"))
+                .unwrap_or_default()
+        };
+        let _ = writeln!(
+            s,
+            "\"{}\",\"{}\",{},{},{},{},{},{:.6},{},{:.6},{:.4},{},{},{},{},{},{}",
+            r.case,
+            r.setting,
+            r.spp,
+            r.width,
+            r.height,
+            r.primitives,
+            r.groups,
+            r.build_s,
+            r.primary_rays,
+            r.primary_s,
+            r.mrays_per_s(),
+            c(Some(r.render_s)),
+            c(r.peak_mib),
+            c(r.vs_same.as_ref().map(|x| x.differing_share())),
+            c(r.vs_same.as_ref().map(|x| x.rms)),
+            c(r.vs_hi.as_ref().map(|x| x.differing_share())),
+            c(r.vs_hi.as_ref().map(|x| x.rms)),
+        );
+    }
+    s
+}
+
+pub use plot::plot_png;

@@ -1,0 +1,232 @@
+//! The fixed cases of `rest-embree bench`.
+
+use super::Case;
+use crate::scene::{load_str, SceneError};
+use std::fmt::Write as _;
+
+/// The paper's scenes, built into the binary so the benchmark runs from any directory.
+pub const PAPER_SCENES: [(&str, &str); 3] = [
+    (
+        "calibration_cube",
+        include_str!("../../scenes/calibration_cube.toml"),
+    ),
+    ("bar_array", include_str!("../../scenes/bar_array.toml")),
+    ("lattice", include_str!("../../scenes/lattice.toml")),
+];
+
+/// A paper scene with overrides.
+pub fn paper(name: &str, sets: &[String]) -> Result<crate::scene::Scene, SceneError> {
+    let (_, text) = PAPER_SCENES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .ok_or_else(|| SceneError::new("bench", "", format!("no paper scene named {name}")))?;
+    let sets: Vec<(String, String)> = sets
+        .iter()
+        .map(|s| (format!("--set {s}"), s.clone()))
+        .collect();
+    load_str(&format!("scenes/{name}.toml"), text, &sets)
+}
+
+fn sets(list: &[&str]) -> Vec<String> {
+    list.iter().map(|s| s.to_string()).collect()
+}
+
+/// A small deterministic generator for the many-groups scenes.
+struct Rng(u64);
+impl Rng {
+    fn f(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.f()
+    }
+}
+
+/// `n` boxes in a cloud in front of the camera, each in its own group with its own velocity
+/// (|β| ≤ 0.8), or (`one_group`) all in one group at rest: the same geometry either way.
+pub fn many_groups(
+    n: usize,
+    one_group: bool,
+    size: u32,
+) -> Result<crate::scene::Scene, SceneError> {
+    let mut r = Rng(2024);
+    let mut s = format!(
+        "[camera]\nposition = [0, -120, 0]\nlook_at = [0, 0, 0]\nfov_y = 50\ntime = 120\n[image]\nwidth = {size}\nheight = {size}\n\
+         [[light]]\nposition = [0, -120, 40]\n"
+    );
+    if one_group {
+        s += "[[group]]\nname = \"all\"\n";
+    }
+    for i in 0..n {
+        let c = [
+            r.range(-40.0, 40.0),
+            r.range(-40.0, 40.0),
+            r.range(-40.0, 40.0),
+        ];
+        let (d, b) = (
+            [r.range(-1.0, 1.0), r.range(-1.0, 1.0), r.range(-1.0, 1.0)],
+            r.range(0.0, 0.8),
+        );
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1e-9);
+        if !one_group {
+            let _ = write!(
+                s,
+                "[[group]]\nname = \"g{i}\"\nvelocity = [{:?}, {:?}, {:?}]\n",
+                d[0] / len * b,
+                d[1] / len * b,
+                d[2] / len * b
+            );
+        }
+        let h = 0.6;
+        let _ = write!(
+            s,
+            "[[group.object]]\ntype = \"box\"\nmin = [{:?}, {:?}, {:?}]\nmax = [{:?}, {:?}, {:?}]\n",
+            c[0] - h,
+            c[1] - h,
+            c[2] - h,
+            c[0] + h,
+            c[1] + h,
+            c[2] + h
+        );
+    }
+    load_str(&format!("many-groups-{n}"), &s, &[])
+}
+
+/// The 11 × 11 bars, each bar its own group, all at one velocity (merging makes them one).
+pub fn bars_as_groups(beta: f64) -> Result<crate::scene::Scene, SceneError> {
+    let base = PAPER_SCENES[1].1;
+    let head = &base[..base.find("[[group]]").expect("bar_array.toml has a group")];
+    let mut s = head.replace("group = \"bars\"\n", "").to_string();
+    for j in 0..11 {
+        for i in 0..11 {
+            let (x, y) = (-10.0 + 2.0 * i as f64, -10.0 + 2.0 * j as f64);
+            let _ = write!(
+                s,
+                "[[group]]\nname = \"bar{i}_{j}\"\nvelocity = [{beta:?}, 0, 0]\n[[group.object]]\ntype = \"box\"\n\
+                 min = [{:?}, {:?}, -3]\nmax = [{:?}, {:?}, 0]\nmaterial = \"bar\"\n",
+                x - 0.3,
+                y - 0.3,
+                x + 0.3,
+                y + 0.3
+            );
+        }
+    }
+    load_str("bars-as-groups", &s, &[])
+}
+
+/// Settings measured on every lattice speed.
+const LATTICE_SETTINGS: [&str; 5] = [
+    "embree",
+    "embree-8",
+    "embree-single",
+    "bvh",
+    "embree no-cull",
+];
+
+/// The fixed suite. `quick` shrinks images for a fast look (CI-sized).
+pub fn cases(quick: bool) -> Result<Vec<Case>, SceneError> {
+    let px = if quick { 128 } else { 512 };
+    let size = |w: u32| {
+        vec![
+            format!("image.width={w}"),
+            format!("image.height={w}"),
+            "image.samples=1".into(),
+        ]
+    };
+    let mut out = Vec::new();
+    for b in ["0", "0.5", "0.9", "0.99"] {
+        let mut s = size(px);
+        s.push(format!("group.lattice.velocity=[-{b},0,0]"));
+        out.push(
+            Case::new(
+                &format!("lattice beta={b}"),
+                paper("lattice", &s)?,
+                &LATTICE_SETTINGS,
+            )
+            .with_bare()
+            .with_spp(&[4]),
+        );
+    }
+    // What shadow and secondary rays cost the paper's lattice at 0.9c.
+    let mut s = size(px);
+    s.extend(sets(&["group.lattice.velocity=[-0.9,0,0]", "light=[]"]));
+    out.push(Case::new(
+        "lattice beta=0.9, no lights",
+        paper("lattice", &s)?,
+        &["embree", "bvh"],
+    ));
+    let mut s = size(px);
+    s.extend(sets(&[
+        "group.lattice.velocity=[-0.9,0,0]",
+        "material.rod.reflect=0.5",
+    ]));
+    out.push(Case::new(
+        "lattice beta=0.9, mirror rods",
+        paper("lattice", &s)?,
+        &["embree", "bvh"],
+    ));
+    // A large lattice: 100^3 nodes (1M spheres, ~3M rods) at 1024^2.
+    let n = if quick { 30 } else { 100 };
+    let big = paper(
+        "lattice",
+        &[
+            format!("image.width={}", 2 * px),
+            format!("image.height={}", 2 * px),
+            "image.samples=1".into(),
+            format!("group.lattice.object.lattice.counts=[{n},{n},{n}]"),
+            format!(
+                "group.lattice.object.lattice.origin=[0,{h},{h}]",
+                h = -(n as f64 - 1.0) / 2.0
+            ),
+            "group.lattice.velocity=[-0.9,0,0]".into(),
+        ],
+    )?;
+    out.push(
+        Case::new(&format!("lattice {n}^3 beta=0.9"), big, &["embree", "bvh"])
+            .without_hi_reference(),
+    );
+    // Many velocity groups, against one group holding the same boxes.
+    let gpx = px / 2;
+    let many = if quick {
+        [1usize, 100, 1000]
+    } else {
+        [1, 1000, 10000]
+    };
+    out.push(
+        Case::new(
+            &format!("{} boxes in 1 group", many[2]),
+            many_groups(many[2], true, gpx)?,
+            &["embree", "bvh"],
+        )
+        .without_hi_reference(),
+    );
+    for &g in &many[1..] {
+        let settings: &[&str] = if g <= 1000 {
+            &["embree", "bvh", "embree no-tree"]
+        } else {
+            &["embree", "bvh"]
+        };
+        out.push(
+            Case::new(
+                &format!("{g} boxes in {g} groups"),
+                many_groups(g, false, gpx)?,
+                settings,
+            )
+            .without_hi_reference(),
+        );
+    }
+    // Merging groups of one velocity: 121 bars, 121 groups.
+    out.push(
+        Case::new(
+            "121 bars as 121 groups, beta=0.9",
+            bars_as_groups(0.9)?,
+            &["embree", "embree no-merge"],
+        )
+        .without_hi_reference(),
+    );
+    Ok(out)
+}

@@ -1,0 +1,182 @@
+//! Culling for primary rays among many groups: every primary ray starts at the imaging event
+//! E0, and from there a group is seen exactly where its apparent (retarded) shape is. That shape
+//! lies in a box computed from the retarded-position map of PHYSICS.md §2.1 (see
+//! [`apparent_box`]). A static BVH over those boxes, traversed by the spatial ray x0 + λa (λ
+//! is the lookback, so it doubles as the distance), finds the groups a primary ray can meet.
+
+use super::group_tree::world_box;
+use crate::geometry::{Aabb, BoxTree};
+use crate::spacetime::{Event, NullRay, Velocity};
+use glam::DVec3;
+
+pub struct ApparentTree {
+    event: Event,
+    tree: BoxTree,
+}
+
+/// x_app = γ(X − β·sqrt(X² + ρ²)) (PHYSICS.md §2.1), without cancellation for X > 0.
+fn x_app(v: &Velocity, x: f64, rho: f64) -> f64 {
+    let (g, b) = (v.gamma(), v.beta());
+    let s = (x * x + rho * rho).sqrt();
+    if x <= 0.0 {
+        g * (x - b * s)
+    } else {
+        (x * x / g - g * b * b * rho * rho) / (x + b * s)
+    }
+}
+
+/// The box holding every apparent position, as seen from `event`, of a group with rest-frame
+/// bounds `rest` moving at `v`. By §2.1 the offsets perpendicular to v are unchanged and the
+/// offset along v is x_app(X, ρ), increasing in the rest-frame offset X and decreasing in the
+/// distance ρ from the line of motion through the camera; so the apparent shape lies in the
+/// prism "the box's perpendicular section × [x_app(X_min, ρ_max), x_app(X_max, ρ_min)]".
+pub fn apparent_box(rest: &Aabb, v: &Velocity, event: Event) -> Aabb {
+    let now = world_box(rest, v, event.t);
+    if v.is_zero() {
+        return now;
+    }
+    let u = v.direction();
+    let corners: Vec<DVec3> = (0..8)
+        .map(|k| {
+            DVec3::new(
+                if k & 1 == 0 { now.min.x } else { now.max.x },
+                if k & 2 == 0 { now.min.y } else { now.max.y },
+                if k & 4 == 0 { now.min.z } else { now.max.z },
+            ) - event.x
+        })
+        .collect();
+    // Lab-simultaneous offsets along v, and their rest-frame values X = γ x∥.
+    let along: Vec<f64> = corners.iter().map(|c| c.dot(u)).collect();
+    let x_min = v.gamma() * along.iter().cloned().fold(f64::INFINITY, f64::min);
+    let x_max = v.gamma() * along.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let perp = |c: DVec3| c - c.dot(u) * u;
+    let rho_max = corners
+        .iter()
+        .map(|&c| perp(c).length())
+        .fold(0.0, f64::max);
+    // |r⊥| is convex: bounded below by its supporting plane at the box centre.
+    let c = now.centroid() - event.x;
+    let cp = perp(c);
+    let rho_min = if cp.length() > 0.0 {
+        let grad = perp(cp / cp.length());
+        (cp.length() - grad.abs().dot(0.5 * now.extent())).max(0.0)
+    } else {
+        0.0
+    };
+    let (lo, hi) = (x_app(v, x_min, rho_max), x_app(v, x_max, rho_min));
+    let mut b = Aabb::EMPTY;
+    for &c in &corners {
+        for x in [lo, hi] {
+            b.grow(event.x + perp(c) + x * u);
+        }
+    }
+    // A little slack for rounding.
+    let pad = DVec3::splat(1e-9 * (b.max_abs() + 1.0));
+    Aabb::new(b.min - pad, b.max + pad)
+}
+
+impl ApparentTree {
+    pub fn build(groups: &[(Aabb, Velocity)], event: Event) -> ApparentTree {
+        let boxes: Vec<Aabb> = groups
+            .iter()
+            .map(|(b, v)| apparent_box(b, v, event))
+            .collect();
+        ApparentTree {
+            event,
+            tree: BoxTree::build(&boxes),
+        }
+    }
+
+    /// Whether this tree serves the ray (it starts at the imaging event).
+    pub fn serves(&self, ray: &NullRay) -> bool {
+        ray.origin == self.event
+    }
+
+    pub fn traverse(
+        &self,
+        ray: &NullRay,
+        tmin: f64,
+        tmax: f64,
+        visit: impl FnMut(u32, f64) -> f64,
+    ) {
+        self.tree.traverse(ray.origin.x, ray.dir, tmin, tmax, visit);
+    }
+}
+
+/// Up to this many primary rays traverse the apparent tree together.
+pub const PACKET: usize = 16;
+
+impl ApparentTree {
+    /// Traverse with a packet of primary rays (all starting at the imaging event): each node is
+    /// tested against every ray still active in one loop, and descended when any ray meets it.
+    /// `visit(group, ray, tmax)` returns the ray's new tmax (best hit so far).
+    pub fn traverse_packet(
+        &self,
+        dirs: &[glam::DVec3],
+        tmin: f64,
+        tmax: &mut [f64],
+        mut visit: impl FnMut(u32, usize, f64) -> f64,
+    ) {
+        let nodes = &self.tree.nodes;
+        if nodes.is_empty() || self.tree.indices.is_empty() {
+            return;
+        }
+        let n = dirs.len().min(PACKET);
+        let o = self.event.x;
+        let mut inv = [glam::DVec3::ZERO; PACKET];
+        for (i, d) in dirs.iter().take(n).enumerate() {
+            inv[i] = d.recip();
+        }
+        let hits_node = |b: &Aabb, tmax: &[f64]| -> u32 {
+            let mut mask = 0u32;
+            for i in 0..n {
+                let a = (b.min - o) * inv[i];
+                let c = (b.max - o) * inv[i];
+                let lo = a.min(c);
+                let hi = a.max(c);
+                let t0 = tmin.max(lo.x).max(lo.y).max(lo.z);
+                let t1 = tmax[i].min(hi.x).min(hi.y).min(hi.z);
+                mask |= u32::from(t0 <= t1) << i;
+            }
+            mask
+        };
+        let mut stack = [0u32; 128];
+        let mut sp = 1;
+        while sp > 0 {
+            sp -= 1;
+            let node = nodes[stack[sp] as usize];
+            let mask = hits_node(&node.bounds, tmax);
+            if mask == 0 {
+                continue;
+            }
+            if node.count > 0 {
+                for &g in
+                    &self.tree.indices[node.first as usize..(node.first + node.count) as usize]
+                {
+                    for i in 0..n {
+                        if mask & (1 << i) != 0 {
+                            tmax[i] = visit(g, i, tmax[i]);
+                        }
+                    }
+                }
+            } else if sp + 2 <= stack.len() {
+                stack[sp] = node.first + 1;
+                stack[sp + 1] = node.first;
+                sp += 2;
+            } else {
+                // Deeper than any tree built here; fall back to one ray at a time.
+                for i in 0..n {
+                    if mask & (1 << i) != 0 {
+                        let ray = NullRay::new(self.event, dirs[i]);
+                        let mut t = tmax[i];
+                        self.tree.traverse(ray.origin.x, ray.dir, tmin, t, |g, tm| {
+                            t = visit(g, i, tm);
+                            t
+                        });
+                        tmax[i] = t;
+                    }
+                }
+            }
+        }
+    }
+}
