@@ -152,7 +152,7 @@ fn run_bench(args: &BenchArgs) -> Result<(), String> {
     set_threads(args.threads)?;
     let cases = match &args.scene {
         None => {
-            let mut all = bench::cases(args.quick).map_err(|e| e.to_string())?;
+            let mut all = bench::cases(args.quick);
             if !args.cases.is_empty() {
                 all.retain(|c| args.cases.iter().any(|f| c.name.contains(f.as_str())));
                 if all.is_empty() {
@@ -181,7 +181,9 @@ fn run_bench(args: &BenchArgs) -> Result<(), String> {
                 accel::backend_by_name(backend).map_err(|e| format!("--backend: {e}"))?;
             }
             let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-            vec![bench::Case::new(&path.display().to_string(), scene, &refs).with_bare()]
+            vec![bench::LazyCase::ready(
+                bench::Case::new(&path.display().to_string(), scene, &refs).with_bare(),
+            )]
         }
     };
     let rows = bench::run(&cases, args.repeat, |name| eprintln!("bench: {name}"))?;

@@ -1,6 +1,6 @@
 //! The fixed cases of `rest-embree bench`.
 
-use super::Case;
+use super::{Case, LazyCase};
 use crate::scene::{load_str, SceneError};
 use std::fmt::Write as _;
 
@@ -127,68 +127,70 @@ const LATTICE_SETTINGS: [&str; 5] = [
     "embree no-cull",
 ];
 
-/// The fixed suite. `quick` shrinks images for a fast look (CI-sized).
-pub fn cases(quick: bool) -> Result<Vec<Case>, SceneError> {
-    let px = if quick { 128 } else { 512 };
-    let size = |w: u32| {
+/// The fixed suite, each case built only when it runs (so a row's peak memory is its own).
+/// `quick` shrinks images and scenes for a fast look (CI-sized).
+pub fn cases(quick: bool) -> Vec<LazyCase> {
+    let px: u32 = if quick { 128 } else { 512 };
+    fn size(w: u32) -> Vec<String> {
         vec![
             format!("image.width={w}"),
             format!("image.height={w}"),
             "image.samples=1".into(),
         ]
-    };
+    }
     let mut out = Vec::new();
     for b in ["0", "0.5", "0.9", "0.99"] {
-        let mut s = size(px);
-        s.push(format!("group.lattice.velocity=[-{b},0,0]"));
-        out.push(
-            Case::new(
-                &format!("lattice beta={b}"),
-                paper("lattice", &s)?,
-                &LATTICE_SETTINGS,
-            )
-            .with_bare()
-            .with_spp(&[4]),
-        );
+        out.push(LazyCase::new(&format!("lattice beta={b}"), move || {
+            let mut s = size(px);
+            s.push(format!("group.lattice.velocity=[-{b},0,0]"));
+            let name = format!("lattice beta={b}");
+            Ok(Case::new(&name, paper("lattice", &s)?, &LATTICE_SETTINGS)
+                .with_bare()
+                .with_spp(&[4]))
+        }));
     }
     // What shadow and secondary rays cost the paper's lattice at 0.9c.
-    let mut s = size(px);
-    s.extend(sets(&["group.lattice.velocity=[-0.9,0,0]", "light=[]"]));
-    out.push(Case::new(
-        "lattice beta=0.9, no lights",
-        paper("lattice", &s)?,
-        &["embree", "bvh"],
-    ));
-    let mut s = size(px);
-    s.extend(sets(&[
-        "group.lattice.velocity=[-0.9,0,0]",
-        "material.rod.reflect=0.5",
-    ]));
-    out.push(Case::new(
-        "lattice beta=0.9, mirror rods",
-        paper("lattice", &s)?,
-        &["embree", "bvh"],
-    ));
+    out.push(LazyCase::new("lattice beta=0.9, no lights", move || {
+        let mut s = size(px);
+        s.extend(sets(&["group.lattice.velocity=[-0.9,0,0]", "light=[]"]));
+        Ok(Case::new(
+            "lattice beta=0.9, no lights",
+            paper("lattice", &s)?,
+            &["embree", "bvh"],
+        ))
+    }));
+    out.push(LazyCase::new("lattice beta=0.9, mirror rods", move || {
+        let mut s = size(px);
+        s.extend(sets(&[
+            "group.lattice.velocity=[-0.9,0,0]",
+            "material.rod.reflect=0.5",
+        ]));
+        Ok(Case::new(
+            "lattice beta=0.9, mirror rods",
+            paper("lattice", &s)?,
+            &["embree", "bvh"],
+        ))
+    }));
     // A large lattice: 100^3 nodes (1M spheres, ~3M rods) at 1024^2.
     let n = if quick { 30 } else { 100 };
-    let big = paper(
-        "lattice",
-        &[
-            format!("image.width={}", 2 * px),
-            format!("image.height={}", 2 * px),
-            "image.samples=1".into(),
-            format!("group.lattice.object.lattice.counts=[{n},{n},{n}]"),
-            format!(
-                "group.lattice.object.lattice.origin=[0,{h},{h}]",
-                h = -(n as f64 - 1.0) / 2.0
-            ),
-            "group.lattice.velocity=[-0.9,0,0]".into(),
-        ],
-    )?;
-    out.push(
-        Case::new(&format!("lattice {n}^3 beta=0.9"), big, &["embree", "bvh"])
-            .without_hi_reference(),
-    );
+    let big_name = format!("lattice {n}^3 beta=0.9");
+    out.push(LazyCase::new(&big_name.clone(), move || {
+        let big = paper(
+            "lattice",
+            &[
+                format!("image.width={}", 2 * px),
+                format!("image.height={}", 2 * px),
+                "image.samples=1".into(),
+                format!("group.lattice.object.lattice.counts=[{n},{n},{n}]"),
+                format!(
+                    "group.lattice.object.lattice.origin=[0,{h},{h}]",
+                    h = -(n as f64 - 1.0) / 2.0
+                ),
+                "group.lattice.velocity=[-0.9,0,0]".into(),
+            ],
+        )?;
+        Ok(Case::new(&big_name, big, &["embree", "bvh"]).without_hi_reference())
+    }));
     // Many velocity groups, against one group holding the same boxes.
     let gpx = px / 2;
     let many = if quick {
@@ -196,37 +198,44 @@ pub fn cases(quick: bool) -> Result<Vec<Case>, SceneError> {
     } else {
         [1, 1000, 10000]
     };
-    out.push(
-        Case::new(
-            &format!("{} boxes in 1 group", many[2]),
-            many_groups(many[2], true, gpx)?,
-            &["embree", "bvh"],
-        )
-        .without_hi_reference(),
-    );
-    for &g in &many[1..] {
-        let settings: &[&str] = if g <= 1000 {
-            &["embree", "bvh", "embree no-tree"]
-        } else {
-            &["embree", "bvh"]
-        };
-        out.push(
-            Case::new(
-                &format!("{g} boxes in {g} groups"),
-                many_groups(g, false, gpx)?,
-                settings,
+    let top = many[2];
+    out.push(LazyCase::new(
+        &format!("{top} boxes in 1 group"),
+        move || {
+            Ok(Case::new(
+                &format!("{top} boxes in 1 group"),
+                many_groups(top, true, gpx)?,
+                &["embree", "bvh"],
             )
-            .without_hi_reference(),
-        );
+            .without_hi_reference())
+        },
+    ));
+    for g in many[1..].iter().copied() {
+        out.push(LazyCase::new(
+            &format!("{g} boxes in {g} groups"),
+            move || {
+                let settings: &[&str] = if g <= 1000 {
+                    &["embree", "bvh", "embree no-tree"]
+                } else {
+                    &["embree", "bvh"]
+                };
+                Ok(Case::new(
+                    &format!("{g} boxes in {g} groups"),
+                    many_groups(g, false, gpx)?,
+                    settings,
+                )
+                .without_hi_reference())
+            },
+        ));
     }
     // Merging groups of one velocity: 121 bars, 121 groups.
-    out.push(
-        Case::new(
+    out.push(LazyCase::new("121 bars as 121 groups, beta=0.9", || {
+        Ok(Case::new(
             "121 bars as 121 groups, beta=0.9",
             bars_as_groups(0.9)?,
             &["embree", "embree no-merge"],
         )
-        .without_hi_reference(),
-    );
-    Ok(out)
+        .without_hi_reference())
+    }));
+    out
 }

@@ -153,9 +153,9 @@ impl ApparentTree {
                 for &g in
                     &self.tree.indices[node.first as usize..(node.first + node.count) as usize]
                 {
-                    for i in 0..n {
+                    for (i, t) in tmax.iter_mut().enumerate().take(n) {
                         if mask & (1 << i) != 0 {
-                            tmax[i] = visit(g, i, tmax[i]);
+                            *t = visit(g, i, *t);
                         }
                     }
                 }
