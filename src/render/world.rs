@@ -157,17 +157,32 @@ impl World {
         options: WorldOptions,
     ) -> Result<World, String> {
         // Which scene groups share a rest frame.
+        // Keyed by the velocity's exact bits (all zero velocities alike), in file order.
         let mut sets: Vec<(Velocity, Vec<usize>)> = Vec::new();
+        let mut index: std::collections::HashMap<[u64; 4], usize> =
+            std::collections::HashMap::new();
         for (i, g) in scene.groups.iter().enumerate() {
             if g.geometry.is_empty() {
                 continue;
             }
-            match sets
-                .iter_mut()
-                .find(|(v, _)| options.merge_equal_velocities && v.same_as(&g.velocity))
-            {
-                Some((_, members)) => members.push(i),
-                None => sets.push((g.velocity, vec![i])),
+            let v = g.velocity;
+            let d = v.direction();
+            let key = if v.is_zero() {
+                [0; 4]
+            } else {
+                [
+                    d.x.to_bits(),
+                    d.y.to_bits(),
+                    d.z.to_bits(),
+                    v.rapidity().to_bits(),
+                ]
+            };
+            match index.get(&key).filter(|_| options.merge_equal_velocities) {
+                Some(&k) => sets[k].1.push(i),
+                None => {
+                    index.insert(key, sets.len());
+                    sets.push((v, vec![i]));
+                }
             }
         }
         let mut groups = Vec::with_capacity(sets.len());

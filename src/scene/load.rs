@@ -101,9 +101,10 @@ fn build(doc: &Doc) -> R<Scene> {
     let mut groups = Vec::new();
     let mut objects = Vec::new();
     let mut total: u64 = 0;
+    let mut group_names = std::collections::HashSet::new();
     for t in &group_tables {
         let name = t.req_string("name")?.to_string();
-        if groups.iter().any(|g: &Group| g.name == name) {
+        if !group_names.insert(name.clone()) {
             return Err(t.error("name", format!("a group named `{name}` is defined twice")));
         }
         let velocity = velocity(t, "direction")?.unwrap_or(Velocity::ZERO);
