@@ -121,6 +121,14 @@ pub struct World {
     primary_tree: Option<ApparentTree>,
 }
 
+/// A masked lane of a batch.
+const INACTIVE: Ray = Ray {
+    origin: DVec3::ZERO,
+    dir: DVec3::X,
+    tmin: 1.0,
+    tmax: 0.0,
+};
+
 /// A ray boosted into a group's rest frame and rebased to the near side of the group's bounds.
 struct RestRay {
     ray: Ray,
@@ -321,28 +329,35 @@ impl World {
         let mut hits: Vec<Option<Hit>> = vec![None; n];
         out.iter_mut().for_each(|o| *o = None);
         for (gi, g) in self.groups.iter().enumerate() {
+            // Every ray keeps its lane, so a packet stays a square of neighbouring pixels; a ray
+            // that misses the group's bounds is masked (inactive), not removed.
             batch.clear();
             meta.clear();
             for (i, r) in rays.iter().enumerate() {
-                if let Some(rr) = self.rest_ray(g, r, tmin, best[i]) {
-                    batch.push(rr.ray);
-                    meta.push((i, rr));
-                }
-            }
-            if batch.is_empty() {
-                continue;
-            }
-            match &g.accel {
-                Some(accel) => accel.intersect(&batch, &mut hits[..batch.len()]),
-                None => {
-                    for (b, h) in batch.iter().zip(hits.iter_mut()) {
-                        *h = g.intersect1(b);
+                match self.rest_ray(g, r, tmin, best[i]) {
+                    Some(rr) => {
+                        batch.push(rr.ray);
+                        meta.push(Some(rr));
+                    }
+                    None => {
+                        batch.push(INACTIVE);
+                        meta.push(None);
                     }
                 }
             }
-            for (k, h) in hits[..batch.len()].iter().enumerate() {
-                if let Some(h) = h {
-                    let (i, ref rr) = meta[k];
+            if meta.iter().all(Option::is_none) {
+                continue;
+            }
+            match &g.accel {
+                Some(accel) => accel.intersect(&batch, &mut hits[..n]),
+                None => {
+                    for (b, h) in batch.iter().zip(hits.iter_mut()) {
+                        *h = if b.is_active() { g.intersect1(b) } else { None };
+                    }
+                }
+            }
+            for (i, (h, rr)) in hits[..n].iter().zip(&meta).enumerate() {
+                if let (Some(h), Some(rr)) = (h, rr) {
                     let hit = Self::surface_hit(gi, rr, *h);
                     if hit.lambda < best[i] {
                         best[i] = hit.lambda;
