@@ -176,7 +176,7 @@ impl Scene {
             scene.attach(&device, g, sphere_map, 1)?;
         }
         if !rods.is_empty() {
-            let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE)?;
+            let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE)?;
             let verts = scene.buffer::<[[f32; 4]; 2]>(
                 &g,
                 RTC_BUFFER_TYPE_VERTEX,
@@ -190,20 +190,7 @@ impl Scene {
             for (k, slot) in idx.iter_mut().enumerate() {
                 *slot = 2 * k as u32;
             }
-            scene.attach(&device, g, rod_map.clone(), 1)?;
-            // The round ends: a sphere at each end of every rod (cylinder ∪ spheres = capsule).
-            let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_SPHERE_POINT)?;
-            let caps = scene.buffer::<[f32; 4]>(
-                &g,
-                RTC_BUFFER_TYPE_VERTEX,
-                RTC_FORMAT_FLOAT4,
-                rods.len() * 2,
-            )?;
-            for (k, r) in rods.iter().enumerate() {
-                caps[2 * k] = r[0];
-                caps[2 * k + 1] = r[1];
-            }
-            scene.attach(&device, g, rod_map, 2)?;
+            scene.attach(&device, g, rod_map, 1)?;
         }
         unsafe { rtcCommitScene(raw) };
         device.check("committing a scene")?;
