@@ -231,6 +231,55 @@ fn find_split(
     (left > 0 && left < count).then_some(left)
 }
 
+/// A near-first walk over a binary tree laid out as the box tree's nodes are: `node(i)` gives
+/// node i's `(first, count)` (interior when count is 0, children at first and first + 1),
+/// `entry(i, tmax)` where a ray enters node i (None: it misses), and `visit(item, tmax)` returns
+/// the new tmax (the best hit so far); a tmax below tmin stops the walk. Both the box tree and
+/// the kinetic group tree walk this way, with different entry tests.
+pub fn walk(
+    indices: &[u32],
+    node: impl Fn(u32) -> (u32, u32),
+    mut entry: impl FnMut(u32, f64) -> Option<f64>,
+    tmin: f64,
+    tmax: f64,
+    mut visit: impl FnMut(u32, f64) -> f64,
+) {
+    let mut tmax = tmax;
+    let mut stack = SmallStack::new();
+    if let Some(e) = entry(0, tmax) {
+        stack.push((0, e));
+    }
+    while let Some((i, e)) = stack.pop() {
+        if e > tmax {
+            continue;
+        }
+        let (first, count) = node(i);
+        if count > 0 {
+            for &item in &indices[first as usize..(first + count) as usize] {
+                tmax = visit(item, tmax);
+                if tmax < tmin {
+                    return;
+                }
+            }
+        } else {
+            let (l, r) = (first, first + 1);
+            match (entry(l, tmax), entry(r, tmax)) {
+                (Some(a), Some(b)) if a <= b => {
+                    stack.push((r, b));
+                    stack.push((l, a));
+                }
+                (Some(a), Some(b)) => {
+                    stack.push((l, a));
+                    stack.push((r, b));
+                }
+                (Some(a), None) => stack.push((l, a)),
+                (None, Some(b)) => stack.push((r, b)),
+                (None, None) => {}
+            }
+        }
+    }
+}
+
 impl BoxTree {
     /// Visit the items whose boxes the ray `o + t d` meets in (tmin, tmax), nearer subtrees
     /// first; `visit(item, tmax)` returns the new tmax, and a tmax below tmin stops the walk.
@@ -240,53 +289,25 @@ impl BoxTree {
         d: DVec3,
         tmin: f64,
         tmax: f64,
-        mut visit: impl FnMut(u32, f64) -> f64,
+        visit: impl FnMut(u32, f64) -> f64,
     ) {
         if self.nodes.is_empty() || self.indices.is_empty() {
             return;
         }
         let inv = d.recip();
-        let mut tmax = tmax;
-        let mut stack = SmallStack::new();
-        if let Some((e, _)) = self.nodes[0].bounds.clip(o, inv, tmin, tmax) {
-            stack.push((0, e));
-        }
-        while let Some((i, e)) = stack.pop() {
-            if e > tmax {
-                continue;
-            }
-            let n = self.nodes[i as usize];
-            if n.count > 0 {
-                for &item in &self.indices[n.first as usize..(n.first + n.count) as usize] {
-                    tmax = visit(item, tmax);
-                    if tmax < tmin {
-                        return;
-                    }
-                }
-            } else {
-                let (l, r) = (n.first, n.first + 1);
-                let el = self.nodes[l as usize]
+        let nodes = &self.nodes;
+        walk(
+            &self.indices,
+            |i| (nodes[i as usize].first, nodes[i as usize].count),
+            |i, tmax| {
+                nodes[i as usize]
                     .bounds
                     .clip(o, inv, tmin, tmax)
-                    .map(|x| x.0);
-                let er = self.nodes[r as usize]
-                    .bounds
-                    .clip(o, inv, tmin, tmax)
-                    .map(|x| x.0);
-                match (el, er) {
-                    (Some(a), Some(b)) if a <= b => {
-                        stack.push((r, b));
-                        stack.push((l, a));
-                    }
-                    (Some(a), Some(b)) => {
-                        stack.push((l, a));
-                        stack.push((r, b));
-                    }
-                    (Some(a), None) => stack.push((l, a)),
-                    (None, Some(b)) => stack.push((r, b)),
-                    (None, None) => {}
-                }
-            }
-        }
+                    .map(|x| x.0)
+            },
+            tmin,
+            tmax,
+            visit,
+        );
     }
 }

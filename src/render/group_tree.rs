@@ -9,7 +9,7 @@
 //! ray against the group's moving, Lorentz-contracted box. It holds for any past null ray —
 //! primary, reflected or shadow — with no assumption about when it starts.
 
-use crate::geometry::{Aabb, BoxTree, SmallStack};
+use crate::geometry::{walk, Aabb, BoxTree};
 use crate::spacetime::{NullRay, Velocity};
 use glam::DVec3;
 
@@ -226,46 +226,19 @@ impl GroupTree {
         ray: &NullRay,
         tmin: f64,
         tmax: f64,
-        mut visit: impl FnMut(u32, f64) -> f64,
+        visit: impl FnMut(u32, f64) -> f64,
     ) {
         if self.nodes.is_empty() {
             return;
         }
-        let mut tmax = tmax;
-        let mut stack = SmallStack::new();
-        if let Some(e) = self.entry(&self.nodes[0], ray, tmin, tmax) {
-            stack.push((0, e));
-        }
-        while let Some((i, e)) = stack.pop() {
-            if e > tmax {
-                continue;
-            }
-            let n = self.nodes[i as usize];
-            if n.count > 0 {
-                for &g in &self.indices[n.first as usize..(n.first + n.count) as usize] {
-                    tmax = visit(g, tmax);
-                    if tmax < tmin {
-                        return;
-                    }
-                }
-            } else {
-                let (l, r) = (n.first, n.first + 1);
-                let el = self.entry(&self.nodes[l as usize], ray, tmin, tmax);
-                let er = self.entry(&self.nodes[r as usize], ray, tmin, tmax);
-                match (el, er) {
-                    (Some(a), Some(b)) if a <= b => {
-                        stack.push((r, b));
-                        stack.push((l, a));
-                    }
-                    (Some(a), Some(b)) => {
-                        stack.push((l, a));
-                        stack.push((r, b));
-                    }
-                    (Some(a), None) => stack.push((l, a)),
-                    (None, Some(b)) => stack.push((r, b)),
-                    (None, None) => {}
-                }
-            }
-        }
+        let nodes = &self.nodes;
+        walk(
+            &self.indices,
+            |i| (nodes[i as usize].first, nodes[i as usize].count),
+            |i, tmax| self.entry(&nodes[i as usize], ray, tmin, tmax),
+            tmin,
+            tmax,
+            visit,
+        );
     }
 }

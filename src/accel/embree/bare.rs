@@ -2,8 +2,8 @@
 //! with nothing else (no boosts, no rebasing, no f64 refinement, no hit bookkeeping), so the
 //! cost of the relativistic layer is a ratio measured in the same run.
 
-use super::packet::flush_denormals;
-use super::EmbreeAccel;
+use super::packet::{fill_lane, flush_denormals};
+use super::{EmbreeAccel, EmbreeRay};
 use embree_sys::*;
 use glam::DVec3;
 
@@ -40,9 +40,8 @@ impl EmbreeAccel {
                 let mut rh = RTCRayHit16::default();
                 let mut valid = Valid([0; 16]);
                 for (i, r) in chunk.iter().enumerate() {
-                    set(&mut rh.ray, i, r);
+                    fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
                     rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-                    valid.0[i] = -1;
                 }
                 unsafe { rtcIntersect16(valid.0.as_ptr(), self.scene.raw, &mut ctx, &mut rh) };
                 hits += (0..chunk.len())
@@ -52,9 +51,8 @@ impl EmbreeAccel {
                 let mut rh = RTCRayHit8::default();
                 let mut valid = Valid([0; 16]);
                 for (i, r) in chunk.iter().enumerate() {
-                    set8(&mut rh.ray, i, r);
+                    fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
                     rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-                    valid.0[i] = -1;
                 }
                 unsafe { rtcIntersect8(valid.0.as_ptr(), self.scene.raw, &mut ctx, &mut rh) };
                 hits += (0..chunk.len())
@@ -91,20 +89,16 @@ impl EmbreeAccel {
     }
 }
 
-macro_rules! setter {
-    ($name:ident, $T:ty) => {
-        fn $name(ray: &mut $T, i: usize, r: &BareRay) {
-            ray.org_x[i] = r.org[0];
-            ray.org_y[i] = r.org[1];
-            ray.org_z[i] = r.org[2];
-            ray.dir_x[i] = r.dir[0];
-            ray.dir_y[i] = r.dir[1];
-            ray.dir_z[i] = r.dir[2];
-            ray.tnear[i] = 0.0;
-            ray.tfar[i] = f32::INFINITY;
-            ray.mask[i] = u32::MAX;
+impl BareRay {
+    /// As the packet code's ray: from the origin, nothing excluded.
+    fn lane(&self) -> EmbreeRay {
+        EmbreeRay {
+            org: self.org,
+            dir: self.dir,
+            tnear: 0.0,
+            tfar: f32::INFINITY,
+            len: 1.0,
+            active: true,
         }
-    };
+    }
 }
-setter!(set, RTCRay16);
-setter!(set8, RTCRay8);

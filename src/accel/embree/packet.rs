@@ -103,13 +103,13 @@ macro_rules! packet_fns {
 #[repr(C, align(64))]
 struct Valid<const N: usize>([i32; N]);
 
-trait Lane {
+pub(super) trait Lane {
     fn set(&mut self, i: usize, e: &EmbreeRay);
 }
 
 /// Put a ray in lane i; inactive rays (masked by the caller, e.g. missing the group's bounds)
 /// stay out of the valid mask.
-fn fill_lane<R: Lane>(ray: &mut R, i: usize, e: &EmbreeRay, valid: &mut [i32]) {
+pub(super) fn fill_lane<R: Lane>(ray: &mut R, i: usize, e: &EmbreeRay, valid: &mut [i32]) {
     if e.active {
         ray.set(i, e);
         valid[i] = -1;
