@@ -372,3 +372,42 @@ fn retarded_position_2_1_both_branches() {
         assert_eq!(app.y, rho, "the perpendicular offset is unchanged");
     }
 }
+
+#[test]
+fn gamma_minus_one_at_small_speeds_8_1() {
+    // PHYSICS.md §8.1: naive γ − 1 gives 2.2e-16 at β = 1e-8 (truth 5e-17) and 0 at 1e-9.
+    for beta in [1e-8f64, 1e-9, 1e-4] {
+        let v = Velocity::from_beta(DVec3::X, beta).unwrap();
+        let want = 0.5 * beta * beta * (1.0 + 0.75 * beta * beta);
+        assert_rel(
+            v.gamma_minus_one(),
+            want,
+            1e-12,
+            &format!("γ − 1 at β = {beta}"),
+        );
+    }
+    assert_eq!(Velocity::ZERO.gamma_minus_one(), 0.0);
+}
+
+#[test]
+fn identity_keys_tell_frames_apart() {
+    let a = Velocity::from_beta(DVec3::X, 0.5).unwrap();
+    let b = Velocity::from_beta(DVec3::new(2.0, 0.0, 0.0), 0.5).unwrap();
+    let c = Velocity::from_beta(DVec3::X, 0.5000000001).unwrap();
+    assert_eq!(
+        a.identity_key(),
+        b.identity_key(),
+        "same velocity, other spelling"
+    );
+    assert_ne!(
+        a.identity_key(),
+        c.identity_key(),
+        "a different speed is another frame"
+    );
+    assert_ne!(a.identity_key(), a.reversed().identity_key());
+    // Every way of saying "at rest" is one frame.
+    let z1 = Velocity::from_beta_vec(DVec3::ZERO).unwrap();
+    let z2 = Velocity::from_rapidity(DVec3::Y, 0.0).unwrap();
+    assert_eq!(z1.identity_key(), z2.identity_key());
+    assert_eq!(z1.identity_key(), Velocity::ZERO.identity_key());
+}

@@ -32,10 +32,6 @@ impl Bvh {
         }
     }
 
-    pub fn node_count(&self) -> usize {
-        self.nodes.len()
-    }
-
     /// Walks the tree; `visit` returns a new tmax when a leaf primitive is hit, and traversal
     /// stops early when `any` is set.
     #[inline]

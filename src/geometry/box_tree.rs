@@ -2,7 +2,7 @@
 //! and of the world's culling structure over velocity groups.
 
 use super::Aabb;
-pub use small_stack::SmallStack;
+use small_stack::SmallStack;
 
 mod small_stack {
     /// A traversal stack on the stack: trees here are at most 64 deep for any realistic input;

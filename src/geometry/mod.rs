@@ -8,5 +8,5 @@ mod box_tree;
 mod primitive;
 
 pub use aabb::Aabb;
-pub use box_tree::{walk, BoxTree, SmallStack, TreeNode};
+pub use box_tree::{walk, BoxTree, TreeNode};
 pub use primitive::{Geometry, Part, Primitive};

@@ -32,11 +32,6 @@ impl CameraRays {
         }
     }
 
-    /// Focal length in pixels of a pinhole camera: (height / 2) / tan(fov_y / 2).
-    pub fn focal_px(&self) -> f64 {
-        self.focal
-    }
-
     /// The world-frame past null ray through image point (px, py), in pixels from the top-left
     /// corner (pixel (i, j) has its centre at (i + 0.5, j + 0.5)).
     pub fn ray(&self, px: f64, py: f64) -> NullRay {

@@ -3,8 +3,9 @@
 //!
 //! What a scene doesn't need is skipped (each switchable, for the benchmarks): groups that
 //! share a velocity are merged into one rest-frame scene; a ray is tested against a group's
-//! bounds before the group's accelerator, and only from where it enters them; with many groups a
-//! kinetic tree over the groups (group_tree.rs) finds the few a ray can meet, so a ray that misses
+//! bounds before the group's accelerator, and only from where it enters them; groups of a few
+//! primitives skip the accelerator; with many groups, trees over the groups find the few a ray
+//! can meet (apparent_tree.rs for primary rays, group_tree.rs for the rest), so a ray that misses
 //! every group costs a handful of box tests.
 
 use super::apparent_tree::ApparentTree;
@@ -54,8 +55,7 @@ impl Default for WorldOptions {
 pub struct GroupRt {
     /// The imaging event's position in this group's rest frame.
     pub event_rest: DVec3,
-    /// Intersect the few primitives in f64 directly instead of calling the accelerator.
-    pub direct: bool,
+
     pub velocity: Velocity,
     pub boost: Boost,
     pub unboost: Boost,
@@ -164,8 +164,8 @@ impl World {
         backend: &dyn Backend,
         options: WorldOptions,
     ) -> Result<World, String> {
-        // Which scene groups share a rest frame.
-        // Keyed by the velocity's exact bits (all zero velocities alike), in file order.
+        let event = scene.camera.imaging_event();
+        // Which scene groups share a rest frame, in file order.
         let mut sets: Vec<(Velocity, Vec<usize>)> = Vec::new();
         let mut index: std::collections::HashMap<[u64; 4], usize> =
             std::collections::HashMap::new();
@@ -174,17 +174,7 @@ impl World {
                 continue;
             }
             let v = g.velocity;
-            let d = v.direction();
-            let key = if v.is_zero() {
-                [0; 4]
-            } else {
-                [
-                    d.x.to_bits(),
-                    d.y.to_bits(),
-                    d.z.to_bits(),
-                    v.rapidity().to_bits(),
-                ]
-            };
+            let key = v.identity_key();
             match index.get(&key).filter(|_| options.merge_equal_velocities) {
                 Some(&k) => sets[k].1.push(i),
                 None => {
@@ -203,8 +193,7 @@ impl World {
                 .iter()
                 .map(|&i| scene.groups[i].name.as_str())
                 .collect();
-            let direct = geometry.prims.len() <= DIRECT_MAX;
-            let accel = if direct {
+            let accel = if geometry.prims.len() <= DIRECT_MAX {
                 None
             } else {
                 Some(backend.build(geometry.clone()).map_err(|e| {
@@ -215,13 +204,11 @@ impl World {
                     )
                 })?)
             };
+            let boost = Boost::to_rest(&velocity);
             groups.push(GroupRt {
-                event_rest: Boost::to_rest(&velocity)
-                    .event(scene.camera.imaging_event())
-                    .x,
-                direct,
+                event_rest: boost.event(event).x,
                 velocity,
-                boost: Boost::to_rest(&velocity),
+                boost,
                 unboost: Boost::from_rest(&velocity),
                 bounds,
                 geometry,
@@ -233,7 +220,6 @@ impl World {
         if options.group_tree && groups.len() >= GROUP_TREE_MIN {
             let items: Vec<(Aabb, Velocity)> =
                 groups.iter().map(|g| (g.bounds, g.velocity)).collect();
-            let event = scene.camera.imaging_event();
             // Kinetic trees are tight near their reference times: spread them over the window in
             // which primary rays meet the groups, twice as deep as the farthest emission seen
             // from the imaging event (secondary rays reach further back).
@@ -254,7 +240,7 @@ impl World {
             primary_tree = Some(ApparentTree::build(&items, event));
         }
         Ok(World {
-            event: scene.camera.imaging_event(),
+            event,
             groups,
             options,
             tree,
@@ -378,34 +364,40 @@ impl World {
     ) {
         use super::apparent_tree::PACKET;
         for (rs, os) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
-            let dirs: Vec<DVec3> = rs.iter().map(|r| r.dir).collect();
+            let mut dirs = [DVec3::ZERO; PACKET];
+            for (d, r) in dirs.iter_mut().zip(rs) {
+                *d = r.dir;
+            }
             let mut tmax = [f64::INFINITY; PACKET];
             os.iter_mut().for_each(|o| *o = None);
-            tree.traverse_packet(&dirs, tmin, &mut tmax[..rs.len()], |gi, i, t| {
-                let g = &self.groups[gi as usize];
-                if let Some(rr) = self.rest_ray(g, &rs[i], tmin, t) {
-                    if let Some(h) = g.intersect1(&rr.ray) {
-                        let sh = Self::surface_hit(gi as usize, &rr, h);
-                        if sh.lambda < t {
-                            os[i] = Some(sh);
-                            return sh.lambda;
+            tree.traverse_packet(
+                &dirs[..rs.len()],
+                tmin,
+                &mut tmax[..rs.len()],
+                |gi, i, t| {
+                    let g = &self.groups[gi as usize];
+                    if let Some(rr) = self.rest_ray(g, &rs[i], tmin, t) {
+                        if let Some(h) = g.intersect1(&rr.ray) {
+                            let sh = Self::surface_hit(gi as usize, &rr, h);
+                            if sh.lambda < t {
+                                os[i] = Some(sh);
+                                return sh.lambda;
+                            }
                         }
                     }
-                }
-                t
-            });
+                    t
+                },
+            );
         }
     }
 
     /// The visible hit on one ray (secondary rays, and every ray when there are many groups).
     pub fn closest_hit(&self, ray: &NullRay, tmin: f64) -> Option<SurfaceHit> {
         let mut best: Option<SurfaceHit> = None;
-        let mut hit = [None];
         let mut visit = |gi: usize, tmax: f64| -> f64 {
             let g = &self.groups[gi];
             if let Some(rr) = self.rest_ray(g, ray, tmin, tmax) {
-                hit[0] = g.intersect1(&rr.ray);
-                if let Some(h) = hit[0] {
+                if let Some(h) = g.intersect1(&rr.ray) {
                     let sh = Self::surface_hit(gi, &rr, h);
                     if sh.lambda < tmax {
                         best = Some(sh);

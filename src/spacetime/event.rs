@@ -22,14 +22,6 @@ impl Event {
     pub fn interval(&self) -> f64 {
         self.t * self.t - self.x.length_squared()
     }
-
-    pub fn scale(self, s: f64) -> Event {
-        Event::new(self.t * s, self.x * s)
-    }
-
-    pub fn is_finite(&self) -> bool {
-        self.t.is_finite() && self.x.is_finite()
-    }
 }
 
 impl Add for Event {

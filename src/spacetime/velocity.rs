@@ -152,8 +152,18 @@ impl Velocity {
             rapidity: self.rapidity,
         }
     }
-    /// True when both denote the same velocity (bitwise on the stored parameters).
-    pub fn same_as(&self, other: &Velocity) -> bool {
-        (self.is_zero() && other.is_zero()) || self == other
+    /// A key equal for velocities that are exactly the same (bitwise on the stored parameters;
+    /// every velocity of zero alike): groups with one key share one rest frame.
+    pub fn identity_key(&self) -> [u64; 4] {
+        if self.is_zero() {
+            return [0; 4];
+        }
+        let d = self.dir;
+        [
+            d.x.to_bits(),
+            d.y.to_bits(),
+            d.z.to_bits(),
+            self.rapidity.to_bits(),
+        ]
     }
 }
