@@ -70,11 +70,22 @@ impl Aabb {
     pub fn clip(&self, o: DVec3, inv_d: DVec3, tmin: f64, tmax: f64) -> Option<(f64, f64)> {
         let a = (self.min - o) * inv_d;
         let b = (self.max - o) * inv_d;
-        let lo = a.min(b);
-        let hi = a.max(b);
-        // NaN (0 * inf on a slab boundary) is dropped by f64::max / f64::min.
-        let t0 = tmin.max(lo.x).max(lo.y).max(lo.z);
-        let t1 = tmax.min(hi.x).min(hi.y).min(hi.z);
+        // Plain comparisons (one instruction each): a NaN (0 · inf on a slab boundary) fails
+        // every comparison, so it never replaces the interval's ends.
+        let (mut t0, mut t1) = (tmin, tmax);
+        for k in 0..3 {
+            let (lo, hi) = if a[k] < b[k] {
+                (a[k], b[k])
+            } else {
+                (b[k], a[k])
+            };
+            if lo > t0 {
+                t0 = lo;
+            }
+            if hi < t1 {
+                t1 = hi;
+            }
+        }
         (t0 <= t1).then_some((t0, t1))
     }
 }

@@ -73,34 +73,30 @@ impl Geometry {
     }
 }
 
-/// Both roots of a·t² + 2b·t + c = 0, ascending.
-fn quadratic_roots(a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
-    let disc = b * b - a * c;
-    if disc < 0.0 || a == 0.0 {
+/// Where the ray `oc + t d` (relative to a centre) is at distance r from it, ascending: a
+/// sphere, or with the components along an axis removed from both, an infinite cylinder.
+/// The discriminant is a²(r² − l²) with l the closest approach, computed from a·l = a·oc − b·d
+/// (nothing lost when the ray passes close by) and tested before any division or root.
+fn round_roots(oc: DVec3, d: DVec3, r: f64) -> Option<(f64, f64)> {
+    let a = d.length_squared();
+    if a == 0.0 {
         return None;
     }
-    let q = -(b + b.signum() * disc.sqrt());
-    let (t0, t1) = (q / a, if q != 0.0 { c / q } else { q / a });
+    let b = oc.dot(d);
+    let l = a * oc - b * d;
+    let h = r * r * a * a - l.length_squared();
+    if h < 0.0 {
+        return None;
+    }
+    let inv = 1.0 / a;
+    let q = -(b + b.signum() * (h * inv).sqrt());
+    let cc = oc.length_squared() - r * r;
+    let (t0, t1) = (q * inv, if q != 0.0 { cc / q } else { q * inv });
     Some((t0.min(t1), t0.max(t1)))
 }
 
 fn sphere_hit(c: DVec3, r: f64, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64> {
-    let oc = o - c;
-    let a = d.length_squared();
-    let b = oc.dot(d);
-    // c − b²/a computed as |oc − (b/a) d|² − r² loses nothing when the ray passes close by.
-    let l = oc - (b / a) * d;
-    let h = r * r - l.length_squared();
-    if h < 0.0 {
-        return None;
-    }
-    let cc = oc.length_squared() - r * r;
-    let sq = (a * h).sqrt();
-    let q = -(b + b.signum() * sq);
-    let (mut t0, mut t1) = (q / a, if q != 0.0 { cc / q } else { q / a });
-    if t0 > t1 {
-        std::mem::swap(&mut t0, &mut t1);
-    }
+    let (t0, t1) = round_roots(o - c, d, r)?;
     [t0, t1].into_iter().find(|&t| t > tmin && t < tmax)
 }
 
@@ -193,7 +189,10 @@ impl Primitive {
     }
 }
 
-fn capsule_hit(
+/// The capsule (points within r of the segment ab) is convex, so the ray meets it on one
+/// interval: it enters where it enters the infinite cylinder if that point lies beside the
+/// segment, else where it enters the end ball on that side; likewise for the exit.
+pub(crate) fn capsule_hit(
     a: DVec3,
     b: DVec3,
     r: f64,
@@ -210,46 +209,59 @@ fn capsule_hit(
     }
     let bard = ba.dot(d);
     let baoa = ba.dot(oa);
-    // Cylinder body, in coordinates perpendicular to the axis (no large-number cancellation).
-    let dp = d - (bard / baba) * ba;
-    let op = oa - (baoa / baba) * ba;
-    let mut best: Option<f64> = None;
-    let mut take = |t: f64| {
-        if t > tmin && t < tmax && best.is_none_or(|b| t < b) {
-            best = Some(t);
+    // Perpendicular to the axis and scaled by |ba|² (no division, no large-number cancellation).
+    let dp = baba * d - bard * ba;
+    let op = baba * oa - baoa * ba;
+    let rr = r * r * baba * baba;
+    let qa = dp.length_squared();
+    let (t_in, t_out) = if qa == 0.0 {
+        // Along the axis: in through one end ball, out through the other.
+        if op.length_squared() > rr {
+            return None;
         }
-    };
-    if let Some((t0, t1)) =
-        quadratic_roots(dp.length_squared(), op.dot(dp), op.length_squared() - r * r)
-    {
-        for t in [t0, t1] {
-            let y = baoa + t * bard;
-            if y > 0.0 && y < baba {
-                take(t);
-            }
-        }
-    }
-    // Round caps: only the parts of each sphere beyond its end of the axis.
-    for (c, beyond) in [(a, -1.0), (b, 1.0)] {
-        let oc = o - c;
-        let aa = d.length_squared();
-        let bb = oc.dot(d);
-        let l = oc - (bb / aa) * d;
-        let h = r * r - l.length_squared();
+        let (first, last) = if bard > 0.0 { (a, b) } else { (b, a) };
+        (
+            round_roots(o - first, d, r)?.0,
+            round_roots(o - last, d, r)?.1,
+        )
+    } else {
+        // The infinite cylinder: qa·t² + 2qb·t + |op|² − rr = 0. Its discriminant, qa·(rr − l²)
+        // with l the closest approach, is tested before any division or root.
+        let qb = op.dot(dp);
+        let l = qa * op - qb * dp;
+        let h = rr * qa * qa - l.length_squared();
         if h < 0.0 {
-            continue;
+            return None;
         }
-        if let Some((t0, t1)) = quadratic_roots(aa, bb, oc.length_squared() - r * r) {
-            for t in [t0, t1] {
-                let y = baoa + t * bard;
-                let outside = if beyond < 0.0 { y <= 0.0 } else { y >= baba };
-                if outside {
-                    take(t);
-                }
-            }
+        let inv = 1.0 / qa;
+        let q = -(qb + qb.signum() * (h * inv).sqrt());
+        let (u, v) = (
+            q * inv,
+            if q != 0.0 {
+                (op.length_squared() - rr) / q
+            } else {
+                q * inv
+            },
+        );
+        let (c0, c1) = (u.min(v), u.max(v));
+        let ball = |t: f64| {
+            let y = baoa + t * bard;
+            (y <= 0.0 || y >= baba).then(|| round_roots(o - if y <= 0.0 { a } else { b }, d, r))
+        };
+        let t_in = match ball(c0) {
+            None => c0,
+            Some(roots) => roots?.0,
+        };
+        if t_in > tmin {
+            return (t_in < tmax).then_some(t_in);
         }
-    }
-    best
+        let t_out = match ball(c1) {
+            None => c1,
+            Some(roots) => roots?.1,
+        };
+        (t_in, t_out)
+    };
+    [t_in, t_out].into_iter().find(|&t| t > tmin && t < tmax)
 }
 
 fn triangle_hit(v: [DVec3; 3], o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64> {

@@ -30,9 +30,9 @@ impl EmbreeAccel {
     /// Trace with bare Embree in this accelerator's packet width; returns the hit count.
     pub fn trace_bare(&self, rays: &[BareRay]) -> usize {
         flush_denormals();
-        let mut ctx = RTCIntersectContext::default();
-        unsafe { rtcInitIntersectContext(&mut ctx) };
-        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        // No f64 rays: user geometry tests Embree's own f32 rays.
+        let mut context = self.context(true, &[], &[]);
+        let ctx = context.raw();
         let mut hits = 0;
         let w = self.width.clamp(1, 16);
         for chunk in rays.chunks(w) {
@@ -43,7 +43,7 @@ impl EmbreeAccel {
                     fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
                     rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                 }
-                unsafe { rtcIntersect16(valid.0.as_ptr(), self.scene.raw, &mut ctx, &mut rh) };
+                unsafe { rtcIntersect16(valid.0.as_ptr(), self.scene.raw, ctx, &mut rh) };
                 hits += (0..chunk.len())
                     .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
                     .count();
@@ -54,7 +54,7 @@ impl EmbreeAccel {
                     fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
                     rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                 }
-                unsafe { rtcIntersect8(valid.0.as_ptr(), self.scene.raw, &mut ctx, &mut rh) };
+                unsafe { rtcIntersect8(valid.0.as_ptr(), self.scene.raw, ctx, &mut rh) };
                 hits += (0..chunk.len())
                     .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
                     .count();
@@ -80,7 +80,7 @@ impl EmbreeAccel {
                             ..Default::default()
                         },
                     };
-                    unsafe { rtcIntersect1(self.scene.raw, &mut ctx, &mut rh) };
+                    unsafe { rtcIntersect1(self.scene.raw, ctx, &mut rh) };
                     hits += usize::from(rh.hit.geomID != RTC_INVALID_GEOMETRY_ID);
                 }
             }

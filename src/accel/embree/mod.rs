@@ -11,6 +11,7 @@
 mod bare;
 mod device;
 mod packet;
+mod round;
 mod scene;
 
 pub use bare::BareRay;
@@ -120,9 +121,21 @@ impl EmbreeAccel {
         }
     }
 
-    /// Embree's hit back in the caller's units, refined in f64 on the primitive that was hit.
-    fn to_hit(&self, r: &Ray, e: &EmbreeRay, t_embree: f32, geom: u32, prim: u32) -> Option<Hit> {
-        let prim = self.scene.prim(geom, prim)?;
+    /// Embree's hit back in the caller's units: exact already for user geometry (`exact_t`,
+    /// from the context), else refined in f64 on the primitive that was hit.
+    fn to_hit(
+        &self,
+        r: &Ray,
+        e: &EmbreeRay,
+        t_embree: f32,
+        geom: u32,
+        prim: u32,
+        exact_t: f64,
+    ) -> Option<Hit> {
+        let (prim, exact) = self.scene.prim(geom, prim)?;
+        if exact {
+            return (exact_t > r.tmin && exact_t < r.tmax).then_some(Hit { t: exact_t, prim });
+        }
         let t = (t_embree as f64 - self.pullback) / e.len;
         let slack = 1e-4 * t.abs().max(self.pullback / e.len) + 4.0 * self.pullback / e.len;
         let p = &self.geometry.prims[prim as usize];

@@ -1,5 +1,6 @@
 //! Ray packets and single rays through Embree's C API.
 
+use super::round::ExactContext;
 use super::{EmbreeAccel, EmbreeRay};
 use crate::accel::{Hit, Ray};
 use embree_sys::*;
@@ -27,15 +28,6 @@ pub(super) fn flush_denormals() {
     });
 }
 
-fn context(coherent: bool) -> RTCIntersectContext {
-    let mut ctx = RTCIntersectContext::default();
-    unsafe { rtcInitIntersectContext(&mut ctx) };
-    if coherent {
-        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    }
-    ctx
-}
-
 macro_rules! packet_fns {
     ($n:literal, $isect:ident, $occl:ident, $RayHitN:ident, $RayN:ident, $rtc_isect:ident, $rtc_occl:ident) => {
         impl EmbreeAccel {
@@ -43,13 +35,15 @@ macro_rules! packet_fns {
                 let mut rh = $RayHitN::default();
                 let mut valid = Valid([0i32; $n]);
                 let mut er = [EmbreeRay::default(); $n];
+                let mut lens = [1.0; $n];
                 for (i, r) in rays.iter().enumerate() {
                     er[i] = self.embree_ray(r);
+                    lens[i] = er[i].len;
                     fill_lane(&mut rh.ray, i, &er[i], &mut valid.0);
                     rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                 }
-                let mut ctx = context(true);
-                unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, &mut ctx, &mut rh) };
+                let mut ctx = self.context(true, rays, &lens);
+                unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), &mut rh) };
                 for (i, r) in rays.iter().enumerate() {
                     hits[i] = if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID {
                         self.to_hit(
@@ -58,6 +52,7 @@ macro_rules! packet_fns {
                             rh.ray.tfar[i],
                             rh.hit.geomID[i],
                             rh.hit.primID[i],
+                            ctx.exact_t(i),
                         )
                     } else {
                         None
@@ -68,12 +63,14 @@ macro_rules! packet_fns {
             pub(super) fn $occl(&self, rays: &[Ray], out: &mut [bool]) {
                 let mut ray = $RayN::default();
                 let mut valid = Valid([0i32; $n]);
+                let mut lens = [1.0; $n];
                 for (i, r) in rays.iter().enumerate() {
                     let e = self.embree_ray(r);
+                    lens[i] = e.len;
                     fill_lane(&mut ray, i, &e, &mut valid.0);
                 }
-                let mut ctx = context(true);
-                unsafe { $rtc_occl(valid.0.as_ptr(), self.scene.raw, &mut ctx, &mut ray) };
+                let mut ctx = self.context(true, rays, &lens);
+                unsafe { $rtc_occl(valid.0.as_ptr(), self.scene.raw, ctx.raw(), &mut ray) };
                 for i in 0..rays.len() {
                     out[i] = valid.0[i] != 0 && ray.tfar[i] == f32::NEG_INFINITY;
                 }
@@ -153,6 +150,16 @@ fn single(e: &EmbreeRay) -> RTCRay {
 }
 
 impl EmbreeAccel {
+    /// The context for a query of these rays (lanes in order), as user geometry needs it.
+    pub(super) fn context<'a>(
+        &self,
+        coherent: bool,
+        rays: &'a [Ray],
+        lens: &[f64],
+    ) -> ExactContext<'a> {
+        ExactContext::new(coherent, rays, lens, self.scene.center, self.pullback)
+    }
+
     pub(super) fn intersect1(&self, r: &Ray) -> Option<Hit> {
         let e = self.embree_ray(r);
         if !e.active {
@@ -165,12 +172,19 @@ impl EmbreeAccel {
                 ..Default::default()
             },
         };
-        let mut ctx = context(false);
-        unsafe { rtcIntersect1(self.scene.raw, &mut ctx, &mut rh) };
+        let mut ctx = self.context(false, std::slice::from_ref(r), &[e.len]);
+        unsafe { rtcIntersect1(self.scene.raw, ctx.raw(), &mut rh) };
         if rh.hit.geomID == RTC_INVALID_GEOMETRY_ID {
             return None;
         }
-        self.to_hit(r, &e, rh.ray.tfar, rh.hit.geomID, rh.hit.primID)
+        self.to_hit(
+            r,
+            &e,
+            rh.ray.tfar,
+            rh.hit.geomID,
+            rh.hit.primID,
+            ctx.exact_t(0),
+        )
     }
 
     pub(super) fn occluded1(&self, r: &Ray) -> bool {
@@ -179,8 +193,8 @@ impl EmbreeAccel {
             return false;
         }
         let mut ray = single(&e);
-        let mut ctx = context(false);
-        unsafe { rtcOccluded1(self.scene.raw, &mut ctx, &mut ray) };
+        let mut ctx = self.context(false, std::slice::from_ref(r), &[e.len]);
+        unsafe { rtcOccluded1(self.scene.raw, ctx.raw(), &mut ray) };
         ray.tfar == f32::NEG_INFINITY
     }
 }

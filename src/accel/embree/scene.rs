@@ -1,8 +1,9 @@
 //! One Embree scene per rest-frame geometry, in f32 about the geometry's centre (so f32 never
-//! sees large coordinates), with native primitives: triangles for boxes and meshes, sphere
-//! points for spheres, round linear curves for rods.
+//! sees large coordinates): Embree's triangles for boxes and meshes, while
+//! spheres and rods are user geometry running the exact f64 tests (round.rs).
 
 use super::device::Device;
+use super::round::{self, Round, Rounds};
 use crate::geometry::{Geometry as SceneGeometry, Primitive};
 use embree_sys::*;
 use glam::DVec3;
@@ -21,6 +22,8 @@ impl Drop for GeometryHandle {
 pub struct PrimMap {
     pub prims: Vec<u32>,
     pub per: u32,
+    /// User geometry whose hits are already exact f64 (the context carries their t).
+    pub exact: bool,
 }
 
 pub struct Scene {
@@ -29,6 +32,8 @@ pub struct Scene {
     pub maps: Vec<PrimMap>,
     /// Embree coordinates are rest-frame coordinates minus this.
     pub center: DVec3,
+    /// What Embree's user geometry points into; dropped after the scene is released.
+    rounds: Option<Box<Rounds>>,
     _device: Arc<Device>,
 }
 
@@ -77,6 +82,7 @@ impl Scene {
             raw,
             maps: Vec::new(),
             center,
+            rounds: None,
             _device: device.clone(),
         };
         unsafe {
@@ -85,21 +91,25 @@ impl Scene {
         }
         let (mut tris, mut tri_map): (Vec<[[f32; 3]; 3]>, Vec<u32>) = (Vec::new(), Vec::new());
         let (mut boxes, mut box_map): (Vec<(DVec3, DVec3)>, Vec<u32>) = (Vec::new(), Vec::new());
-        let (mut spheres, mut sphere_map): (Vec<[f32; 4]>, Vec<u32>) = (Vec::new(), Vec::new());
-        let (mut rods, mut rod_map): (Vec<[[f32; 4]; 2]>, Vec<u32>) = (Vec::new(), Vec::new());
+        let (mut rounds, mut round_map): (Vec<Round>, Vec<u32>) = (Vec::new(), Vec::new());
         for (i, p) in geo.prims.iter().enumerate() {
             let i = i as u32;
             match *p {
                 Primitive::Sphere { center: c, radius } => {
-                    let q = f3(c - center);
-                    spheres.push([q[0], q[1], q[2], radius as f32]);
-                    sphere_map.push(i);
+                    rounds.push(Round {
+                        a: c - center,
+                        b: c - center,
+                        radius,
+                    });
+                    round_map.push(i);
                 }
                 Primitive::Capsule { a, b, radius } => {
-                    let (qa, qb) = (f3(a - center), f3(b - center));
-                    let r = radius as f32;
-                    rods.push([[qa[0], qa[1], qa[2], r], [qb[0], qb[1], qb[2], r]]);
-                    rod_map.push(i);
+                    rounds.push(Round {
+                        a: a - center,
+                        b: b - center,
+                        radius,
+                    });
+                    round_map.push(i);
                 }
                 Primitive::Cuboid { min, max } => {
                     boxes.push((min - center, max - center));
@@ -140,7 +150,7 @@ impl Scene {
                     idx[k * 12 + t] = tri.map(|c| (k * 8) as u32 + c);
                 }
             }
-            scene.attach(&device, g, box_map, 12)?;
+            scene.attach(&device, g, box_map, 12, false)?;
         }
         if !tris.is_empty() {
             let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_TRIANGLE)?;
@@ -162,35 +172,21 @@ impl Scene {
             for (k, slot) in idx.iter_mut().enumerate() {
                 *slot = [3 * k as u32, 3 * k as u32 + 1, 3 * k as u32 + 2];
             }
-            scene.attach(&device, g, tri_map, 1)?;
+            scene.attach(&device, g, tri_map, 1, false)?;
         }
-        if !spheres.is_empty() {
-            let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_SPHERE_POINT)?;
-            let verts = scene.buffer::<[f32; 4]>(
-                &g,
-                RTC_BUFFER_TYPE_VERTEX,
-                RTC_FORMAT_FLOAT4,
-                spheres.len(),
-            )?;
-            verts.copy_from_slice(&spheres);
-            scene.attach(&device, g, sphere_map, 1)?;
-        }
-        if !rods.is_empty() {
-            let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE)?;
-            let verts = scene.buffer::<[[f32; 4]; 2]>(
-                &g,
-                RTC_BUFFER_TYPE_VERTEX,
-                RTC_FORMAT_FLOAT4,
-                rods.len() * 2,
-            )?;
-            verts.copy_from_slice(&rods);
-            // One segment per rod, with vertices of its own: no neighbours, round caps at both ends.
-            let idx =
-                scene.buffer::<u32>(&g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT, rods.len())?;
-            for (k, slot) in idx.iter_mut().enumerate() {
-                *slot = 2 * k as u32;
+        if !rounds.is_empty() {
+            let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_USER)?;
+            let data = Box::new(Rounds(rounds));
+            let ptr = &*data as *const Rounds as *mut std::ffi::c_void;
+            unsafe {
+                rtcSetGeometryUserPrimitiveCount(g.0, data.0.len() as u32);
+                rtcSetGeometryUserData(g.0, ptr);
+                rtcSetGeometryBoundsFunction(g.0, Some(round::bounds), ptr);
+                rtcSetGeometryIntersectFunction(g.0, Some(round::intersect));
+                rtcSetGeometryOccludedFunction(g.0, Some(round::occluded));
             }
-            scene.attach(&device, g, rod_map, 1)?;
+            scene.rounds = Some(data);
+            scene.attach(&device, g, round_map, 1, true)?;
         }
         unsafe { rtcCommitScene(raw) };
         device.check("committing a scene")?;
@@ -210,8 +206,7 @@ impl Scene {
         Ok(GeometryHandle(g))
     }
 
-    /// A new buffer of `count` items of T on the geometry, as a slice to fill. Buffers of
-    /// `[T; 2]` items are counted in T (curve vertices).
+    /// A new buffer of `count` items of T on the geometry, as a slice to fill.
     #[allow(clippy::mut_from_ref)]
     fn buffer<T: Copy>(
         &self,
@@ -220,17 +215,14 @@ impl Scene {
         format: RTCFormat,
         count: usize,
     ) -> Result<&mut [T], String> {
-        let (stride, items) = match format {
-            RTC_FORMAT_FLOAT4 => (16, count),
-            _ => (std::mem::size_of::<T>(), count),
-        };
-        let ptr = unsafe { rtcSetNewGeometryBuffer(g.0, kind, 0, format, stride, items) };
+        let stride = std::mem::size_of::<T>();
+        let ptr = unsafe { rtcSetNewGeometryBuffer(g.0, kind, 0, format, stride, count) };
         self._device.check("allocating a buffer")?;
         if ptr.is_null() {
             return Err("Embree could not allocate a geometry buffer".into());
         }
-        let n = items * stride / std::mem::size_of::<T>();
-        // SAFETY: Embree allocated items * stride bytes, aligned for f32/u32, owned by the
+        let n = count;
+        // SAFETY: Embree allocated count * stride bytes, aligned for f32/u32, owned by the
         // geometry, which outlives this slice (it is filled before the geometry is committed).
         Ok(unsafe { std::slice::from_raw_parts_mut(ptr as *mut T, n) })
     }
@@ -241,6 +233,7 @@ impl Scene {
         g: GeometryHandle,
         prims: Vec<u32>,
         per: u32,
+        exact: bool,
     ) -> Result<(), String> {
         unsafe { rtcCommitGeometry(g.0) };
         device.check("committing a geometry")?;
@@ -250,15 +243,16 @@ impl Scene {
             self.maps.resize_with(id + 1, || PrimMap {
                 prims: Vec::new(),
                 per: 1,
+                exact: false,
             });
         }
-        self.maps[id] = PrimMap { prims, per };
+        self.maps[id] = PrimMap { prims, per, exact };
         Ok(())
     }
 
-    /// The scene primitive an Embree hit names.
-    pub fn prim(&self, geom: u32, prim: u32) -> Option<u32> {
+    /// The scene primitive an Embree hit names, and whether its t is exact already.
+    pub fn prim(&self, geom: u32, prim: u32) -> Option<(u32, bool)> {
         let m = self.maps.get(geom as usize)?;
-        m.prims.get((prim / m.per) as usize).copied()
+        Some((*m.prims.get((prim / m.per) as usize)?, m.exact))
     }
 }
