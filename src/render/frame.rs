@@ -36,10 +36,6 @@ impl Frame {
         }
     }
 
-    pub fn set(&mut self, x: u32, y: u32, v: &PixelValue) {
-        self.pixels[(y * self.width + x) as usize] = *v;
-    }
-
     pub fn get(&self, x: u32, y: u32) -> &PixelValue {
         &self.pixels[(y * self.width + x) as usize]
     }

@@ -85,22 +85,35 @@ pub fn primary_rays_by_tile(scene: &Scene) -> Vec<Vec<crate::spacetime::NullRay>
         .collect()
 }
 
-/// Render with acceleration structures already built.
+/// Render with acceleration structures already built. Each band of TILE rows is rendered tile
+/// by tile straight into its rows of the frame (no second copy of the image in flight).
 pub fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
     let (w, h) = scene.image.frame_size();
     let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
-    let results: Vec<_> = tiles(scene)
-        .par_iter()
-        .map(|&(x0, y0)| tile::render_tile(scene, world, &cam, x0, y0))
-        .collect();
     let mut frame = Frame::new(w, h);
+    let band = (w * TILE) as usize;
+    let per_band: Vec<(u64, u64)> = frame
+        .pixels
+        .par_chunks_mut(band.max(1))
+        .enumerate()
+        .map(|(b, rows)| {
+            let y0 = b as u32 * TILE;
+            let mut counts = (0, 0);
+            for x0 in (0..w).step_by(TILE as usize) {
+                let tile = tile::render_tile(scene, world, &cam, x0, y0);
+                counts.0 += tile.primary_rays;
+                counts.1 += tile.nonfinite;
+                for p in tile.pixels {
+                    rows[((p.y - y0) * w + p.x) as usize] = p.value;
+                }
+            }
+            counts
+        })
+        .collect();
     let mut stats = RenderStats::default();
-    for tile in results {
-        stats.primary_rays += tile.primary_rays;
-        stats.nonfinite_pixels += tile.nonfinite;
-        for p in tile.pixels {
-            frame.set(p.x, p.y, &p.value);
-        }
+    for (rays, nonfinite) in per_band {
+        stats.primary_rays += rays;
+        stats.nonfinite_pixels += nonfinite;
     }
     (frame, stats)
 }

@@ -3,6 +3,7 @@
 //! cost of the relativistic layer is a ratio measured in the same run.
 
 use super::packet::{fill_lane, flush_denormals};
+use super::round::Lanes;
 use super::{EmbreeAccel, EmbreeRay};
 use embree_sys::*;
 use glam::DVec3;
@@ -31,7 +32,8 @@ impl EmbreeAccel {
     pub fn trace_bare(&self, rays: &[BareRay]) -> usize {
         flush_denormals();
         // No f64 rays: user geometry tests Embree's own f32 rays.
-        let mut context = self.context(true, &[], &[]);
+        let lanes = Lanes::<16>::new(&[]);
+        let mut context = self.context(true, &[], &lanes);
         let ctx = context.raw();
         let mut hits = 0;
         let w = self.width.clamp(1, 16);

@@ -1,6 +1,6 @@
 //! Ray packets and single rays through Embree's C API.
 
-use super::round::ExactContext;
+use super::round::{ExactContext, Lanes};
 use super::{EmbreeAccel, EmbreeRay};
 use crate::accel::{Hit, Ray};
 use embree_sys::*;
@@ -35,14 +35,14 @@ macro_rules! packet_fns {
                 let mut rh = $RayHitN::default();
                 let mut valid = Valid([0i32; $n]);
                 let mut er = [EmbreeRay::default(); $n];
-                let mut lens = [1.0; $n];
+                let mut lanes = Lanes::<$n>::new(rays);
                 for (i, r) in rays.iter().enumerate() {
                     er[i] = self.embree_ray(r);
-                    lens[i] = er[i].len;
+                    lanes.len[i] = er[i].len;
                     fill_lane(&mut rh.ray, i, &er[i], &mut valid.0);
                     rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                 }
-                let mut ctx = self.context(true, rays, &lens);
+                let mut ctx = self.context(true, rays, &lanes);
                 unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), &mut rh) };
                 for (i, r) in rays.iter().enumerate() {
                     hits[i] = if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID {
@@ -63,13 +63,13 @@ macro_rules! packet_fns {
             pub(super) fn $occl(&self, rays: &[Ray], out: &mut [bool]) {
                 let mut ray = $RayN::default();
                 let mut valid = Valid([0i32; $n]);
-                let mut lens = [1.0; $n];
+                let mut lanes = Lanes::<$n>::new(rays);
                 for (i, r) in rays.iter().enumerate() {
                     let e = self.embree_ray(r);
-                    lens[i] = e.len;
+                    lanes.len[i] = e.len;
                     fill_lane(&mut ray, i, &e, &mut valid.0);
                 }
-                let mut ctx = self.context(true, rays, &lens);
+                let mut ctx = self.context(true, rays, &lanes);
                 unsafe { $rtc_occl(valid.0.as_ptr(), self.scene.raw, ctx.raw(), &mut ray) };
                 for i in 0..rays.len() {
                     out[i] = valid.0[i] != 0 && ray.tfar[i] == f32::NEG_INFINITY;
@@ -151,13 +151,13 @@ fn single(e: &EmbreeRay) -> RTCRay {
 
 impl EmbreeAccel {
     /// The context for a query of these rays (lanes in order), as user geometry needs it.
-    pub(super) fn context<'a>(
+    pub(super) fn context<'a, const N: usize>(
         &self,
         coherent: bool,
         rays: &'a [Ray],
-        lens: &[f64],
+        lanes: &'a Lanes<N>,
     ) -> ExactContext<'a> {
-        ExactContext::new(coherent, rays, lens, self.scene.center, self.pullback)
+        ExactContext::new(coherent, rays, lanes, self.scene.center, self.pullback)
     }
 
     pub(super) fn intersect1(&self, r: &Ray) -> Option<Hit> {
@@ -172,7 +172,10 @@ impl EmbreeAccel {
                 ..Default::default()
             },
         };
-        let mut ctx = self.context(false, std::slice::from_ref(r), &[e.len]);
+        let rays = std::slice::from_ref(r);
+        let mut lanes = Lanes::<1>::new(rays);
+        lanes.len[0] = e.len;
+        let mut ctx = self.context(false, rays, &lanes);
         unsafe { rtcIntersect1(self.scene.raw, ctx.raw(), &mut rh) };
         if rh.hit.geomID == RTC_INVALID_GEOMETRY_ID {
             return None;
@@ -193,7 +196,10 @@ impl EmbreeAccel {
             return false;
         }
         let mut ray = single(&e);
-        let mut ctx = self.context(false, std::slice::from_ref(r), &[e.len]);
+        let rays = std::slice::from_ref(r);
+        let mut lanes = Lanes::<1>::new(rays);
+        lanes.len[0] = e.len;
+        let mut ctx = self.context(false, rays, &lanes);
         unsafe { rtcOccluded1(self.scene.raw, ctx.raw(), &mut ray) };
         ray.tfar == f32::NEG_INFINITY
     }

@@ -35,16 +35,31 @@ pub(super) struct ExactContext<'a> {
     center: DVec3,
     /// Embree's t = t · len + pullback (the caller's ray was pulled back and normalised).
     pullback: f64,
-    len: [f64; 16],
+    len: &'a [f64],
     /// The exact t of the closest user-geometry hit so far in each lane (starts at tmax).
-    best: [Cell<f64>; 16],
+    best: &'a [Cell<f64>],
+}
+
+/// Per-lane storage of an `ExactContext` for up to N rays.
+pub(super) struct Lanes<const N: usize> {
+    pub len: [f64; N],
+    pub best: [Cell<f64>; N],
+}
+
+impl<const N: usize> Lanes<N> {
+    pub fn new(rays: &[Ray]) -> Self {
+        Lanes {
+            len: [1.0; N],
+            best: std::array::from_fn(|i| Cell::new(rays.get(i).map_or(f64::INFINITY, |r| r.tmax))),
+        }
+    }
 }
 
 impl<'a> ExactContext<'a> {
-    pub fn new(
+    pub fn new<const N: usize>(
         coherent: bool,
         rays: &'a [Ray],
-        lens: &[f64],
+        lanes: &'a Lanes<N>,
         center: DVec3,
         pullback: f64,
     ) -> Self {
@@ -54,17 +69,13 @@ impl<'a> ExactContext<'a> {
         if coherent {
             rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         }
-        let mut len = [1.0; 16];
-        len[..lens.len()].copy_from_slice(lens);
-        let best =
-            std::array::from_fn(|i| Cell::new(rays.get(i).map_or(f64::INFINITY, |r| r.tmax)));
         ExactContext {
             rtc,
-            rays,
+            rays: &rays[..rays.len().min(N)],
             center,
             pullback,
-            len,
-            best,
+            len: &lanes.len,
+            best: &lanes.best,
         }
     }
 
