@@ -44,7 +44,7 @@ pub struct BenchArgs {
     /// Override any value of SCENE, as for render.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// Primary-ray passes per row; the fastest counts.
+    /// Primary-ray passes and renders per row; the fastest of each counts.
     #[arg(long, default_value_t = 3)]
     pub repeat: usize,
     /// Worker threads (default: all cores).

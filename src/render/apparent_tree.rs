@@ -130,13 +130,7 @@ impl ApparentTree {
         let hits_node = |b: &Aabb, tmax: &[f64]| -> u32 {
             let mut mask = 0u32;
             for i in 0..n {
-                let a = (b.min - o) * inv[i];
-                let c = (b.max - o) * inv[i];
-                let lo = a.min(c);
-                let hi = a.max(c);
-                let t0 = tmin.max(lo.x).max(lo.y).max(lo.z);
-                let t1 = tmax[i].min(hi.x).min(hi.y).min(hi.z);
-                mask |= u32::from(t0 <= t1) << i;
+                mask |= u32::from(b.clip(o, inv[i], tmin, tmax[i]).is_some()) << i;
             }
             mask
         };

@@ -130,6 +130,7 @@ const INACTIVE: Ray = Ray {
 };
 
 /// A ray boosted into a group's rest frame and rebased to the near side of the group's bounds.
+#[derive(Clone, Copy)]
 struct RestRay {
     ray: Ray,
     shift: f64,
@@ -308,46 +309,42 @@ impl World {
             }
             return;
         }
-        let n = rays.len();
-        let mut best = vec![f64::INFINITY; n];
-        let mut batch = Vec::with_capacity(n);
-        let mut meta = Vec::with_capacity(n);
-        let mut hits: Vec<Option<Hit>> = vec![None; n];
-        out.iter_mut().for_each(|o| *o = None);
-        for (gi, g) in self.groups.iter().enumerate() {
-            // Every ray keeps its lane, so a packet stays a square of neighbouring pixels; a ray
-            // that misses the group's bounds is masked (inactive), not removed.
-            batch.clear();
-            meta.clear();
-            for (i, r) in rays.iter().enumerate() {
-                match self.rest_ray(g, r, tmin, best[i]) {
-                    Some(rr) => {
-                        batch.push(rr.ray);
-                        meta.push(Some(rr));
-                    }
+        // A packet's worth of rays at a time, through every group, on the stack.
+        const CHUNK: usize = 16;
+        for (rays, out) in rays.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+            let n = rays.len();
+            let mut best = [f64::INFINITY; CHUNK];
+            let mut batch = [INACTIVE; CHUNK];
+            let mut meta: [Option<RestRay>; CHUNK] = [None; CHUNK];
+            let mut hits: [Option<Hit>; CHUNK] = [None; CHUNK];
+            out.iter_mut().for_each(|o| *o = None);
+            for (gi, g) in self.groups.iter().enumerate() {
+                // Every ray keeps its lane, so a packet stays a square of neighbouring pixels;
+                // a ray that misses the group's bounds is masked (inactive), not removed.
+                let mut any = false;
+                for (i, r) in rays.iter().enumerate() {
+                    meta[i] = self.rest_ray(g, r, tmin, best[i]);
+                    batch[i] = meta[i].map_or(INACTIVE, |rr| rr.ray);
+                    any |= meta[i].is_some();
+                }
+                if !any {
+                    continue;
+                }
+                match &g.accel {
+                    Some(accel) => accel.intersect(&batch[..n], &mut hits[..n]),
                     None => {
-                        batch.push(INACTIVE);
-                        meta.push(None);
+                        for (b, h) in batch[..n].iter().zip(hits.iter_mut()) {
+                            *h = if b.is_active() { g.intersect1(b) } else { None };
+                        }
                     }
                 }
-            }
-            if meta.iter().all(Option::is_none) {
-                continue;
-            }
-            match &g.accel {
-                Some(accel) => accel.intersect(&batch, &mut hits[..n]),
-                None => {
-                    for (b, h) in batch.iter().zip(hits.iter_mut()) {
-                        *h = if b.is_active() { g.intersect1(b) } else { None };
-                    }
-                }
-            }
-            for (i, (h, rr)) in hits[..n].iter().zip(&meta).enumerate() {
-                if let (Some(h), Some(rr)) = (h, rr) {
-                    let hit = Self::surface_hit(gi, rr, *h);
-                    if hit.lambda < best[i] {
-                        best[i] = hit.lambda;
-                        out[i] = Some(hit);
+                for i in 0..n {
+                    if let (Some(h), Some(rr)) = (hits[i], &meta[i]) {
+                        let hit = Self::surface_hit(gi, rr, h);
+                        if hit.lambda < best[i] {
+                            best[i] = hit.lambda;
+                            out[i] = Some(hit);
+                        }
                     }
                 }
             }
