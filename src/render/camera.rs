@@ -63,6 +63,21 @@ impl CameraRays {
         NullRay::new(origin, dir)
     }
 
+    /// A pinhole camera's looking direction (unit, in the camera's rest frame) through image
+    /// point (px, py); None for other projections.
+    pub fn pinhole_dir(&self, px: f64, py: f64) -> Option<DVec3> {
+        let c = &self.camera;
+        matches!(c.projection, Projection::Pinhole { .. }).then(|| {
+            let (u, v) = (px - 0.5 * self.width, 0.5 * self.height - py);
+            (self.focal * c.forward + u * c.right + v * c.up).normalize()
+        })
+    }
+
+    /// A world-frame looking direction as the camera sees it (unit, camera's rest frame).
+    pub fn to_camera_dir(&self, world_dir: DVec3) -> DVec3 {
+        self.to_camera.view_dir(world_dir).0
+    }
+
     /// γ_c(1 + β_c·a): the camera's lookback factor for a world-frame looking direction `a`;
     /// the Doppler factor of a surface with factor s is this over s.
     pub fn lookback_factor(&self, dir_world: DVec3) -> f64 {

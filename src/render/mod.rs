@@ -7,6 +7,7 @@ mod camera;
 mod frame;
 mod group_tree;
 mod sampler;
+mod screen_cull;
 mod shade;
 mod tile;
 mod world;
@@ -15,6 +16,7 @@ pub use apparent_tree::{apparent_box, ApparentTree};
 pub use camera::CameraRays;
 pub use frame::{Frame, PixelValue, CHANNELS};
 pub use group_tree::{world_box, GroupTree};
+pub use screen_cull::ScreenCull;
 pub use world::{SurfaceHit, World, WorldOptions, GROUP_TREE_MIN};
 
 use crate::accel::Backend;
@@ -58,9 +60,10 @@ fn tiles(scene: &Scene) -> Vec<(u32, u32)> {
 /// measure of intersection throughput); returns (rays, hits).
 pub fn trace_primary(scene: &Scene, world: &World) -> (u64, u64) {
     let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
+    let cull = ScreenCull::new(world, &cam);
     tiles(scene)
         .par_iter()
-        .map(|&(x0, y0)| tile::trace_tile(scene, world, &cam, x0, y0))
+        .map(|&(x0, y0)| tile::trace_tile(scene, world, &cam, cull.as_ref(), x0, y0))
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
 
@@ -90,6 +93,7 @@ pub fn primary_rays_by_tile(scene: &Scene) -> Vec<Vec<crate::spacetime::NullRay>
 pub fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
     let (w, h) = scene.image.frame_size();
     let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
+    let cull = ScreenCull::new(world, &cam);
     let mut frame = Frame::new(w, h);
     let band = (w * TILE) as usize;
     let per_band: Vec<(u64, u64)> = frame
@@ -100,7 +104,7 @@ pub fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
             let y0 = b as u32 * TILE;
             let mut counts = (0, 0);
             for x0 in (0..w).step_by(TILE as usize) {
-                let tile = tile::render_tile(scene, world, &cam, x0, y0);
+                let tile = tile::render_tile(scene, world, &cam, cull.as_ref(), x0, y0);
                 counts.0 += tile.primary_rays;
                 counts.1 += tile.nonfinite;
                 for p in tile.pixels {

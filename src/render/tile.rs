@@ -4,6 +4,7 @@
 use super::camera::CameraRays;
 use super::frame::PixelValue;
 use super::sampler::sample_offset;
+use super::screen_cull::ScreenCull;
 use super::shade::Shader;
 use super::world::{SurfaceHit, World};
 use super::TILE;
@@ -46,26 +47,62 @@ pub fn primary_rays(
     }
 }
 
-/// Trace (without shading) every sample's primary rays of one tile; returns rays and hits.
-pub fn trace_tile(scene: &Scene, world: &World, cam: &CameraRays, x0: u32, y0: u32) -> (u64, u64) {
+/// Which of `coords` (frame pixels) may see a group: indices into `coords`. The others are
+/// background (their 4 × 4 block misses every group's rectangle on the image).
+fn live_pixels(
+    cam: &CameraRays,
+    coords: &[(u32, u32)],
+    offset: (u32, u32),
+    cull: Option<&ScreenCull>,
+) -> Vec<usize> {
+    let Some(cull) = cull else {
+        return (0..coords.len()).collect();
+    };
+    // Pixels come in 4 × 4 blocks: one test per block.
+    let mut last: Option<((u32, u32), bool)> = None;
+    (0..coords.len())
+        .filter(|&k| {
+            let (x, y) = (coords[k].0 + offset.0, coords[k].1 + offset.1);
+            let block = (x & !3, y & !3);
+            match last {
+                Some((b, v)) if b == block => v,
+                _ => {
+                    let v = cull.block_visible(cam, x, y);
+                    last = Some((block, v));
+                    v
+                }
+            }
+        })
+        .collect()
+}
+
+/// Trace (without shading) every sample's primary rays of one tile; returns the primary rays
+/// resolved (culled ones as background included) and the hits.
+pub fn trace_tile(
+    scene: &Scene,
+    world: &World,
+    cam: &CameraRays,
+    cull: Option<&ScreenCull>,
+    x0: u32,
+    y0: u32,
+) -> (u64, u64) {
     let (w, h) = scene.image.frame_size();
-    let coords = tile_pixels(x0, y0, w, h);
+    let all = tile_pixels(x0, y0, w, h);
+    let offset = scene.image.frame_offset();
+    let coords: Vec<(u32, u32)> = live_pixels(cam, &all, offset, cull)
+        .into_iter()
+        .map(|k| all[k])
+        .collect();
     let n = scene.image.samples;
     let mut rays = Vec::with_capacity(coords.len());
     let mut hits = vec![None; coords.len()];
     let mut found = 0;
     for s in 0..n {
-        primary_rays(
-            cam,
-            &coords,
-            scene.image.frame_offset(),
-            Some((s, n)),
-            &mut rays,
-        );
+        primary_rays(cam, &coords, offset, Some((s, n)), &mut rays);
         world.closest_hits(&rays, 0.0, &mut hits);
         found += hits.iter().filter(|h| h.is_some()).count() as u64;
     }
-    (n as u64 * coords.len() as u64, found)
+    (n as u64 * all.len() as u64, found)
 }
 
 pub struct TilePixel {
@@ -80,16 +117,30 @@ pub struct TileResult {
     pub nonfinite: u64,
 }
 
-pub fn render_tile(scene: &Scene, world: &World, cam: &CameraRays, x0: u32, y0: u32) -> TileResult {
+pub fn render_tile(
+    scene: &Scene,
+    world: &World,
+    cam: &CameraRays,
+    cull: Option<&ScreenCull>,
+    x0: u32,
+    y0: u32,
+) -> TileResult {
     let (w, h) = scene.image.frame_size();
     let coords = tile_pixels(x0, y0, w, h);
+    let offset = scene.image.frame_offset();
+    let live = live_pixels(cam, &coords, offset, cull);
+    let live_coords: Vec<(u32, u32)> = live.iter().map(|&k| coords[k]).collect();
     let n = scene.image.samples;
     let shader = Shader::new(scene, world);
-    let mut sum = vec![DVec3::ZERO; coords.len()];
+    // Pixels left out by the cull see the background in every sample.
+    let mut sum = vec![n as f64 * scene.image.background; coords.len()];
+    for &k in &live {
+        sum[k] = DVec3::ZERO;
+    }
     let mut covered = vec![0u32; coords.len()];
     let mut aov: Vec<Option<(NullRay, SurfaceHit)>> = vec![None; coords.len()];
-    let mut rays = Vec::with_capacity(coords.len());
-    let mut hits = vec![None; coords.len()];
+    let mut rays = Vec::with_capacity(live.len());
+    let mut hits = vec![None; live.len()];
     let mut primary = 0u64;
     // With one sample the pixel centre serves both colour and passes; with more, an extra
     // centre ray gives crisp passes (ids, lookback) that compositors expect.
@@ -98,10 +149,10 @@ pub fn render_tile(scene: &Scene, world: &World, cam: &CameraRays, x0: u32, y0: 
     for s in 0..n + u32::from(aov_pass) {
         let centre = s == n;
         let sample = if centre { None } else { Some((s, n)) };
-        primary_rays(cam, &coords, scene.image.frame_offset(), sample, &mut rays);
-        primary += rays.len() as u64;
+        primary_rays(cam, &live_coords, offset, sample, &mut rays);
+        primary += coords.len() as u64;
         world.closest_hits(&rays, 0.0, &mut hits);
-        for (k, (r, hit)) in rays.iter().zip(&hits).enumerate() {
+        for (&k, (r, hit)) in live.iter().zip(rays.iter().zip(&hits)) {
             if !centre {
                 sum[k] += match hit {
                     Some(hh) => {

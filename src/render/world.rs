@@ -249,6 +249,11 @@ impl World {
         })
     }
 
+    /// The imaging event (world frame), where every primary ray starts.
+    pub fn event(&self) -> crate::spacetime::Event {
+        self.event
+    }
+
     pub fn uses_group_tree(&self) -> bool {
         self.tree.is_some()
     }

@@ -1,0 +1,124 @@
+//! Primary rays that cannot meet any group go straight to the background without being made.
+//!
+//! In a group's rest frame the group is static and every primary ray starts at one point, the
+//! imaging event's rest-frame position; from there the group's bounds are seen within a cone of
+//! looking directions (the cap holding the directions to its eight corners). A Lorentz transformation acts on directions as a Möbius map of the
+//! celestial sphere, which takes circles to circles, so that cone, carried into the world frame
+//! and on into the camera's rest frame (the aberration of PHYSICS.md §1.1 each time), is again
+//! a cone, found exactly from three of its boundary directions. A 4 × 4 block of pixels (one ray
+//! packet) whose directions all lie outside every group's cone is background, with no camera
+//! ray, boost or bounds test spent on it. Pinhole cameras only (a block's directions are then
+//! within the angle of its farthest corner from its centre); at most `MAX_GROUPS` groups (with
+//! more, the group tree culls).
+
+use super::camera::CameraRays;
+use super::world::World;
+use glam::DVec3;
+
+const MAX_GROUPS: usize = 64;
+
+/// A cone of looking directions in the camera's rest frame.
+#[derive(Clone, Copy, Debug)]
+struct Cone {
+    axis: DVec3,
+    half_angle: f64,
+}
+
+pub struct ScreenCull {
+    cones: Vec<Cone>,
+}
+
+/// The angle between two unit vectors, accurate for small angles too (acos is not near 1).
+fn angle(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+/// The circle through three unit vectors, as a cone (axis toward them).
+fn cone_through(p: [DVec3; 3]) -> Option<Cone> {
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    let len = n.length();
+    if len.is_nan() || len <= 0.0 {
+        return None;
+    }
+    let mut axis = n / len;
+    if axis.dot(p[0]) < 0.0 {
+        axis = -axis;
+    }
+    let half_angle = p.iter().map(|q| angle(axis, *q)).fold(0.0, f64::max);
+    Some(Cone { axis, half_angle })
+}
+
+impl ScreenCull {
+    /// None when this cull does not apply: bounds culling switched off, a camera that is not a
+    /// pinhole, more than `MAX_GROUPS` groups, or a group whose bounds hold the imaging event or
+    /// fill nearly a hemisphere of its view.
+    pub fn new(world: &World, cam: &CameraRays) -> Option<ScreenCull> {
+        if !world.options.bounds_cull || world.groups.len() > MAX_GROUPS {
+            return None;
+        }
+        cam.pinhole_dir(0.0, 0.0)?;
+        let mut cones = Vec::with_capacity(world.groups.len());
+        for g in &world.groups {
+            let b = &g.bounds;
+            let e = g.event_rest;
+            if e.cmpge(b.min).all() && e.cmple(b.max).all() {
+                return None;
+            }
+            // The box's looking directions lie in the spherical hull of its corners', so in
+            // the cap around the direction to its centre that holds all eight corners.
+            let axis = (b.centroid() - g.event_rest).normalize();
+            let theta = (0..8)
+                .map(|k| {
+                    let corner = DVec3::new(
+                        if k & 1 == 0 { b.min.x } else { b.max.x },
+                        if k & 2 == 0 { b.min.y } else { b.max.y },
+                        if k & 4 == 0 { b.min.z } else { b.max.z },
+                    );
+                    angle(axis, (corner - g.event_rest).normalize())
+                })
+                .fold(0.0, f64::max);
+            // A cap reaching to 90 degrees is of no use.
+            if theta.is_nan() || theta >= std::f64::consts::FRAC_PI_2 - 1e-6 {
+                return None;
+            }
+            let (u, v) = (
+                axis.any_orthonormal_vector(),
+                axis.cross(axis.any_orthonormal_vector()),
+            );
+            // Three boundary directions, seen in the world frame, then by the camera.
+            let seen = |side: DVec3| {
+                let rest = theta.cos() * axis + theta.sin() * side;
+                cam.to_camera_dir(g.unboost.view_dir(rest).0)
+            };
+            let mut c = cone_through([
+                seen(u),
+                seen(-0.5 * u + 0.866_025_403_784_438_6 * v),
+                seen(-0.5 * u - 0.866_025_403_784_438_6 * v),
+            ])?;
+            // The image of the axis lies inside the image cone unless the map turned the cone
+            // inside out (it then covers more than a hemisphere: no use).
+            let centre = cam.to_camera_dir(g.unboost.view_dir(axis).0);
+            if centre.dot(c.axis) < c.half_angle.cos() || c.half_angle > 1.4 {
+                return None;
+            }
+            // Slack for rounding in the maps (a pixel is ~1e-3 rad).
+            c.half_angle += 1e-6;
+            cones.push(c);
+        }
+        Some(ScreenCull { cones })
+    }
+
+    /// Whether any group may be seen from the 4 × 4 block holding full-image pixel (x, y).
+    pub fn block_visible(&self, cam: &CameraRays, x: u32, y: u32) -> bool {
+        let (x0, y0) = ((x & !3) as f64, (y & !3) as f64);
+        let dir = |px: f64, py: f64| cam.pinhole_dir(px, py).unwrap_or(DVec3::Z);
+        let centre = dir(x0 + 2.0, y0 + 2.0);
+        let radius = [(0.0, 0.0), (4.0, 0.0), (0.0, 4.0), (4.0, 4.0)]
+            .iter()
+            .map(|&(dx, dy)| angle(centre, dir(x0 + dx, y0 + dy)))
+            .fold(0.0, f64::max);
+        self.cones
+            .iter()
+            .any(|c| angle(centre, c.axis) <= c.half_angle + radius)
+    }
+}
