@@ -5,7 +5,7 @@ mod common;
 use common::*;
 use glam::DVec3;
 use rest_embree::geometry::Aabb;
-use rest_embree::render::{render_world, GroupTree, World, WorldOptions};
+use rest_embree::render::{render_world, GroupTree, SlicedGroupTree, World, WorldOptions};
 use rest_embree::spacetime::{Boost, Event, NullRay, Velocity};
 
 #[test]
@@ -25,8 +25,10 @@ fn group_tree_visits_every_group_a_ray_meets() {
         .collect();
     let t_ref = 20.0;
     let tree = GroupTree::build(&groups, t_ref);
+    // Sliced: inner slices first test each node's static box over their time span.
+    let sliced = SlicedGroupTree::build(&groups, -80.0, 80.0, 16);
     let mut checked = 0;
-    for _ in 0..12000 {
+    for k in 0..24000 {
         // Rays from arbitrary events, before and after the reference time.
         let o = Event::new(
             r.range(-100.0, 100.0),
@@ -43,10 +45,15 @@ fn group_tree_visits_every_group_a_ray_meets() {
             r.range(1.0, 200.0)
         };
         let mut visited = vec![false; groups.len()];
-        tree.traverse(&ray, 0.0, tmax, |g, t| {
+        let mark = |g: u32, t: f64| {
             visited[g as usize] = true;
             t
-        });
+        };
+        if k % 2 == 0 {
+            tree.traverse(&ray, 0.0, tmax, mark);
+        } else {
+            sliced.traverse(&ray, 0.0, tmax, mark);
+        }
         for (i, (b, v)) in groups.iter().enumerate() {
             // Exact: the ray in the group's rest frame against its rest-frame bounds.
             let boost = Boost::to_rest(v);
@@ -63,7 +70,7 @@ fn group_tree_visits_every_group_a_ray_meets() {
         }
     }
     assert!(
-        checked > 600,
+        checked > 1200,
         "enough ray-group meetings were checked ({checked})"
     );
 }

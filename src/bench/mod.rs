@@ -351,7 +351,15 @@ pub fn summary(rows: &[Row]) -> String {
     };
     for c in &cases {
         if let (Some(e), Some(b)) = (find(c, "embree"), find(c, "embree bare (no relativity)")) {
-            let _ = writeln!(s, "- {c}: embree through the relativistic layer / bare Embree on the same rays = {:.2}", e.mrays_per_s() / b.mrays_per_s());
+            let _ = write!(s, "- {c}: embree through the relativistic layer / bare Embree on the same rays = {:.2}", e.mrays_per_s() / b.mrays_per_s());
+            if let Some(n) = find(c, "embree no-cull") {
+                let _ = write!(
+                    s,
+                    " (without bounds and screen culling: {:.2})",
+                    n.mrays_per_s() / b.mrays_per_s()
+                );
+            }
+            s.push('\n');
         }
         if let (Some(e), Some(b)) = (find(c, "embree"), find(c, "bvh")) {
             let _ = writeln!(

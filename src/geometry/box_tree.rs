@@ -77,12 +77,28 @@ struct BuildItem {
     end: usize,
 }
 
+/// An item being sorted into the tree: its box, centroid and index, kept together so the
+/// build's passes read memory in order instead of chasing indices.
+#[derive(Clone, Copy)]
+struct Item {
+    bounds: Aabb,
+    centroid: DVec3,
+    index: u32,
+}
+
 impl BoxTree {
     /// Build over the boxes of `n` items (binned SAH, leaves of up to 4 items).
     pub fn build(boxes: &[Aabb]) -> BoxTree {
         let n = boxes.len();
-        let centroids: Vec<DVec3> = boxes.iter().map(|b| b.centroid()).collect();
-        let mut indices: Vec<u32> = (0..n as u32).collect();
+        let mut items: Vec<Item> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, b)| Item {
+                bounds: *b,
+                centroid: b.centroid(),
+                index: i as u32,
+            })
+            .collect();
         let mut nodes = Vec::with_capacity(2 * n.div_ceil(MAX_LEAF).max(1));
         nodes.push(TreeNode {
             bounds: Aabb::EMPTY,
@@ -95,20 +111,19 @@ impl BoxTree {
             end: n,
         }];
         while let Some(item) = stack.pop() {
-            let idx = &mut indices[item.start..item.end];
-            let bounds = idx
-                .iter()
-                .fold(Aabb::EMPTY, |b, &i| b.union(&boxes[i as usize]));
-            let cbounds = idx.iter().fold(Aabb::EMPTY, |mut b, &i| {
-                b.grow(centroids[i as usize]);
-                b
-            });
+            let part = &mut items[item.start..item.end];
+            let (bounds, cbounds) =
+                part.iter()
+                    .fold((Aabb::EMPTY, Aabb::EMPTY), |(b, mut c), it| {
+                        c.grow(it.centroid);
+                        (b.union(&it.bounds), c)
+                    });
             nodes[item.node].bounds = bounds;
-            let count = idx.len();
+            let count = part.len();
             let split = if count <= 1 {
                 None
             } else {
-                find_split(idx, boxes, &centroids, &bounds, &cbounds)
+                find_split(part, &bounds, &cbounds)
             };
             let mid = match split {
                 Some(m) => Some(m),
@@ -126,8 +141,8 @@ impl BoxTree {
                         } else {
                             2
                         };
-                        idx.select_nth_unstable_by(mid, |&a, &b| {
-                            centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis])
+                        part.select_nth_unstable_by(mid, |a, b| {
+                            a.centroid[axis].total_cmp(&b.centroid[axis])
                         });
                     }
                     let left = nodes.len();
@@ -160,20 +175,17 @@ impl BoxTree {
                 }
             }
         }
-        BoxTree { nodes, indices }
+        BoxTree {
+            nodes,
+            indices: items.iter().map(|it| it.index).collect(),
+        }
     }
 }
 
-/// Binned SAH: the split position (count of the left side, after partitioning `idx`) or None
+/// Binned SAH: the split position (count of the left side, after partitioning `items`) or None
 /// when a leaf is cheaper.
-fn find_split(
-    idx: &mut [u32],
-    boxes: &[Aabb],
-    centroids: &[DVec3],
-    bounds: &Aabb,
-    cbounds: &Aabb,
-) -> Option<usize> {
-    let count = idx.len();
+fn find_split(items: &mut [Item], bounds: &Aabb, cbounds: &Aabb) -> Option<usize> {
+    let count = items.len();
     let ext = cbounds.extent();
     let mut best: Option<(f64, usize, usize)> = None; // cost, axis, bin
     for axis in 0..3 {
@@ -184,10 +196,10 @@ fn find_split(
         let bin_of = |c: DVec3| (((c[axis] - cbounds.min[axis]) * scale) as usize).min(BINS - 1);
         let mut bin_box = [Aabb::EMPTY; BINS];
         let mut bin_n = [0usize; BINS];
-        for &i in idx.iter() {
-            let b = bin_of(centroids[i as usize]);
+        for it in items.iter() {
+            let b = bin_of(it.centroid);
             bin_n[b] += 1;
-            bin_box[b] = bin_box[b].union(&boxes[i as usize]);
+            bin_box[b] = bin_box[b].union(&it.bounds);
         }
         let mut right_area = [0.0; BINS];
         let mut right_n = [0usize; BINS];
@@ -221,10 +233,10 @@ fn find_split(
     let scale = BINS as f64 / ext[axis];
     let mut left = 0;
     for k in 0..count {
-        let c = centroids[idx[k] as usize];
+        let c = items[k].centroid;
         let b = (((c[axis] - cbounds.min[axis]) * scale) as usize).min(BINS - 1);
         if b <= bin {
-            idx.swap(k, left);
+            items.swap(k, left);
             left += 1;
         }
     }

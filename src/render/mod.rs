@@ -15,7 +15,7 @@ mod world;
 pub use apparent_tree::{apparent_box, ApparentTree};
 pub use camera::CameraRays;
 pub use frame::{Frame, PixelValue, CHANNELS};
-pub use group_tree::{world_box, GroupTree};
+pub use group_tree::{world_box, GroupTree, SlicedGroupTree};
 pub use screen_cull::ScreenCull;
 pub use world::{SurfaceHit, World, WorldOptions, GROUP_TREE_MIN};
 
