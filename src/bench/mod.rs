@@ -146,6 +146,21 @@ fn reference(scene: &Scene, spp: u32) -> Result<Frame, String> {
     Ok(render_world(&s, &World::build(&s, bvh.as_ref())?).0)
 }
 
+/// The fastest of at least `repeat` runs of `f`, and of as many more as fit in a quarter of a
+/// second: a pass of a few milliseconds is easily slowed by anything else on the machine.
+fn fastest(repeat: usize, mut f: impl FnMut()) -> f64 {
+    let start = Instant::now();
+    let mut best = f64::INFINITY;
+    let mut runs = 0;
+    while runs < repeat.max(1) || (start.elapsed().as_secs_f64() < 0.25 && runs < 100) {
+        let t = Instant::now();
+        f();
+        best = best.min(t.elapsed().as_secs_f64());
+        runs += 1;
+    }
+    best
+}
+
 fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, Frame), String> {
     let (backend_name, options) = parse_setting(setting);
     let backend = backend_by_name(backend_name)?;
@@ -155,12 +170,8 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
     let world = World::build_with(&scene, backend.as_ref(), options)?;
     let build_s = t.elapsed().as_secs_f64();
     // One untimed pass first: thread pools, page faults and caches are warm for every row.
-    let (mut primary_s, mut primary_rays) = (f64::INFINITY, trace_primary(&scene, &world).0);
-    for _ in 0..repeat.max(1) {
-        let t = Instant::now();
-        primary_rays = trace_primary(&scene, &world).0;
-        primary_s = primary_s.min(t.elapsed().as_secs_f64());
-    }
+    let mut primary_rays = trace_primary(&scene, &world).0;
+    let primary_s = fastest(repeat, || primary_rays = trace_primary(&scene, &world).0);
     // Renders of a few milliseconds vary by tens of percent from run to run: the fastest of
     // `repeat` counts, as for the primary rays.
     let t = Instant::now();
@@ -223,13 +234,10 @@ fn bare_embree(case: &Case, repeat: usize) -> Result<Option<(u64, f64)>, String>
         })
         .collect();
     let n: u64 = tiles.iter().map(|t| t.len() as u64).sum();
-    let mut best = f64::INFINITY;
     let _warm: usize = tiles.par_iter().map(|t| accel.trace_bare(t)).sum();
-    for _ in 0..repeat.max(1) {
-        let t = Instant::now();
+    let best = fastest(repeat, || {
         let _hits: usize = tiles.par_iter().map(|t| accel.trace_bare(t)).sum();
-        best = best.min(t.elapsed().as_secs_f64());
-    }
+    });
     Ok(Some((n, best)))
 }
 

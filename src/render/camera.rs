@@ -73,6 +73,12 @@ impl CameraRays {
         })
     }
 
+    /// A pinhole camera's focal length in pixels (0 for other projections): image points L
+    /// pixels apart look in directions at most L / focal radians apart.
+    pub fn focal_px(&self) -> f64 {
+        self.focal
+    }
+
     /// A world-frame looking direction as the camera sees it (unit, camera's rest frame).
     pub fn to_camera_dir(&self, world_dir: DVec3) -> DVec3 {
         self.to_camera.view_dir(world_dir).0

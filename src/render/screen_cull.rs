@@ -2,18 +2,20 @@
 //!
 //! In a group's rest frame the group is static and every primary ray starts at one point, the
 //! imaging event's rest-frame position; from there the group's bounds are seen within a cone of
-//! looking directions (the cap holding the directions to its eight corners). A Lorentz transformation acts on directions as a Möbius map of the
-//! celestial sphere, which takes circles to circles, so that cone, carried into the world frame
-//! and on into the camera's rest frame (the aberration of PHYSICS.md §1.1 each time), is again
-//! a cone, found exactly from three of its boundary directions. A 4 × 4 block of pixels (one ray
-//! packet) whose directions all lie outside every group's cone is background, with no camera
-//! ray, boost or bounds test spent on it. Pinhole cameras only (a block's directions are then
-//! within the angle of its farthest corner from its centre); at most `MAX_GROUPS` groups (with
-//! more, the group tree culls).
+//! looking directions (the cap holding the directions to its eight corners). A Lorentz
+//! transformation acts on directions as a Möbius map of the celestial sphere, which takes
+//! circles to circles, so that cone, carried into the world frame and on into the camera's rest
+//! frame (the aberration of PHYSICS.md §1.1 each time), is again a cone, found exactly from
+//! three of its boundary directions. A 4 × 4 block of pixels (one ray packet) whose directions
+//! all lie outside every group's cone is background, with no camera ray, boost or bounds test
+//! spent on it: one dot product per block and group. Pinhole cameras only (image points L
+//! pixels apart then look at most L / focal radians apart, which bounds a block's spread of
+//! directions); at most `MAX_GROUPS` groups (with more, the group tree culls).
 
 use super::camera::CameraRays;
 use super::world::World;
 use glam::DVec3;
+use std::f64::consts::PI;
 
 const MAX_GROUPS: usize = 64;
 
@@ -25,7 +27,9 @@ struct Cone {
 }
 
 pub struct ScreenCull {
-    cones: Vec<Cone>,
+    /// Per group: the cone's axis and the cosine of its half-angle widened by a block's
+    /// angular radius (a block is visible when its centre direction is within that).
+    cones: Vec<(DVec3, f64)>,
 }
 
 /// The angle between two unit vectors, accurate for small angles too (acos is not near 1).
@@ -57,6 +61,9 @@ impl ScreenCull {
             return None;
         }
         cam.pinhole_dir(0.0, 0.0)?;
+        // Image points L pixels apart look at most L / focal apart: a 4 x 4 block's directions
+        // are within 2 sqrt(2) / focal of its centre's.
+        let block_radius = 8f64.sqrt() / cam.focal_px();
         let mut cones = Vec::with_capacity(world.groups.len());
         for g in &world.groups {
             let b = &g.bounds;
@@ -90,7 +97,7 @@ impl ScreenCull {
                 let rest = theta.cos() * axis + theta.sin() * side;
                 cam.to_camera_dir(g.unboost.view_dir(rest).0)
             };
-            let mut c = cone_through([
+            let c = cone_through([
                 seen(u),
                 seen(-0.5 * u + 0.866_025_403_784_438_6 * v),
                 seen(-0.5 * u - 0.866_025_403_784_438_6 * v),
@@ -102,8 +109,8 @@ impl ScreenCull {
                 return None;
             }
             // Slack for rounding in the maps (a pixel is ~1e-3 rad).
-            c.half_angle += 1e-6;
-            cones.push(c);
+            let reach = c.half_angle + block_radius + 1e-6;
+            cones.push((c.axis, if reach < PI { reach.cos() } else { -1.0 }));
         }
         Some(ScreenCull { cones })
     }
@@ -111,14 +118,11 @@ impl ScreenCull {
     /// Whether any group may be seen from the 4 × 4 block holding full-image pixel (x, y).
     pub fn block_visible(&self, cam: &CameraRays, x: u32, y: u32) -> bool {
         let (x0, y0) = ((x & !3) as f64, (y & !3) as f64);
-        let dir = |px: f64, py: f64| cam.pinhole_dir(px, py).unwrap_or(DVec3::Z);
-        let centre = dir(x0 + 2.0, y0 + 2.0);
-        let radius = [(0.0, 0.0), (4.0, 0.0), (0.0, 4.0), (4.0, 4.0)]
-            .iter()
-            .map(|&(dx, dy)| angle(centre, dir(x0 + dx, y0 + dy)))
-            .fold(0.0, f64::max);
+        let Some(centre) = cam.pinhole_dir(x0 + 2.0, y0 + 2.0) else {
+            return true;
+        };
         self.cones
             .iter()
-            .any(|c| angle(centre, c.axis) <= c.half_angle + radius)
+            .any(|&(axis, cos_reach)| centre.dot(axis) >= cos_reach)
     }
 }

@@ -119,6 +119,10 @@ pub struct World {
     /// With many groups: every ray's culling (kinetic), and the primary rays' (apparent boxes).
     tree: Option<SlicedGroupTree>,
     primary_tree: Option<ApparentTree>,
+    /// Whether rays are clipped to a group's bounds (and moved to where they enter) before its
+    /// accelerator: needed to skip groups and to keep f32 coordinates small when rays come from
+    /// afar; pure cost for one group seen from close by, whose rays all start near it.
+    clip_rays: bool,
 }
 
 /// A masked lane of a batch.
@@ -240,12 +244,20 @@ impl World {
             ));
             primary_tree = Some(ApparentTree::build(&items, event));
         }
+        // Rays start at the imaging event or on a surface: with one group, all near it unless
+        // the imaging event is far (more than 4 diagonals from the bounds' centre).
+        let clip_rays = options.bounds_cull
+            && (groups.len() > 1
+                || groups.iter().any(|g| {
+                    (g.event_rest - g.bounds.centroid()).length() > 4.0 * g.bounds.diagonal()
+                }));
         Ok(World {
             event,
             groups,
             options,
             tree,
             primary_tree,
+            clip_rays,
         })
     }
 
@@ -269,7 +281,7 @@ impl World {
             g.boost.event(ray.origin).x
         };
         let (dir, s) = g.boost.null_dir(ray.dir);
-        let shift = if self.options.bounds_cull {
+        let shift = if self.clip_rays {
             g.bounds.clip(origin, dir.recip(), tmin, tmax)?.0
         } else {
             0.0
