@@ -150,6 +150,7 @@ fn group_tree_and_merging_do_not_change_the_picture() {
                 merge_equal_velocities: false,
                 bounds_cull: true,
                 group_tree: false,
+                ..Default::default()
             },
         )
         .unwrap();

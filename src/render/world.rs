@@ -40,6 +40,9 @@ pub struct WorldOptions {
     pub bounds_cull: bool,
     /// Use the kinetic group tree when there are many groups.
     pub group_tree: bool,
+    /// Groups of at most this many primitives are intersected directly in f64, without an
+    /// accelerator (0: every group gets one, as tests of a backend want).
+    pub direct_max: usize,
 }
 
 impl Default for WorldOptions {
@@ -48,6 +51,7 @@ impl Default for WorldOptions {
             merge_equal_velocities: true,
             bounds_cull: true,
             group_tree: true,
+            direct_max: DIRECT_MAX,
         }
     }
 }
@@ -198,7 +202,7 @@ impl World {
                 .iter()
                 .map(|&i| scene.groups[i].name.as_str())
                 .collect();
-            let accel = if geometry.prims.len() <= DIRECT_MAX {
+            let accel = if geometry.prims.len() <= options.direct_max {
                 None
             } else {
                 Some(backend.build(geometry.clone()).map_err(|e| {
