@@ -76,6 +76,31 @@ fn live_pixels(
         .collect()
 }
 
+/// A tile's pixels (frame coordinates), where the frame sits in the image, and those the
+/// screen cull keeps (indices into `all`, and their coordinates).
+struct TilePixels {
+    all: Vec<(u32, u32)>,
+    offset: (u32, u32),
+    live: Vec<usize>,
+    live_coords: Vec<(u32, u32)>,
+}
+
+impl TilePixels {
+    fn new(scene: &Scene, cam: &CameraRays, cull: Option<&ScreenCull>, x0: u32, y0: u32) -> Self {
+        let (w, h) = scene.image.frame_size();
+        let all = tile_pixels(x0, y0, w, h);
+        let offset = scene.image.frame_offset();
+        let live = live_pixels(cam, &all, offset, cull);
+        let live_coords = live.iter().map(|&k| all[k]).collect();
+        TilePixels {
+            all,
+            offset,
+            live,
+            live_coords,
+        }
+    }
+}
+
 /// Trace (without shading) every sample's primary rays of one tile; returns the primary rays
 /// resolved (culled ones as background included) and the hits.
 pub fn trace_tile(
@@ -86,13 +111,8 @@ pub fn trace_tile(
     x0: u32,
     y0: u32,
 ) -> (u64, u64) {
-    let (w, h) = scene.image.frame_size();
-    let all = tile_pixels(x0, y0, w, h);
-    let offset = scene.image.frame_offset();
-    let coords: Vec<(u32, u32)> = live_pixels(cam, &all, offset, cull)
-        .into_iter()
-        .map(|k| all[k])
-        .collect();
+    let t = TilePixels::new(scene, cam, cull, x0, y0);
+    let (all, offset, coords) = (t.all, t.offset, t.live_coords);
     let n = scene.image.samples;
     let mut rays = Vec::with_capacity(coords.len());
     let mut hits = vec![None; coords.len()];
@@ -125,11 +145,12 @@ pub fn render_tile(
     x0: u32,
     y0: u32,
 ) -> TileResult {
-    let (w, h) = scene.image.frame_size();
-    let coords = tile_pixels(x0, y0, w, h);
-    let offset = scene.image.frame_offset();
-    let live = live_pixels(cam, &coords, offset, cull);
-    let live_coords: Vec<(u32, u32)> = live.iter().map(|&k| coords[k]).collect();
+    let TilePixels {
+        all: coords,
+        offset,
+        live,
+        live_coords,
+    } = TilePixels::new(scene, cam, cull, x0, y0);
     let n = scene.image.samples;
     let shader = Shader::new(scene, world);
     // Pixels left out by the cull see the background in every sample.
