@@ -73,43 +73,75 @@ impl<'a> Shader<'a> {
         NullRay::new(hit_event + offset, dir_w)
     }
 
+    /// The colour of a hit: its light from each light not in shadow, and what it reflects
+    /// and transmits.
     pub fn shade(&self, ray: &NullRay, hit: &SurfaceHit, depth: u32) -> DVec3 {
+        let mut shadows = Vec::with_capacity(self.lights.len());
+        let lit = self.prepare(ray, hit, &mut shadows);
+        let visible: Vec<bool> = shadows
+            .iter()
+            .map(|q| {
+                q.as_ref()
+                    .is_some_and(|q| !self.world.occluded(&q.ray, 0.0, q.tmax))
+            })
+            .collect();
+        self.finish(&lit, &shadows, &visible, depth)
+    }
+
+    pub fn light_count(&self) -> usize {
+        self.lights.len()
+    }
+
+    /// Everything about a hit's shading that does not depend on other rays: the ambient and
+    /// emitted light, and (appended to `shadows`, one entry per light, None where the light
+    /// cannot reach the surface) each light's contribution and the shadow ray that decides it.
+    pub fn prepare(
+        &self,
+        ray: &NullRay,
+        hit: &SurfaceHit,
+        shadows: &mut Vec<Option<ShadowQuery>>,
+    ) -> Lit<'a> {
         let scene = self.scene;
         let g = &self.world.groups[hit.group];
         let prim = &g.geometry.prims[hit.prim as usize];
         let mat = &scene.materials[g.geometry.part_of(hit.prim).material as usize];
-        if let Some(e) = mat.emission {
-            return e;
-        }
         let v = hit.dir / hit.s;
         let n = prim.normal(hit.point);
         let inside = n.dot(v) > 0.0;
         let nf = if inside { -n } else { n };
         let event = ray.at(hit.lambda);
-        let mut color = scene.render.ambient * mat.color;
-        let from = if self.lights.is_empty() {
-            event
-        } else {
-            self.spawn(hit.group, event, nf, nf).origin
+        let mut lit = Lit {
+            mat,
+            group: hit.group,
+            event,
+            v,
+            nf,
+            inside,
+            base: scene.render.ambient * mat.color,
         };
-        for l in &self.lights {
+        if let Some(e) = mat.emission {
+            lit.base = e;
+            shadows.extend(self.lights.iter().map(|_| None));
+            return lit;
+        }
+        if self.lights.is_empty() {
+            return lit;
+        }
+        let from = self.spawn(hit.group, event, nf, nf).origin;
+        shadows.extend(self.lights.iter().map(|l| {
             // The emission event on the light's worldline that lies on `from`'s past light
             // cone, found in the light's rest frame, where the light is static.
             let at_light = l.to_light.event(from);
             let delta = l.light.position - at_light.x;
             let dist = delta.length();
             if dist == 0.0 {
-                continue;
+                return None;
             }
             let (dir_w, k) = l.from_light.view_dir(delta / dist);
             let to_light = g.boost.view_dir(dir_w).0;
             let ndl = nf.dot(to_light);
             if ndl <= 0.0 {
-                continue;
-            }
-            let shadow = NullRay::new(from, dir_w);
-            if self.world.occluded(&shadow, 0.0, dist * k * (1.0 - 1e-9)) {
-                continue;
+                return None;
             }
             let atten = if l.light.inverse_square {
                 1.0 / (dist * dist)
@@ -121,15 +153,41 @@ impl<'a> Shader<'a> {
                 let r = reflect(-to_light, nf);
                 term += mat.specular * r.dot(-v).max(0.0).powf(mat.shininess);
             }
-            color += l.light.radiance * atten * term;
+            Some(ShadowQuery {
+                ray: NullRay::new(from, dir_w),
+                tmax: dist * k * (1.0 - 1e-9),
+                light: l.light.radiance * atten * term,
+            })
+        }));
+        lit
+    }
+
+    /// The colour of a prepared hit, given its shadow rays and which reach their light.
+    pub fn finish(
+        &self,
+        lit: &Lit,
+        shadows: &[Option<ShadowQuery>],
+        visible: &[bool],
+        depth: u32,
+    ) -> DVec3 {
+        let mat = lit.mat;
+        if mat.emission.is_some() {
+            return lit.base;
         }
-        if depth >= scene.render.max_depth {
+        let mut color = lit.base;
+        for (q, &seen) in shadows.iter().zip(visible) {
+            if let (Some(q), true) = (q, seen) {
+                color += q.light;
+            }
+        }
+        if depth >= self.scene.render.max_depth {
             return color;
         }
+        let (v, nf, event) = (lit.v, lit.nf, lit.event);
         let (mut kr, mut kt) = (mat.reflect, mat.transmit);
         let mut refracted = None;
         if kt > 0.0 {
-            let eta = if inside { mat.ior } else { 1.0 / mat.ior };
+            let eta = if lit.inside { mat.ior } else { 1.0 / mat.ior };
             let (f, t) = fresnel_refract(v, nf, eta);
             match t {
                 Some(t) => {
@@ -144,13 +202,32 @@ impl<'a> Shader<'a> {
             }
         }
         if kr > 0.0 {
-            let r = self.spawn(hit.group, event, nf, reflect(v, nf));
+            let r = self.spawn(lit.group, event, nf, reflect(v, nf));
             color += kr * self.trace(&r, depth + 1);
         }
         if let (Some(t), true) = (refracted, kt > 0.0) {
-            let r = self.spawn(hit.group, event, -nf, t);
+            let r = self.spawn(lit.group, event, -nf, t);
             color += kt * self.trace(&r, depth + 1);
         }
         color
     }
+}
+
+/// A shadow ray to one light, and the light it brings if nothing is in the way.
+pub struct ShadowQuery {
+    pub ray: NullRay,
+    pub tmax: f64,
+    light: DVec3,
+}
+
+/// A hit prepared for shading: see [`Shader::prepare`].
+pub struct Lit<'a> {
+    mat: &'a crate::scene::Material,
+    group: usize,
+    event: Event,
+    v: DVec3,
+    nf: DVec3,
+    inside: bool,
+    /// Ambient (or emitted) light.
+    base: DVec3,
 }

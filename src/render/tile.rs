@@ -125,6 +125,59 @@ pub fn trace_tile(
     (n as u64 * all.len() as u64, found)
 }
 
+/// The colours of primary hits (background where none), with the shadow rays of all of them
+/// traced together, light by light, so they go to the backends in packets.
+fn shade_hits(
+    shader: &Shader,
+    world: &World,
+    rays: &[NullRay],
+    hits: &[Option<SurfaceHit>],
+    background: DVec3,
+) -> Vec<DVec3> {
+    // One entry per light and hit (None where there is no shadow ray), hit-major.
+    let lights = shader.light_count();
+    let mut shadows = Vec::with_capacity(lights * hits.len());
+    let lits: Vec<_> = rays
+        .iter()
+        .zip(hits)
+        .map(|(r, h)| match h {
+            Some(h) => Some(shader.prepare(r, h, &mut shadows)),
+            None => {
+                shadows.extend((0..lights).map(|_| None));
+                None
+            }
+        })
+        .collect();
+    let mut visible = vec![false; shadows.len()];
+    let (mut which, mut shadow, mut tmax) = (Vec::new(), Vec::new(), Vec::new());
+    for light in 0..lights {
+        which.clear();
+        shadow.clear();
+        tmax.clear();
+        for (at, q) in shadows.iter().enumerate().skip(light).step_by(lights) {
+            if let Some(q) = q {
+                which.push(at);
+                shadow.push(q.ray);
+                tmax.push(q.tmax);
+            }
+        }
+        let mut blocked = vec![false; shadow.len()];
+        world.occluded_many(&shadow, &tmax, &mut blocked);
+        for (&at, b) in which.iter().zip(blocked) {
+            visible[at] = !b;
+        }
+    }
+    lits.iter()
+        .enumerate()
+        .map(|(k, lit)| {
+            let mine = k * lights..(k + 1) * lights;
+            lit.as_ref().map_or(background, |l| {
+                shader.finish(l, &shadows[mine.clone()], &visible[mine], 0)
+            })
+        })
+        .collect()
+}
+
 pub struct TilePixel {
     pub x: u32,
     pub y: u32,
@@ -173,15 +226,16 @@ pub fn render_tile(
         primary_rays(cam, &live_coords, offset, sample, &mut rays);
         primary += coords.len() as u64;
         world.closest_hits(&rays, 0.0, &mut hits);
-        for (&k, (r, hit)) in live.iter().zip(rays.iter().zip(&hits)) {
+        let colors = if centre {
+            Vec::new()
+        } else {
+            shade_hits(&shader, world, &rays, &hits, scene.image.background)
+        };
+        for (j, (&k, hit)) in live.iter().zip(&hits).enumerate() {
+            let r = &rays[j];
             if !centre {
-                sum[k] += match hit {
-                    Some(hh) => {
-                        covered[k] += 1;
-                        shader.shade(r, hh, 0)
-                    }
-                    None => scene.image.background,
-                };
+                covered[k] += u32::from(hit.is_some());
+                sum[k] += colors[j];
             }
             if s == aov_sample {
                 aov[k] = hit.map(|hh| (*r, hh));

@@ -442,6 +442,55 @@ impl World {
         best
     }
 
+    /// [`World::occluded`] for many rays (lookback from 0 to `tmax[i]`) at once: with few
+    /// groups they go to each group's backend together (packets), as primary rays do.
+    pub fn occluded_many(&self, rays: &[NullRay], tmax: &[f64], out: &mut [bool]) {
+        if self.tree.is_some() {
+            for ((r, &t), o) in rays.iter().zip(tmax).zip(out.iter_mut()) {
+                *o = self.occluded(r, 0.0, t);
+            }
+            return;
+        }
+        const CHUNK: usize = 16;
+        for ((rays, tmax), out) in rays
+            .chunks(CHUNK)
+            .zip(tmax.chunks(CHUNK))
+            .zip(out.chunks_mut(CHUNK))
+        {
+            let n = rays.len();
+            let mut batch = [INACTIVE; CHUNK];
+            let mut hit = [false; CHUNK];
+            out.iter_mut().for_each(|o| *o = false);
+            for g in &self.groups {
+                // Rays already in shadow stay out (masked) of the other groups' packets.
+                let mut any = false;
+                for i in 0..n {
+                    batch[i] = match out[i] {
+                        true => INACTIVE,
+                        false => self
+                            .rest_ray(g, &rays[i], 0.0, tmax[i])
+                            .map_or(INACTIVE, |rr| rr.ray),
+                    };
+                    any |= batch[i].is_active();
+                }
+                if !any {
+                    continue;
+                }
+                match &g.accel {
+                    Some(accel) => accel.occluded(&batch[..n], &mut hit[..n]),
+                    None => {
+                        for (b, h) in batch[..n].iter().zip(hit.iter_mut()) {
+                            *h = b.is_active() && g.occluded1(b);
+                        }
+                    }
+                }
+                for i in 0..n {
+                    out[i] |= batch[i].is_active() && hit[i];
+                }
+            }
+        }
+    }
+
     /// Whether anything lies on the ray between lookback `tmin` and `tmax`.
     pub fn occluded(&self, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
         let test = |gi: usize| -> bool {
