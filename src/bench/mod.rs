@@ -104,7 +104,7 @@ pub struct Row {
     pub build_s: f64,
     pub primary_rays: u64,
     pub primary_s: f64,
-        pub render_s: f64,
+    pub render_s: f64,
     /// The first render (fastest is `render_s`): it also builds what is built on first use.
     pub first_render_s: f64,
     pub peak_mib: Option<f64>,
@@ -167,7 +167,7 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
     let (backend_name, options) = parse_setting(setting);
     let backend = backend_by_name(backend_name)?;
     let scene = with_spp(&case.scene, spp);
-        memory::reset_peak();
+    memory::reset_peak();
     let t = Instant::now();
     let mut world = World::build_with(&scene, backend.as_ref(), options)?;
     let mut build_s = t.elapsed().as_secs_f64();
@@ -186,7 +186,7 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
     let primary_s = fastest(repeat, || primary_rays = trace_primary(&scene, &world).0);
     // Renders of a few milliseconds vary by tens of percent from run to run: the fastest of
     // `repeat` counts, as for the primary rays.
-        // The first render also builds whatever is built on first use (the time slices of many
+    // The first render also builds whatever is built on first use (the time slices of many
     // groups): the cold cost of a frame is build + first render.
     let t = Instant::now();
     let (mut frame, _) = render_world(&scene, &world);
@@ -210,7 +210,7 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
             build_s,
             primary_rays,
             primary_s,
-                        render_s,
+            render_s,
             first_render_s,
             peak_mib: memory::peak_mib(),
             vs_same: None,
@@ -311,7 +311,7 @@ pub fn run(
                     build_s: 0.0,
                     primary_rays: n,
                     primary_s: secs,
-                                        render_s: f64::NAN,
+                    render_s: f64::NAN,
                     first_render_s: f64::NAN,
                     peak_mib: None,
                     vs_same: None,
@@ -420,7 +420,7 @@ pub fn summary(rows: &[Row]) -> String {
     for r in rows.iter().filter(|r| r.case.contains("^3")) {
         let _ = writeln!(
             s,
-                        "- {} ({}): build {:.2} s + first render {:.2} s = {:.2} s wall, peak {} MiB",
+            "- {} ({}): build {:.2} s + first render {:.2} s = {:.2} s wall, peak {} MiB",
             r.case,
             r.setting,
             r.build_s,
@@ -456,7 +456,7 @@ pub fn csv(rows: &[Row]) -> String {
             r.primary_rays,
             r.primary_s,
             r.mrays_per_s(),
-                        c(Some(r.render_s)),
+            c(Some(r.render_s)),
             c(Some(r.first_render_s)),
             c(r.peak_mib),
             c(r.vs_same.as_ref().map(|x| x.differing_share())),

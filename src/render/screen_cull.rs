@@ -115,9 +115,10 @@ impl ScreenCull {
         Some(ScreenCull { cones })
     }
 
-    /// Whether any group may be seen from the 4 × 4 block holding full-image pixel (x, y).
+    /// Whether any group may be seen from the 4 × 4 block of pixels whose top-left pixel is
+    /// (x, y) in full-image coordinates.
     pub fn block_visible(&self, cam: &CameraRays, x: u32, y: u32) -> bool {
-        let (x0, y0) = ((x & !3) as f64, (y & !3) as f64);
+        let (x0, y0) = (x as f64, y as f64);
         let Some(centre) = cam.pinhole_dir(x0 + 2.0, y0 + 2.0) else {
             return true;
         };

@@ -47,31 +47,33 @@ pub fn primary_rays(
     }
 }
 
-/// Which of `coords` (frame pixels) may see a group: indices into `coords`. The others are
-/// background (their 4 × 4 block misses every group's rectangle on the image).
+/// Which of the tile's `coords` (frame pixels) may see a group: indices into `coords`. The
+/// others are background: their 4 × 4 block (aligned in the frame, as the tile's packets are)
+/// misses every group's cone of directions.
 fn live_pixels(
     cam: &CameraRays,
     coords: &[(u32, u32)],
     offset: (u32, u32),
     cull: Option<&ScreenCull>,
+    (x0, y0): (u32, u32),
 ) -> Vec<usize> {
+    const SIDE: u32 = TILE / 4;
+    let every = || (0..coords.len()).collect();
     let Some(cull) = cull else {
-        return (0..coords.len()).collect();
+        return every();
     };
-    // Pixels come in 4 × 4 blocks: one test per block.
-    let mut last: Option<((u32, u32), bool)> = None;
+    let mut visible = [true; (SIDE * SIDE) as usize];
+    for (b, v) in visible.iter_mut().enumerate() {
+        let (bx, by) = (b as u32 % SIDE, b as u32 / SIDE);
+        *v = cull.block_visible(cam, x0 + 4 * bx + offset.0, y0 + 4 * by + offset.1);
+    }
+    if visible.iter().all(|&v| v) {
+        return every();
+    }
     (0..coords.len())
         .filter(|&k| {
-            let (x, y) = (coords[k].0 + offset.0, coords[k].1 + offset.1);
-            let block = (x & !3, y & !3);
-            match last {
-                Some((b, v)) if b == block => v,
-                _ => {
-                    let v = cull.block_visible(cam, x, y);
-                    last = Some((block, v));
-                    v
-                }
-            }
+            let (x, y) = coords[k];
+            visible[((y - y0) / 4 * SIDE + (x - x0) / 4) as usize]
         })
         .collect()
 }
@@ -90,7 +92,7 @@ impl TilePixels {
         let (w, h) = scene.image.frame_size();
         let all = tile_pixels(x0, y0, w, h);
         let offset = scene.image.frame_offset();
-        let live = live_pixels(cam, &all, offset, cull);
+        let live = live_pixels(cam, &all, offset, cull, (x0, y0));
         let live_coords = live.iter().map(|&k| all[k]).collect();
         TilePixels {
             all,
