@@ -9,5 +9,5 @@ mod primitive;
 
 pub use aabb::Aabb;
 pub use box_tree::{walk, BoxTree, TreeNode};
-pub(crate) use primitive::{capsule_hit, sphere_hit};
+pub(crate) use primitive::capsule_hit;
 pub use primitive::{Geometry, Part, Primitive};

@@ -95,14 +95,7 @@ fn round_roots(oc: DVec3, d: DVec3, r: f64) -> Option<(f64, f64)> {
     Some((t0.min(t1), t0.max(t1)))
 }
 
-pub(crate) fn sphere_hit(
-    c: DVec3,
-    r: f64,
-    o: DVec3,
-    d: DVec3,
-    tmin: f64,
-    tmax: f64,
-) -> Option<f64> {
+fn sphere_hit(c: DVec3, r: f64, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64> {
     let (t0, t1) = round_roots(o - c, d, r)?;
     [t0, t1].into_iter().find(|&t| t > tmin && t < tmax)
 }
