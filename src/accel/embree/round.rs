@@ -79,8 +79,10 @@ impl<'a> ExactContext<'a> {
         }
     }
 
+        /// The pointer Embree is given, and hands back to the callbacks: taken from the whole
+    /// struct (repr(C), Embree's part first), so it may be read as the whole struct there.
     pub fn raw(&mut self) -> *mut RTCIntersectContext {
-        &mut self.rtc
+        (self as *mut Self).cast()
     }
 
     /// The exact t of the user-geometry hit in `lane` (valid when Embree reports one there).
