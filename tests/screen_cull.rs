@@ -133,7 +133,7 @@ fn every_pixel_that_sees_a_group_is_kept() {
             "bar array",
             "1e-4",
             "camera moving",
-                        "translated",
+            "translated",
             "cropped",
         ];
         let Some(cull) = ScreenCull::new(&world, &cam) else {

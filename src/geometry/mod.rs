@@ -9,5 +9,6 @@ mod primitive;
 
 pub use aabb::Aabb;
 pub use box_tree::{walk, BoxTree, TreeNode};
+#[cfg(feature = "embree")]
 pub(crate) use primitive::capsule_hit;
 pub use primitive::{Geometry, Part, Primitive};

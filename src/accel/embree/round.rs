@@ -79,7 +79,7 @@ impl<'a> ExactContext<'a> {
         }
     }
 
-        /// The pointer Embree is given, and hands back to the callbacks: taken from the whole
+    /// The pointer Embree is given, and hands back to the callbacks: taken from the whole
     /// struct (repr(C), Embree's part first), so it may be read as the whole struct there.
     pub fn raw(&mut self) -> *mut RTCIntersectContext {
         (self as *mut Self).cast()
