@@ -2,7 +2,7 @@ use super::Aabb;
 use glam::DVec3;
 
 /// One rest-frame primitive. Boxes are axis-aligned; rods are capsules (a cylinder with round
-/// caps, the shape of Embree's round linear curves).
+/// caps).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Primitive {
     Sphere { center: DVec3, radius: f64 },

@@ -2,11 +2,12 @@
 //! Embree as 16-wide packets (8-wide where the CPU has no native 16-wide support), 64-byte
 //! aligned, with the coherent flag and a valid mask; single rays and occlusion queries as well.
 //!
-//! Precision (DESIGN.md): the renderer hands over f64 rays already rebased to the near side of
-//! the group's bounds; here they are made relative to the scene's centre, given a unit direction
-//! (Embree's curves and points prefer one), and only then cast to f32. Embree's t is converted
-//! back, and the hit is refined in f64 on the primitive Embree found, so the lookback times that
-//! decide the merge between groups are as exact as the f64 BVH's.
+//! Precision (DESIGN.md): the renderer hands over f64 rays (rebased to the near side of the
+//! group's bounds when they come from afar); here they are made relative to the scene's centre,
+//! given a unit direction, and only then cast to f32. Spheres and rods are user geometry tested
+//! in f64 on the caller's f64 ray (round.rs); a triangle hit's t is converted back and refined in
+//! f64 on the triangle Embree found. Either way the lookback times that decide the merge between
+//! groups are as exact as the f64 BVH's.
 
 mod bare;
 mod device;
