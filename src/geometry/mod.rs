@@ -10,5 +10,5 @@ mod primitive;
 pub use aabb::Aabb;
 pub use box_tree::{walk, BoxTree, TreeNode};
 #[cfg(feature = "embree")]
-pub(crate) use primitive::capsule_hit;
+pub(crate) use primitive::{capsule_hit, cuboid_hit};
 pub use primitive::{Geometry, Part, Primitive};

@@ -144,19 +144,7 @@ impl Primitive {
         match *self {
             Primitive::Sphere { center, radius } => sphere_hit(center, radius, o, d, tmin, tmax),
             Primitive::Capsule { a, b, radius } => capsule_hit(a, b, radius, o, d, tmin, tmax),
-            Primitive::Cuboid { min, max } => {
-                let inv = d.recip();
-                let a = (min - o) * inv;
-                let bb = (max - o) * inv;
-                let lo = a.min(bb);
-                let hi = a.max(bb);
-                let t0 = lo.x.max(lo.y).max(lo.z);
-                let t1 = hi.x.min(hi.y).min(hi.z);
-                if t0 > t1 {
-                    return None;
-                }
-                [t0, t1].into_iter().find(|&t| t > tmin && t < tmax)
-            }
+            Primitive::Cuboid { min, max } => cuboid_hit(min, max, o, d, tmin, tmax),
             Primitive::Triangle { v } => triangle_hit(v, o, d, tmin, tmax),
         }
     }
@@ -262,6 +250,28 @@ pub(crate) fn capsule_hit(
         (t_in, t_out)
     };
     [t_in, t_out].into_iter().find(|&t| t > tmin && t < tmax)
+}
+
+/// The first crossing of an axis-aligned box's surface (entry, or exit from inside).
+pub(crate) fn cuboid_hit(
+    min: DVec3,
+    max: DVec3,
+    o: DVec3,
+    d: DVec3,
+    tmin: f64,
+    tmax: f64,
+) -> Option<f64> {
+    let inv = d.recip();
+    let a = (min - o) * inv;
+    let bb = (max - o) * inv;
+    let lo = a.min(bb);
+    let hi = a.max(bb);
+    let t0 = lo.x.max(lo.y).max(lo.z);
+    let t1 = hi.x.min(hi.y).min(hi.z);
+    if t0 > t1 {
+        return None;
+    }
+    [t0, t1].into_iter().find(|&t| t > tmin && t < tmax)
 }
 
 fn triangle_hit(v: [DVec3; 3], o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64> {

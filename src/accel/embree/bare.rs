@@ -2,8 +2,8 @@
 //! with nothing else (no boosts, no rebasing, no f64 refinement, no hit bookkeeping), so the
 //! cost of the relativistic layer is a ratio measured in the same run.
 
+use super::exact::Lanes;
 use super::packet::{fill_lane, flush_denormals};
-use super::round::Lanes;
 use super::{EmbreeAccel, EmbreeRay};
 use embree_sys::*;
 use glam::DVec3;

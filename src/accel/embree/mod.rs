@@ -11,8 +11,8 @@
 
 mod bare;
 mod device;
+mod exact;
 mod packet;
-mod round;
 mod scene;
 
 pub use bare::BareRay;

@@ -1,6 +1,6 @@
 //! Ray packets and single rays through Embree's C API.
 
-use super::round::{ExactContext, Lanes};
+use super::exact::{ExactContext, Lanes};
 use super::{EmbreeAccel, EmbreeRay};
 use crate::accel::{Hit, Ray};
 use embree_sys::*;

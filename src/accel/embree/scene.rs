@@ -1,9 +1,9 @@
 //! One Embree scene per rest-frame geometry, in f32 about the geometry's centre (so f32 never
-//! sees large coordinates): Embree's triangles for boxes and meshes, while
-//! spheres and rods are user geometry running the exact f64 tests (round.rs).
+//! sees large coordinates): Embree's triangles for meshes, while spheres, rods and boxes are
+//! user geometry running the exact f64 tests (exact.rs).
 
 use super::device::Device;
-use super::round::{self, Round, Rounds};
+use super::exact::{self, Cuboid, Round, Shape, Shapes};
 use crate::geometry::{Geometry as SceneGeometry, Primitive};
 use embree_sys::*;
 use glam::DVec3;
@@ -33,7 +33,8 @@ pub struct Scene {
     /// Embree coordinates are rest-frame coordinates minus this.
     pub center: DVec3,
     /// What Embree's user geometry points into; dropped after the scene is released.
-    rounds: Option<Box<Rounds>>,
+    rounds: Option<Box<Shapes<Round>>>,
+    cuboids: Option<Box<Shapes<Cuboid>>>,
     _device: Arc<Device>,
 }
 
@@ -45,21 +46,6 @@ impl Drop for Scene {
         unsafe { rtcReleaseScene(self.raw) };
     }
 }
-
-const BOX_TRIANGLES: [[u32; 3]; 12] = [
-    [0, 2, 1],
-    [1, 2, 3], // x = min
-    [4, 5, 6],
-    [5, 7, 6], // x = max
-    [0, 1, 4],
-    [1, 5, 4], // y = min
-    [2, 6, 3],
-    [3, 6, 7], // y = max
-    [0, 4, 2],
-    [2, 4, 6], // z = min
-    [1, 3, 5],
-    [3, 7, 5], // z = max
-];
 
 fn f3(p: DVec3) -> [f32; 3] {
     [p.x as f32, p.y as f32, p.z as f32]
@@ -83,6 +69,7 @@ impl Scene {
             maps: Vec::new(),
             center,
             rounds: None,
+            cuboids: None,
             _device: device.clone(),
         };
         unsafe {
@@ -90,7 +77,7 @@ impl Scene {
             rtcSetSceneFlags(raw, RTC_SCENE_FLAG_ROBUST);
         }
         let (mut tris, mut tri_map): (Vec<[[f32; 3]; 3]>, Vec<u32>) = (Vec::new(), Vec::new());
-        let (mut boxes, mut box_map): (Vec<(DVec3, DVec3)>, Vec<u32>) = (Vec::new(), Vec::new());
+        let (mut cuboids, mut cuboid_map): (Vec<Cuboid>, Vec<u32>) = (Vec::new(), Vec::new());
         let (mut rounds, mut round_map): (Vec<Round>, Vec<u32>) = (Vec::new(), Vec::new());
         for (i, p) in geo.prims.iter().enumerate() {
             let i = i as u32;
@@ -112,45 +99,17 @@ impl Scene {
                     round_map.push(i);
                 }
                 Primitive::Cuboid { min, max } => {
-                    boxes.push((min - center, max - center));
-                    box_map.push(i);
+                    cuboids.push(Cuboid {
+                        min: min - center,
+                        max: max - center,
+                    });
+                    cuboid_map.push(i);
                 }
                 Primitive::Triangle { v } => {
                     tris.push(v.map(|x| f3(x - center)));
                     tri_map.push(i);
                 }
             }
-        }
-        if !boxes.is_empty() {
-            let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_TRIANGLE)?;
-            let verts = scene.buffer::<[f32; 3]>(
-                &g,
-                RTC_BUFFER_TYPE_VERTEX,
-                RTC_FORMAT_FLOAT3,
-                boxes.len() * 8,
-            )?;
-            for (k, (lo, hi)) in boxes.iter().enumerate() {
-                for c in 0..8 {
-                    let p = DVec3::new(
-                        if c & 4 != 0 { hi.x } else { lo.x },
-                        if c & 2 != 0 { hi.y } else { lo.y },
-                        if c & 1 != 0 { hi.z } else { lo.z },
-                    );
-                    verts[k * 8 + c] = f3(p);
-                }
-            }
-            let idx = scene.buffer::<[u32; 3]>(
-                &g,
-                RTC_BUFFER_TYPE_INDEX,
-                RTC_FORMAT_UINT3,
-                boxes.len() * 12,
-            )?;
-            for k in 0..boxes.len() {
-                for (t, tri) in BOX_TRIANGLES.iter().enumerate() {
-                    idx[k * 12 + t] = tri.map(|c| (k * 8) as u32 + c);
-                }
-            }
-            scene.attach(&device, g, box_map, 12, false)?;
         }
         if !tris.is_empty() {
             let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_TRIANGLE)?;
@@ -174,23 +133,38 @@ impl Scene {
             }
             scene.attach(&device, g, tri_map, 1, false)?;
         }
-        if !rounds.is_empty() {
-            let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_USER)?;
-            let data = Box::new(Rounds(rounds));
-            let ptr = &*data as *const Rounds as *mut std::ffi::c_void;
-            unsafe {
-                rtcSetGeometryUserPrimitiveCount(g.0, data.0.len() as u32);
-                rtcSetGeometryUserData(g.0, ptr);
-                rtcSetGeometryBoundsFunction(g.0, Some(round::bounds), ptr);
-                rtcSetGeometryIntersectFunction(g.0, Some(round::intersect));
-                rtcSetGeometryOccludedFunction(g.0, Some(round::occluded));
-            }
-            scene.rounds = Some(data);
-            scene.attach(&device, g, round_map, 1, true)?;
-        }
+        scene.rounds = scene.user_geometry(&device, rounds, round_map)?;
+        scene.cuboids = scene.user_geometry(&device, cuboids, cuboid_map)?;
         unsafe { rtcCommitScene(raw) };
         device.check("committing a scene")?;
         Ok(scene)
+    }
+
+    /// Attach `shapes` (scene primitives `map`) as one user geometry whose hits are exact; the
+    /// returned box is what Embree points into.
+    fn user_geometry<S: Shape>(
+        &mut self,
+        device: &Device,
+        shapes: Vec<S>,
+        map: Vec<u32>,
+    ) -> Result<Option<Box<Shapes<S>>>, String> {
+        if shapes.is_empty() {
+            return Ok(None);
+        }
+        let g = self.new_geometry(device, RTC_GEOMETRY_TYPE_USER)?;
+        let data = Box::new(Shapes(shapes));
+        let ptr = &*data as *const Shapes<S> as *mut std::ffi::c_void;
+        // SAFETY: `data` outlives the Embree scene (the scene drops it after releasing the
+        // scene), and the callbacks read it as `Shapes<S>`.
+        unsafe {
+            rtcSetGeometryUserPrimitiveCount(g.0, data.0.len() as u32);
+            rtcSetGeometryUserData(g.0, ptr);
+            rtcSetGeometryBoundsFunction(g.0, Some(exact::bounds::<S>), ptr);
+            rtcSetGeometryIntersectFunction(g.0, Some(exact::intersect::<S>));
+            rtcSetGeometryOccludedFunction(g.0, Some(exact::occluded::<S>));
+        }
+        self.attach(device, g, map, 1, true)?;
+        Ok(Some(data))
     }
 
     fn new_geometry(

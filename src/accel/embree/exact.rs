@@ -1,17 +1,26 @@
-//! Spheres and rods (capsules) as Embree user geometry: Embree's BVH over their boxes finds the
-//! candidates, and the exact f64 tests of the f64 BVH decide the hit, on the caller's f64 ray
-//! (passed in the intersect context) rather than Embree's f32 copy, so these hits need no
-//! refinement. Embree's own round curves and sphere points are built for hair and particles
+//! Spheres, rods (capsules) and boxes as Embree user geometry: Embree's BVH over their bounds
+//! finds the candidates, and the exact f64 tests of the f64 BVH decide the hit, on the caller's
+//! f64 ray (passed in the intersect context) rather than Embree's f32 copy, so these hits need
+//! no refinement. Embree's own round curves and sphere points are built for hair and particles
 //! (oriented boxes, swept spheres) and were its slow path on the paper's lattice: bare Embree
-//! traced it 1.6-2.0x as fast as the f64 BVH with them, 4-5x with this.
+//! traced it 1.6-2.0x as fast as the f64 BVH with them, 4-5x with this. Boxes as twelve f32
+//! triangles each, refined in f64 after, were slower than one exact slab test.
 
 use crate::accel::Ray;
-use crate::geometry::capsule_hit as round_hit;
+use crate::geometry::{capsule_hit, cuboid_hit};
 use embree_sys::*;
 use glam::DVec3;
 use std::cell::Cell;
 
-/// A capsule (or with a = b, a sphere) relative to the Embree scene's centre.
+/// A primitive Embree traces as user geometry, relative to the Embree scene's centre.
+pub trait Shape: Copy {
+    /// Its first hit by `o + t d` with `tmin < t < tmax`.
+    fn hit(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64>;
+    /// Its bounds (min, max).
+    fn bounds(&self) -> (DVec3, DVec3);
+}
+
+/// A capsule (or with a = b, a sphere).
 #[derive(Clone, Copy, Debug)]
 pub struct Round {
     pub a: DVec3,
@@ -19,9 +28,37 @@ pub struct Round {
     pub radius: f64,
 }
 
-/// The round primitives of one Embree geometry; Embree holds a pointer to it, so it lives in a
+impl Shape for Round {
+    #[inline]
+    fn hit(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64> {
+        capsule_hit(self.a, self.b, self.radius, o, d, tmin, tmax)
+    }
+    fn bounds(&self) -> (DVec3, DVec3) {
+        let r = DVec3::splat(self.radius);
+        (self.a.min(self.b) - r, self.a.max(self.b) + r)
+    }
+}
+
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug)]
+pub struct Cuboid {
+    pub min: DVec3,
+    pub max: DVec3,
+}
+
+impl Shape for Cuboid {
+    #[inline]
+    fn hit(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64> {
+        cuboid_hit(self.min, self.max, o, d, tmin, tmax)
+    }
+    fn bounds(&self) -> (DVec3, DVec3) {
+        (self.min, self.max)
+    }
+}
+
+/// The primitives of one Embree user geometry; Embree holds a pointer to it, so it lives in a
 /// Box that the scene owns and drops after releasing the Embree scene.
-pub struct Rounds(pub Vec<Round>);
+pub struct Shapes<S>(pub Vec<S>);
 
 /// The intersect context handed to Embree: Embree's own first (Embree passes a pointer to it to
 /// the callbacks), then the caller's f64 rays by lane and the exact hit found so far in each.
@@ -104,10 +141,10 @@ const GEOM_ID: usize = 18;
 const INST_ID: usize = 19;
 
 /// # Safety
-/// `user` is the pointer registered for a live `Rounds`, `prim` below its length.
-unsafe fn round<'r>(user: *mut std::ffi::c_void, prim: u32) -> &'r Round {
+/// `user` is the pointer registered for a live `Shapes<S>`, `prim` below its length.
+unsafe fn shape<'r, S: Shape>(user: *mut std::ffi::c_void, prim: u32) -> &'r S {
     unsafe {
-        let all: &'r Rounds = &*(user as *const Rounds);
+        let all: &'r Shapes<S> = &*(user as *const Shapes<S>);
         &all.0[prim as usize]
     }
 }
@@ -126,14 +163,12 @@ unsafe fn read(base: *const f32, n: usize, i: usize) -> (DVec3, DVec3, f64, f64)
     )
 }
 
-pub(super) unsafe extern "C" fn bounds(args: *const RTCBoundsFunctionArguments) {
-    // SAFETY: Embree passes the user pointer we registered (a live `Rounds`) and a prim index
-    // below the primitive count we set.
+pub(super) unsafe extern "C" fn bounds<S: Shape>(args: *const RTCBoundsFunctionArguments) {
+    // SAFETY: Embree passes the user pointer we registered (a live `Shapes<S>`) and a prim
+    // index below the primitive count we set.
     unsafe {
         let args = &*args;
-        let round = round(args.geometryUserPtr, args.primID);
-        let r = DVec3::splat(round.radius);
-        let (lo, hi) = (round.a.min(round.b) - r, round.a.max(round.b) + r);
+        let (lo, hi) = shape::<S>(args.geometryUserPtr, args.primID).bounds();
         // Rounded outward so the f32 box contains the f64 primitive.
         let down = |x: f64| (x as f32).next_down();
         let up = |x: f64| (x as f32).next_up();
@@ -155,9 +190,9 @@ pub(super) unsafe extern "C" fn bounds(args: *const RTCBoundsFunctionArguments) 
 ///
 /// # Safety
 /// `ctx` is an `ExactContext` (every query of this backend passes one); `base` as for `read`.
-unsafe fn lane_hit(
+unsafe fn lane_hit<S: Shape>(
     ctx: &ExactContext,
-    round: &Round,
+    prim: &S,
     base: *const f32,
     n: usize,
     i: usize,
@@ -165,15 +200,7 @@ unsafe fn lane_hit(
     let (o, d, tnear, tfar) = unsafe { read(base, n, i) };
     match ctx.rays.get(i) {
         Some(r) => {
-            let t = round_hit(
-                round.a,
-                round.b,
-                round.radius,
-                r.origin - ctx.center,
-                r.dir,
-                r.tmin,
-                ctx.best[i].get(),
-            )?;
+            let t = prim.hit(r.origin - ctx.center, r.dir, r.tmin, ctx.best[i].get())?;
             let te = (t * ctx.len[i] + ctx.pullback) as f32;
             // Embree's tfar may have been lowered by one of its own primitives.
             (te <= tfar as f32).then(|| {
@@ -181,17 +208,18 @@ unsafe fn lane_hit(
                 te
             })
         }
-        None => round_hit(round.a, round.b, round.radius, o, d, tnear, tfar)
+        None => prim
+            .hit(o, d, tnear, tfar)
             .map(|t| (t as f32).clamp(tnear as f32, tfar as f32)),
     }
 }
 
-pub(super) unsafe extern "C" fn intersect(args: *const RTCIntersectFunctionNArguments) {
+pub(super) unsafe extern "C" fn intersect<S: Shape>(args: *const RTCIntersectFunctionNArguments) {
     // SAFETY: as for `bounds`; `rayhit` is an N-wide RTCRayHitN, `valid` has N entries and
     // `context` is the ExactContext the query was started with.
     unsafe {
         let args = &*args;
-        let round = round(args.geometryUserPtr, args.primID);
+        let prim = shape::<S>(args.geometryUserPtr, args.primID);
         let ctx = &*(args.context as *const ExactContext);
         let n = args.N as usize;
         let base = args.rayhit as *mut f32;
@@ -199,7 +227,7 @@ pub(super) unsafe extern "C" fn intersect(args: *const RTCIntersectFunctionNArgu
             if *args.valid.add(i) == 0 {
                 continue;
             }
-            if let Some(t) = lane_hit(ctx, round, base, n, i) {
+            if let Some(t) = lane_hit(ctx, prim, base, n, i) {
                 let slot = |k: usize| base.add(k * n + i);
                 *slot(TFAR) = t;
                 *slot(NG) = 0.0;
@@ -215,16 +243,16 @@ pub(super) unsafe extern "C" fn intersect(args: *const RTCIntersectFunctionNArgu
     }
 }
 
-pub(super) unsafe extern "C" fn occluded(args: *const RTCOccludedFunctionNArguments) {
+pub(super) unsafe extern "C" fn occluded<S: Shape>(args: *const RTCOccludedFunctionNArguments) {
     // SAFETY: as for `intersect`, with an N-wide RTCRayN.
     unsafe {
         let args = &*args;
-        let round = round(args.geometryUserPtr, args.primID);
+        let prim = shape::<S>(args.geometryUserPtr, args.primID);
         let ctx = &*(args.context as *const ExactContext);
         let n = args.N as usize;
         let base = args.ray as *mut f32;
         for i in 0..n {
-            if *args.valid.add(i) != 0 && lane_hit(ctx, round, base, n, i).is_some() {
+            if *args.valid.add(i) != 0 && lane_hit(ctx, prim, base, n, i).is_some() {
                 *base.add(TFAR * n + i) = f32::NEG_INFINITY;
             }
         }
