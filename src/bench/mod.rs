@@ -395,26 +395,28 @@ pub fn summary(rows: &[Row]) -> String {
             );
         }
     }
-    let one = rows
-        .iter()
-        .find(|r| r.case.ends_with("in 1 group") && r.setting == "embree");
-    for r in rows
-        .iter()
-        .filter(|r| r.case.contains(" groups") && r.setting == "embree" && !r.case.contains("bars"))
-    {
-        if let Some(o) = one {
-            let _ = writeln!(
-                s,
-                                "- {}: render time {:.3} s = {:.2}x that of the same boxes in one group ({:.3} s); \
-                 build + first render {:.3} s = {:.2}x ({:.3} s)",
-                r.case,
-                r.render_s,
-                r.render_s / o.render_s,
-                o.render_s,
-                r.build_s + r.first_render_s,
-                (r.build_s + r.first_render_s) / (o.build_s + o.first_render_s),
-                o.build_s + o.first_render_s
-            );
+    // Many groups against one group holding the same boxes, on each backend.
+    for backend in ["embree", "bvh"] {
+        let one = rows
+            .iter()
+            .find(|r| r.case.ends_with("in 1 group") && r.setting == backend);
+        for r in rows.iter().filter(|r| {
+            r.case.contains(" groups") && r.setting == backend && !r.case.contains("bars")
+        }) {
+            if let Some(o) = one {
+                let _ = writeln!(
+                    s,
+                    "- {} ({backend}): render time {:.3} s = {:.2}x that of the same boxes in one \
+                     group ({:.3} s); build + first render {:.3} s = {:.2}x ({:.3} s)",
+                    r.case,
+                    r.render_s,
+                    r.render_s / o.render_s,
+                    o.render_s,
+                    r.build_s + r.first_render_s,
+                    (r.build_s + r.first_render_s) / (o.build_s + o.first_render_s),
+                    o.build_s + o.first_render_s
+                );
+            }
         }
     }
     for r in rows.iter().filter(|r| r.case.contains("^3")) {
