@@ -66,6 +66,7 @@ impl ScreenCull {
         let block_radius = 8f64.sqrt() / cam.focal_px();
         let mut cones = Vec::with_capacity(world.groups.len());
         for g in &world.groups {
+            let out = g.boost.inverse();
             let b = &g.bounds;
             let e = g.event_rest;
             if e.cmpge(b.min).all() && e.cmple(b.max).all() {
@@ -95,7 +96,7 @@ impl ScreenCull {
             // Three boundary directions, seen in the world frame, then by the camera.
             let seen = |side: DVec3| {
                 let rest = theta.cos() * axis + theta.sin() * side;
-                cam.to_camera_dir(g.unboost.view_dir(rest).0)
+                cam.to_camera_dir(out.view_dir(rest).0)
             };
             let c = cone_through([
                 seen(u),
@@ -104,7 +105,7 @@ impl ScreenCull {
             ])?;
             // The image of the axis lies inside the image cone unless the map turned the cone
             // inside out (it then covers more than a hemisphere: no use).
-            let centre = cam.to_camera_dir(g.unboost.view_dir(axis).0);
+            let centre = cam.to_camera_dir(out.view_dir(axis).0);
             if centre.dot(c.axis) < c.half_angle.cos() || c.half_angle > 1.4 {
                 return None;
             }

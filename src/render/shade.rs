@@ -68,8 +68,9 @@ impl<'a> Shader<'a> {
     /// surface by ε along `side` (rest frame), both boosted back to the world frame.
     fn spawn(&self, group: usize, hit_event: Event, side: DVec3, dir: DVec3) -> NullRay {
         let g = &self.world.groups[group];
-        let offset = g.unboost.event(Event::new(0.0, g.epsilon * side));
-        let (dir_w, _) = g.unboost.view_dir(dir);
+        let out = g.boost.inverse();
+        let offset = out.event(Event::new(0.0, g.epsilon * side));
+        let (dir_w, _) = out.view_dir(dir);
         NullRay::new(hit_event + offset, dir_w)
     }
 

@@ -61,8 +61,8 @@ pub struct GroupRt {
     pub event_rest: DVec3,
 
     pub velocity: Velocity,
+    /// Into the group's rest frame (its inverse leads out).
     pub boost: Boost,
-    pub unboost: Boost,
     pub bounds: Aabb,
     pub geometry: Arc<Geometry>,
     /// None for groups intersected directly.
@@ -72,33 +72,51 @@ pub struct GroupRt {
 }
 
 impl GroupRt {
-    /// One ray's closest hit in this group.
-    fn intersect1(&self, r: &Ray) -> Option<Hit> {
+    /// The closest hit of each ray in this group (None for inactive rays): through the
+    /// accelerator, or the primitives one by one for a group without one.
+    fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         if let Some(accel) = &self.accel {
-            let mut h = [None];
-            accel.intersect(std::slice::from_ref(r), &mut h);
-            return h[0];
+            return accel.intersect(rays, hits);
         }
-        let mut best: Option<Hit> = None;
-        for (i, p) in self.geometry.prims.iter().enumerate() {
-            if let Some(t) = p.intersect(r.origin, r.dir, r.tmin, best.map_or(r.tmax, |b| b.t)) {
-                best = Some(Hit { t, prim: i as u32 });
+        for (r, h) in rays.iter().zip(hits.iter_mut()) {
+            *h = None;
+            if !r.is_active() {
+                continue;
+            }
+            for (i, p) in self.geometry.prims.iter().enumerate() {
+                let tmax = h.map_or(r.tmax, |b| b.t);
+                if let Some(t) = p.intersect(r.origin, r.dir, r.tmin, tmax) {
+                    *h = Some(Hit { t, prim: i as u32 });
+                }
             }
         }
-        best
     }
 
-    /// Whether anything of this group lies on the ray.
-    fn occluded1(&self, r: &Ray) -> bool {
+    /// Whether anything of this group lies on each ray (false for inactive rays).
+    fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
         if let Some(accel) = &self.accel {
-            let mut o = [false];
-            accel.occluded(std::slice::from_ref(r), &mut o);
-            return o[0];
+            return accel.occluded(rays, out);
         }
-        self.geometry
-            .prims
-            .iter()
-            .any(|p| p.intersect(r.origin, r.dir, r.tmin, r.tmax).is_some())
+        for (r, o) in rays.iter().zip(out.iter_mut()) {
+            *o = r.is_active()
+                && self
+                    .geometry
+                    .prims
+                    .iter()
+                    .any(|p| p.intersect(r.origin, r.dir, r.tmin, r.tmax).is_some());
+        }
+    }
+
+    fn intersect1(&self, r: &Ray) -> Option<Hit> {
+        let mut h = [None];
+        self.intersect(std::slice::from_ref(r), &mut h);
+        h[0]
+    }
+
+    fn occluded1(&self, r: &Ray) -> bool {
+        let mut o = [false];
+        self.occluded(std::slice::from_ref(r), &mut o);
+        o[0]
     }
 }
 
@@ -218,7 +236,7 @@ impl World {
                 event_rest: boost.event(event).x,
                 velocity,
                 boost,
-                unboost: Boost::from_rest(&velocity),
+
                 bounds,
                 geometry,
                 accel,
@@ -351,14 +369,7 @@ impl World {
                 if !any {
                     continue;
                 }
-                match &g.accel {
-                    Some(accel) => accel.intersect(&batch[..n], &mut hits[..n]),
-                    None => {
-                        for (b, h) in batch[..n].iter().zip(hits.iter_mut()) {
-                            *h = if b.is_active() { g.intersect1(b) } else { None };
-                        }
-                    }
-                }
+                g.intersect(&batch[..n], &mut hits[..n]);
                 for i in 0..n {
                     if let (Some(h), Some(rr)) = (hits[i], &meta[i]) {
                         let hit = Self::surface_hit(gi, rr, h);
@@ -476,14 +487,7 @@ impl World {
                 if !any {
                     continue;
                 }
-                match &g.accel {
-                    Some(accel) => accel.occluded(&batch[..n], &mut hit[..n]),
-                    None => {
-                        for (b, h) in batch[..n].iter().zip(hit.iter_mut()) {
-                            *h = b.is_active() && g.occluded1(b);
-                        }
-                    }
-                }
+                g.occluded(&batch[..n], &mut hit[..n]);
                 for i in 0..n {
                     out[i] |= batch[i].is_active() && hit[i];
                 }
