@@ -3,7 +3,7 @@
 //! cost of the relativistic layer is a ratio measured in the same run.
 
 use super::exact::Lanes;
-use super::packet::{fill_lane, flush_denormals};
+use super::packet::{flush_denormals, single};
 use super::{EmbreeAccel, EmbreeRay};
 use embree_sys::*;
 use glam::DVec3;
@@ -14,9 +14,6 @@ pub struct BareRay {
     pub org: [f32; 3],
     pub dir: [f32; 3],
 }
-
-#[repr(C, align(64))]
-struct Valid([i32; 16]);
 
 impl EmbreeAccel {
     /// A bare ray from a rest-frame origin and (unit) direction.
@@ -38,54 +35,24 @@ impl EmbreeAccel {
         let mut hits = 0;
         let w = self.width.clamp(1, 16);
         for chunk in rays.chunks(w) {
-            if w == 16 {
-                let mut rh = RTCRayHit16::default();
-                let mut valid = Valid([0; 16]);
-                for (i, r) in chunk.iter().enumerate() {
-                    fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
-                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-                }
-                unsafe { rtcIntersect16(valid.0.as_ptr(), self.scene.raw, ctx, &mut rh) };
-                hits += (0..chunk.len())
-                    .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
-                    .count();
-            } else if w == 8 {
-                let mut rh = RTCRayHit8::default();
-                let mut valid = Valid([0; 16]);
-                for (i, r) in chunk.iter().enumerate() {
-                    fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
-                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-                }
-                unsafe { rtcIntersect8(valid.0.as_ptr(), self.scene.raw, ctx, &mut rh) };
-                hits += (0..chunk.len())
-                    .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
-                    .count();
-            } else {
-                for r in chunk {
-                    let mut rh = RTCRayHit {
-                        ray: RTCRay {
-                            org_x: r.org[0],
-                            org_y: r.org[1],
-                            org_z: r.org[2],
-                            tnear: 0.0,
-                            dir_x: r.dir[0],
-                            dir_y: r.dir[1],
-                            dir_z: r.dir[2],
-                            time: 0.0,
-                            tfar: f32::INFINITY,
-                            mask: u32::MAX,
-                            id: 0,
-                            flags: 0,
-                        },
-                        hit: RTCHit {
-                            geomID: RTC_INVALID_GEOMETRY_ID,
-                            ..Default::default()
-                        },
-                    };
-                    unsafe { rtcIntersect1(self.scene.raw, ctx, &mut rh) };
-                    hits += usize::from(rh.hit.geomID != RTC_INVALID_GEOMETRY_ID);
-                }
-            }
+            hits += match w {
+                16 => self.bare16(chunk, ctx),
+                8 => self.bare8(chunk, ctx),
+                _ => chunk
+                    .iter()
+                    .map(|r| {
+                        let mut rh = RTCRayHit {
+                            ray: single(&r.lane()),
+                            hit: RTCHit {
+                                geomID: RTC_INVALID_GEOMETRY_ID,
+                                ..Default::default()
+                            },
+                        };
+                        unsafe { rtcIntersect1(self.scene.raw, ctx, &mut rh) };
+                        usize::from(rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+                    })
+                    .sum(),
+            };
         }
         hits
     }
@@ -93,7 +60,7 @@ impl EmbreeAccel {
 
 impl BareRay {
     /// As the packet code's ray: from the origin, nothing excluded.
-    fn lane(&self) -> EmbreeRay {
+    pub(super) fn lane(&self) -> EmbreeRay {
         EmbreeRay {
             org: self.org,
             dir: self.dir,

@@ -1,7 +1,7 @@
 //! Ray packets and single rays through Embree's C API.
 
 use super::exact::{ExactContext, Lanes};
-use super::{EmbreeAccel, EmbreeRay};
+use super::{BareRay, EmbreeAccel, EmbreeRay};
 use crate::accel::{Hit, Ray};
 use embree_sys::*;
 use std::cell::Cell;
@@ -29,8 +29,23 @@ pub(super) fn flush_denormals() {
 }
 
 macro_rules! packet_fns {
-    ($n:literal, $isect:ident, $occl:ident, $RayHitN:ident, $RayN:ident, $rtc_isect:ident, $rtc_occl:ident) => {
+    ($n:literal, $isect:ident, $occl:ident, $bare:ident, $RayHitN:ident, $RayN:ident, $rtc_isect:ident, $rtc_occl:ident) => {
         impl EmbreeAccel {
+            /// Bare Embree (the benchmark's baseline): prepared rays in one packet, nothing
+            /// else; returns how many hit.
+            pub(super) fn $bare(&self, rays: &[BareRay], ctx: *mut RTCIntersectContext) -> usize {
+                let mut rh = $RayHitN::default();
+                let mut valid = Valid([0i32; $n]);
+                for (i, r) in rays.iter().enumerate() {
+                    fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
+                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+                }
+                unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx, &mut rh) };
+                (0..rays.len())
+                    .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
+                    .count()
+            }
+
             pub(super) fn $isect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
                 let mut rh = $RayHitN::default();
                 let mut valid = Valid([0i32; $n]);
@@ -117,6 +132,7 @@ packet_fns!(
     16,
     intersect16,
     occluded16,
+    bare16,
     RTCRayHit16,
     RTCRay16,
     rtcIntersect16,
@@ -126,13 +142,14 @@ packet_fns!(
     8,
     intersect8,
     occluded8,
+    bare8,
     RTCRayHit8,
     RTCRay8,
     rtcIntersect8,
     rtcOccluded8
 );
 
-fn single(e: &EmbreeRay) -> RTCRay {
+pub(super) fn single(e: &EmbreeRay) -> RTCRay {
     RTCRay {
         org_x: e.org[0],
         org_y: e.org[1],
