@@ -8,6 +8,15 @@ use glam::DVec3;
 use rest_embree::render::Frame;
 use rest_embree::spacetime::Velocity;
 
+/// A JSON array of numbers from the cases file.
+fn floats(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .expect("an array")
+        .iter()
+        .map(|x| x.as_f64().expect("a number"))
+        .collect()
+}
+
 fn gamma(beta: f64) -> f64 {
     Velocity::from_beta(DVec3::X, beta).unwrap().gamma()
 }
@@ -55,12 +64,7 @@ fn sphere_outlines_3_3() {
     let cases = cases();
     for case in cases["sphere"].as_array().unwrap() {
         let beta = case["beta"].as_f64().unwrap();
-        let c0: Vec<f64> = case["c0"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
+        let c0 = floats(&case["c0"]);
         let r = case["R"].as_f64().unwrap();
         let p = &case["pinhole_f1000_axis_y"];
         let (cu, a, b) = (
@@ -176,18 +180,8 @@ fn marks_on_a_rod_parallel_to_the_motion_4_1() {
     for case in cases["rod_parallel"].as_array().unwrap() {
         let beta = case["beta"].as_f64().unwrap();
         let d = case["D"].as_f64().unwrap();
-        let xi: Vec<f64> = case["xi"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
-        let u: Vec<f64> = case["u"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
+        let xi = floats(&case["xi"]);
+        let u = floats(&case["u"]);
         let on_axis = case["case"].as_str().unwrap().ends_with("image_on_axis");
         let g = gamma(beta);
         let x_mark0 = if on_axis { beta * g * d } else { 0.0 };
@@ -239,18 +233,8 @@ fn rod_perpendicular_to_the_motion_is_a_hyperbola_4_2() {
     for case in cases["rod_perpendicular_hyperbola"].as_array().unwrap() {
         let beta = case["beta"].as_f64().unwrap();
         let x0 = case["x0"].as_f64().unwrap();
-        let zs: Vec<f64> = case["z"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
-        let us: Vec<f64> = case["u"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
+        let zs = floats(&case["z"]);
+        let us = floats(&case["u"]);
         let (g, d) = (gamma(beta), 10.0);
         let x = g * x0;
         let rod = [([x - hw, d - hw, -12.0], [x + hw, d + hw, 12.0])];
