@@ -38,10 +38,7 @@ impl CameraRays {
         let c = &self.camera;
         let (u, v) = (px - 0.5 * self.width, 0.5 * self.height - py);
         let (origin, dir_cam) = match c.projection {
-            Projection::Pinhole { .. } => (
-                self.event,
-                (self.focal * c.forward + u * c.right + v * c.up).normalize(),
-            ),
+            Projection::Pinhole { .. } => (self.event, self.pinhole(u, v)),
             Projection::Orthographic { view_height } => {
                 let s = view_height / self.height;
                 let offset = (u * c.right + v * c.up) * s;
@@ -66,11 +63,15 @@ impl CameraRays {
     /// A pinhole camera's looking direction (unit, in the camera's rest frame) through image
     /// point (px, py); None for other projections.
     pub fn pinhole_dir(&self, px: f64, py: f64) -> Option<DVec3> {
+        matches!(self.camera.projection, Projection::Pinhole { .. })
+            .then(|| self.pinhole(px - 0.5 * self.width, 0.5 * self.height - py))
+    }
+
+    /// The pinhole direction (camera frame) through the image point (u, v) pixels right of and
+    /// above the centre.
+    fn pinhole(&self, u: f64, v: f64) -> DVec3 {
         let c = &self.camera;
-        matches!(c.projection, Projection::Pinhole { .. }).then(|| {
-            let (u, v) = (px - 0.5 * self.width, 0.5 * self.height - py);
-            (self.focal * c.forward + u * c.right + v * c.up).normalize()
-        })
+        (self.focal * c.forward + u * c.right + v * c.up).normalize()
     }
 
     /// A pinhole camera's focal length in pixels (0 for other projections): image points L
