@@ -79,14 +79,12 @@ impl<'a> Shader<'a> {
     pub fn shade(&self, ray: &NullRay, hit: &SurfaceHit, depth: u32) -> DVec3 {
         let mut shadows = Vec::with_capacity(self.lights.len());
         let lit = self.prepare(ray, hit, &mut shadows);
-        let visible: Vec<bool> = shadows
-            .iter()
-            .map(|q| {
-                q.as_ref()
-                    .is_some_and(|q| !self.world.occluded(&q.ray, 0.0, q.tmax))
-            })
-            .collect();
-        self.finish(&lit, &shadows, &visible, depth)
+        self.finish(
+            &lit,
+            &shadows,
+            |_, q| !self.world.occluded(&q.ray, 0.0, q.tmax),
+            depth,
+        )
     }
 
     pub fn light_count(&self) -> usize {
@@ -163,12 +161,13 @@ impl<'a> Shader<'a> {
         lit
     }
 
-    /// The colour of a prepared hit, given its shadow rays and which reach their light.
+    /// The colour of a prepared hit, given its shadow rays and `reaches(light, query)`: whether
+    /// that light's shadow ray reaches it.
     pub fn finish(
         &self,
         lit: &Lit,
         shadows: &[Option<ShadowQuery>],
-        visible: &[bool],
+        reaches: impl Fn(usize, &ShadowQuery) -> bool,
         depth: u32,
     ) -> DVec3 {
         let mat = lit.mat;
@@ -176,8 +175,8 @@ impl<'a> Shader<'a> {
             return lit.base;
         }
         let mut color = lit.base;
-        for (q, &seen) in shadows.iter().zip(visible) {
-            if let (Some(q), true) = (q, seen) {
+        for (l, q) in shadows.iter().enumerate() {
+            if let Some(q) = q.as_ref().filter(|q| reaches(l, q)) {
                 color += q.light;
             }
         }

@@ -174,7 +174,7 @@ fn shade_hits(
         .map(|(k, lit)| {
             let mine = k * lights..(k + 1) * lights;
             lit.as_ref().map_or(background, |l| {
-                shader.finish(l, &shadows[mine.clone()], &visible[mine], 0)
+                shader.finish(l, &shadows[mine], |light, _| visible[k * lights + light], 0)
             })
         })
         .collect()
