@@ -52,10 +52,6 @@ impl Boost {
         }
     }
 
-    pub fn is_identity(&self) -> bool {
-        self.identity
-    }
-
     /// Transform an event (or any 4-vector).
     pub fn event(&self, e: Event) -> Event {
         if self.identity {
