@@ -295,6 +295,7 @@ impl World {
     /// Boost into group g's rest frame; None when the ray misses the group's bounds in
     /// (tmin, tmax). The origin moves along the ray to where it enters the bounds, so the
     /// backend never sees large coordinates (DESIGN.md).
+    #[inline(always)]
     fn rest_ray(&self, g: &GroupRt, ray: &NullRay, tmin: f64, tmax: f64) -> Option<RestRay> {
         // Every primary ray starts at the imaging event: its rest-frame origin is per group.
         let origin = if ray.origin == self.event {
@@ -354,7 +355,10 @@ impl World {
             let n = rays.len();
             let mut best = [f64::INFINITY; CHUNK];
             let mut batch = [INACTIVE; CHUNK];
-            let mut meta: [Option<RestRay>; CHUNK] = [None; CHUNK];
+            // Each lane's shift and lookback factor (valid where the lane is active); kept
+            // apart from the rays so the rays go into the batch straight from registers.
+            let mut shift = [0.0; CHUNK];
+            let mut factor = [0.0; CHUNK];
             let mut hits: [Option<Hit>; CHUNK] = [None; CHUNK];
             out.iter_mut().for_each(|o| *o = None);
             for (gi, g) in self.groups.iter().enumerate() {
@@ -362,17 +366,29 @@ impl World {
                 // a ray that misses the group's bounds is masked (inactive), not removed.
                 let mut any = false;
                 for (i, r) in rays.iter().enumerate() {
-                    meta[i] = self.rest_ray(g, r, tmin, best[i]);
-                    batch[i] = meta[i].map_or(INACTIVE, |rr| rr.ray);
-                    any |= meta[i].is_some();
+                    match self.rest_ray(g, r, tmin, best[i]) {
+                        Some(rr) => {
+                            batch[i] = rr.ray;
+                            shift[i] = rr.shift;
+                            factor[i] = rr.s;
+                            any = true;
+                        }
+                        None => batch[i] = INACTIVE,
+                    }
                 }
                 if !any {
                     continue;
                 }
                 g.intersect(&batch[..n], &mut hits[..n]);
                 for i in 0..n {
-                    if let (Some(h), Some(rr)) = (hits[i], &meta[i]) {
-                        let hit = Self::surface_hit(gi, rr, h);
+                    // Backends report no hit on inactive rays.
+                    if let Some(h) = hits[i] {
+                        let rr = RestRay {
+                            ray: batch[i],
+                            shift: shift[i],
+                            s: factor[i],
+                        };
+                        let hit = Self::surface_hit(gi, &rr, h);
                         if hit.lambda < best[i] {
                             best[i] = hit.lambda;
                             out[i] = Some(hit);

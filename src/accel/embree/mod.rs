@@ -99,12 +99,14 @@ struct EmbreeRay {
 }
 
 impl EmbreeAccel {
+    #[inline(always)]
     fn embree_ray(&self, r: &Ray) -> EmbreeRay {
         if !r.is_active() {
             return EmbreeRay::default();
         }
         let len = r.dir.length();
-        let du = r.dir / len;
+        // One division, not three: the f32 cast below rounds far more than this.
+        let du = r.dir * len.recip();
         let o = r.origin - self.scene.center - self.pullback * du;
         let tnear = (r.tmin * len + self.pullback).max(0.0);
         let tfar = r.tmax * len + self.pullback;
@@ -124,10 +126,11 @@ impl EmbreeAccel {
 
     /// Embree's hit back in the caller's units: exact already for user geometry (`exact_t`,
     /// from the context), else refined in f64 on the primitive that was hit.
+    #[inline(always)]
     fn to_hit(
         &self,
         r: &Ray,
-        e: &EmbreeRay,
+        len: f64,
         t_embree: f32,
         geom: u32,
         prim: u32,
@@ -137,8 +140,8 @@ impl EmbreeAccel {
         if exact {
             return (exact_t > r.tmin && exact_t < r.tmax).then_some(Hit { t: exact_t, prim });
         }
-        let t = (t_embree as f64 - self.pullback) / e.len;
-        let slack = 1e-4 * t.abs().max(self.pullback / e.len) + 4.0 * self.pullback / e.len;
+        let t = (t_embree as f64 - self.pullback) / len;
+        let slack = 1e-4 * t.abs().max(self.pullback / len) + 4.0 * self.pullback / len;
         let p = &self.geometry.prims[prim as usize];
         let refined = p.intersect(
             r.origin,

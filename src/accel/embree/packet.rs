@@ -49,12 +49,11 @@ macro_rules! packet_fns {
             pub(super) fn $isect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
                 let mut rh = $RayHitN::default();
                 let mut valid = Valid([0i32; $n]);
-                let mut er = [EmbreeRay::default(); $n];
                 let mut lanes = Lanes::<$n>::new(rays);
                 for (i, r) in rays.iter().enumerate() {
-                    er[i] = self.embree_ray(r);
-                    lanes.len[i] = er[i].len;
-                    fill_lane(&mut rh.ray, i, &er[i], &mut valid.0);
+                    let e = self.embree_ray(r);
+                    lanes.len[i] = e.len;
+                    fill_lane(&mut rh.ray, i, &e, &mut valid.0);
                     rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                 }
                 let mut ctx = self.context(true, rays, &lanes);
@@ -63,7 +62,7 @@ macro_rules! packet_fns {
                     hits[i] = if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID {
                         self.to_hit(
                             r,
-                            &er[i],
+                            lanes.len[i],
                             rh.ray.tfar[i],
                             rh.hit.geomID[i],
                             rh.hit.primID[i],
@@ -199,7 +198,7 @@ impl EmbreeAccel {
         }
         self.to_hit(
             r,
-            &e,
+            e.len,
             rh.ray.tfar,
             rh.hit.geomID,
             rh.hit.primID,

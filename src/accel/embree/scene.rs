@@ -18,10 +18,9 @@ impl Drop for GeometryHandle {
     }
 }
 
-/// Which scene primitive an Embree (geomID, primID) is: `prims[primID / per]`.
+/// Which scene primitive an Embree (geomID, primID) is: `prims[primID]`.
 pub struct PrimMap {
     pub prims: Vec<u32>,
-    pub per: u32,
     /// User geometry whose hits are already exact f64 (the context carries their t).
     pub exact: bool,
 }
@@ -131,7 +130,7 @@ impl Scene {
             for (k, slot) in idx.iter_mut().enumerate() {
                 *slot = [3 * k as u32, 3 * k as u32 + 1, 3 * k as u32 + 2];
             }
-            scene.attach(&device, g, tri_map, 1, false)?;
+            scene.attach(&device, g, tri_map, false)?;
         }
         scene.rounds = scene.user_geometry(&device, rounds, round_map)?;
         scene.cuboids = scene.user_geometry(&device, cuboids, cuboid_map)?;
@@ -163,7 +162,7 @@ impl Scene {
             rtcSetGeometryIntersectFunction(g.0, Some(exact::intersect::<S>));
             rtcSetGeometryOccludedFunction(g.0, Some(exact::occluded::<S>));
         }
-        self.attach(device, g, map, 1, true)?;
+        self.attach(device, g, map, true)?;
         Ok(Some(data))
     }
 
@@ -206,7 +205,6 @@ impl Scene {
         device: &Device,
         g: GeometryHandle,
         prims: Vec<u32>,
-        per: u32,
         exact: bool,
     ) -> Result<(), String> {
         unsafe { rtcCommitGeometry(g.0) };
@@ -216,17 +214,16 @@ impl Scene {
         if self.maps.len() <= id {
             self.maps.resize_with(id + 1, || PrimMap {
                 prims: Vec::new(),
-                per: 1,
                 exact: false,
             });
         }
-        self.maps[id] = PrimMap { prims, per, exact };
+        self.maps[id] = PrimMap { prims, exact };
         Ok(())
     }
 
     /// The scene primitive an Embree hit names, and whether its t is exact already.
     pub fn prim(&self, geom: u32, prim: u32) -> Option<(u32, bool)> {
         let m = self.maps.get(geom as usize)?;
-        Some((*m.prims.get((prim / m.per) as usize)?, m.exact))
+        Some((*m.prims.get(prim as usize)?, m.exact))
     }
 }
