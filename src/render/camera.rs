@@ -60,18 +60,23 @@ impl CameraRays {
         NullRay::new(origin, dir)
     }
 
-    /// A pinhole camera's looking direction (unit, in the camera's rest frame) through image
-    /// point (px, py); None for other projections.
-    pub fn pinhole_dir(&self, px: f64, py: f64) -> Option<DVec3> {
+    /// A pinhole camera's looking direction (in the camera's rest frame, not normalised)
+    /// through image point (px, py); None for other projections.
+    pub fn pinhole_toward(&self, px: f64, py: f64) -> Option<DVec3> {
         matches!(self.camera.projection, Projection::Pinhole { .. })
-            .then(|| self.pinhole(px - 0.5 * self.width, 0.5 * self.height - py))
+            .then(|| self.toward(px - 0.5 * self.width, 0.5 * self.height - py))
     }
 
     /// The pinhole direction (camera frame) through the image point (u, v) pixels right of and
     /// above the centre.
     fn pinhole(&self, u: f64, v: f64) -> DVec3 {
+        self.toward(u, v).normalize()
+    }
+
+    /// A vector along the pinhole direction through (u, v), not normalised.
+    fn toward(&self, u: f64, v: f64) -> DVec3 {
         let c = &self.camera;
-        (self.focal * c.forward + u * c.right + v * c.up).normalize()
+        self.focal * c.forward + u * c.right + v * c.up
     }
 
     /// A pinhole camera's focal length in pixels (0 for other projections): image points L

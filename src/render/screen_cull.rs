@@ -60,7 +60,7 @@ impl ScreenCull {
         if !world.options.bounds_cull || world.groups.len() > MAX_GROUPS {
             return None;
         }
-        cam.pinhole_dir(0.0, 0.0)?;
+        cam.pinhole_toward(0.0, 0.0)?;
         // Image points L pixels apart look at most L / focal apart: a 4 x 4 block's directions
         // are within 2 sqrt(2) / focal of its centre's.
         let block_radius = 8f64.sqrt() / cam.focal_px();
@@ -120,11 +120,19 @@ impl ScreenCull {
     /// (x, y) in full-image coordinates.
     pub fn block_visible(&self, cam: &CameraRays, x: u32, y: u32) -> bool {
         let (x0, y0) = (x as f64, y as f64);
-        let Some(centre) = cam.pinhole_dir(x0 + 2.0, y0 + 2.0) else {
+        let Some(d) = cam.pinhole_toward(x0 + 2.0, y0 + 2.0) else {
             return true;
         };
-        self.cones
-            .iter()
-            .any(|&(axis, cos_reach)| centre.dot(axis) >= cos_reach)
+        // axis · d ≥ cos_reach |d| without the square root: compare squares, minding signs.
+        let d2 = d.length_squared();
+        self.cones.iter().any(|&(axis, c)| {
+            let a = axis.dot(d);
+            let (a2, c2) = (a * a, c * c * d2);
+            if c >= 0.0 {
+                a >= 0.0 && a2 >= c2
+            } else {
+                a >= 0.0 || a2 <= c2
+            }
+        })
     }
 }

@@ -12,16 +12,23 @@ use crate::scene::Scene;
 use crate::spacetime::NullRay;
 use glam::DVec3;
 
+/// The 4 × 4 blocks of the tile at (x0, y0), clipped to the image, in packet order: each
+/// block's top-left pixel and its width and height.
+fn blocks(x0: u32, y0: u32, w: u32, h: u32) -> impl Iterator<Item = (u32, u32, u32, u32)> {
+    let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
+    (y0..y1).step_by(4).flat_map(move |by| {
+        (x0..x1)
+            .step_by(4)
+            .map(move |bx| (bx, by, (bx + 4).min(x1) - bx, (by + 4).min(y1) - by))
+    })
+}
+
 /// The pixels of the tile at (x0, y0), clipped to the image, in 4 × 4 blocks.
 pub fn tile_pixels(x0: u32, y0: u32, w: u32, h: u32) -> Vec<(u32, u32)> {
     let mut v = Vec::with_capacity((TILE * TILE) as usize);
-    for by in (y0..(y0 + TILE).min(h)).step_by(4) {
-        for bx in (x0..(x0 + TILE).min(w)).step_by(4) {
-            for y in by..(by + 4).min(h).min(y0 + TILE) {
-                for x in bx..(bx + 4).min(w).min(x0 + TILE) {
-                    v.push((x, y));
-                }
-            }
+    for (bx, by, bw, bh) in blocks(x0, y0, w, h) {
+        for y in by..by + bh {
+            v.extend((bx..bx + bw).map(|x| (x, y)));
         }
     }
     v
@@ -47,41 +54,12 @@ pub fn primary_rays(
     }
 }
 
-/// Which of the tile's `coords` (frame pixels) may see a group: indices into `coords`. The
-/// others are background: their 4 × 4 block (aligned in the frame, as the tile's packets are)
-/// misses every group's cone of directions.
-fn live_pixels(
-    cam: &CameraRays,
-    coords: &[(u32, u32)],
-    offset: (u32, u32),
-    cull: Option<&ScreenCull>,
-    (x0, y0): (u32, u32),
-) -> Vec<usize> {
-    const SIDE: u32 = TILE / 4;
-    let every = || (0..coords.len()).collect();
-    let Some(cull) = cull else {
-        return every();
-    };
-    let mut visible = [true; (SIDE * SIDE) as usize];
-    for (b, v) in visible.iter_mut().enumerate() {
-        let (bx, by) = (b as u32 % SIDE, b as u32 / SIDE);
-        *v = cull.block_visible(cam, x0 + 4 * bx + offset.0, y0 + 4 * by + offset.1);
-    }
-    if visible.iter().all(|&v| v) {
-        return every();
-    }
-    (0..coords.len())
-        .filter(|&k| {
-            let (x, y) = coords[k];
-            visible[((y - y0) / 4 * SIDE + (x - x0) / 4) as usize]
-        })
-        .collect()
-}
-
-/// A tile's pixels (frame coordinates), where the frame sits in the image, and those the
-/// screen cull keeps (indices into `all`, and their coordinates).
+/// A tile's pixels that the screen cull keeps (frame coordinates, and their indices among
+/// all the tile's pixels in `tile_pixels` order), how many pixels it has, and where the frame
+/// sits in the image. The others are background: their 4 × 4 block (aligned in the frame, as
+/// the tile's packets are) misses every group's cone of directions.
 struct TilePixels {
-    all: Vec<(u32, u32)>,
+    total: usize,
     offset: (u32, u32),
     live: Vec<usize>,
     live_coords: Vec<(u32, u32)>,
@@ -90,16 +68,24 @@ struct TilePixels {
 impl TilePixels {
     fn new(scene: &Scene, cam: &CameraRays, cull: Option<&ScreenCull>, x0: u32, y0: u32) -> Self {
         let (w, h) = scene.image.frame_size();
-        let all = tile_pixels(x0, y0, w, h);
         let offset = scene.image.frame_offset();
-        let live = live_pixels(cam, &all, offset, cull, (x0, y0));
-        let live_coords = live.iter().map(|&k| all[k]).collect();
-        TilePixels {
-            all,
+        let mut t = TilePixels {
+            total: 0,
             offset,
-            live,
-            live_coords,
+            live: Vec::new(),
+            live_coords: Vec::new(),
+        };
+        for (bx, by, bw, bh) in blocks(x0, y0, w, h) {
+            let n = (bw * bh) as usize;
+            if cull.is_none_or(|c| c.block_visible(cam, bx + offset.0, by + offset.1)) {
+                t.live.extend(t.total..t.total + n);
+                for y in by..by + bh {
+                    t.live_coords.extend((bx..bx + bw).map(|x| (x, y)));
+                }
+            }
+            t.total += n;
         }
+        t
     }
 }
 
@@ -114,7 +100,7 @@ pub fn trace_tile(
     y0: u32,
 ) -> (u64, u64) {
     let t = TilePixels::new(scene, cam, cull, x0, y0);
-    let (all, offset, coords) = (t.all, t.offset, t.live_coords);
+    let (offset, coords) = (t.offset, t.live_coords);
     let n = scene.image.samples;
     let mut rays = Vec::with_capacity(coords.len());
     let mut hits = vec![None; coords.len()];
@@ -124,7 +110,7 @@ pub fn trace_tile(
         world.closest_hits(&rays, 0.0, &mut hits);
         found += hits.iter().filter(|h| h.is_some()).count() as u64;
     }
-    (n as u64 * all.len() as u64, found)
+    (n as u64 * t.total as u64, found)
 }
 
 /// The colours of primary hits (background where none), with the shadow rays of all of them
@@ -201,11 +187,13 @@ pub fn render_tile(
     y0: u32,
 ) -> TileResult {
     let TilePixels {
-        all: coords,
         offset,
         live,
         live_coords,
+        ..
     } = TilePixels::new(scene, cam, cull, x0, y0);
+    let (w, h) = scene.image.frame_size();
+    let coords = tile_pixels(x0, y0, w, h);
     let n = scene.image.samples;
     let shader = Shader::new(scene, world);
     // Pixels left out by the cull see the background in every sample.

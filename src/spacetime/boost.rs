@@ -87,6 +87,9 @@ impl Boost {
 
     /// The unit direction of a null ray after the boost, and the factor `s` of [`Boost::null_dir`].
     pub fn view_dir(&self, a: DVec3) -> (DVec3, f64) {
+        if self.identity {
+            return (a, 1.0);
+        }
         let (d, s) = self.null_dir(a);
         (d / s, s)
     }
