@@ -66,6 +66,11 @@ fn capsules_and_spheres_match_their_distance_functions() {
         );
         let b = if case % 10 == 0 {
             a // a degenerate capsule is a sphere
+        } else if case % 3 == 1 {
+            // Along x, y or z, either way (the lattices' rods).
+            let mut e = DVec3::ZERO;
+            e[(case / 3) % 3] = if case % 2 == 0 { 1.0 } else { -1.0 } * rng.range(0.1, 3.0);
+            a + e
         } else {
             a + rng.unit() * rng.range(0.1, 3.0)
         };
