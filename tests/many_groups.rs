@@ -247,3 +247,110 @@ fn apparent_boxes_hold_every_apparent_position() {
         }
     }
 }
+
+/// A random group: rest-frame box and velocity (up to rapidity 3, β ≈ 0.995).
+fn random_group(r: &mut Rng, spread: f64) -> (Aabb, Velocity) {
+    let c = DVec3::new(
+        r.range(-spread, spread),
+        r.range(-spread, spread),
+        r.range(-spread, spread),
+    );
+    let h = DVec3::new(r.range(0.1, 3.0), r.range(0.1, 3.0), r.range(0.1, 3.0));
+    let v = Velocity::from_rapidity(r.unit(), r.range(0.0, 3.0)).unwrap();
+    (Aabb::new(c - h, c + h), v)
+}
+
+#[test]
+fn reach_boxes_hold_every_point_light_from_the_slice_meets() {
+    use rest_embree::render::reach_box;
+    let mut r = Rng(17);
+    let mut checked = 0;
+    for _ in 0..400 {
+        let (rest, v) = random_group(&mut r, 30.0);
+        let light = DVec3::new(
+            r.range(-40.0, 40.0),
+            r.range(-40.0, 40.0),
+            r.range(-40.0, 40.0),
+        );
+        let t_a = r.range(-60.0, 20.0);
+        let t_b = t_a + r.range(0.0, 10.0);
+        let b = reach_box(&rest, &v, light, t_a, t_b);
+        let (u, g) = (v.direction(), v.gamma());
+        for _ in 0..50 {
+            // A point of the body (rest frame), where it is at world time 0, and the light that
+            // left `light` at t_e: it reaches the point τ later, τ = |d0 + v τ|.
+            let q = rest.min + (rest.max - rest.min) * DVec3::new(r.f(), r.f(), r.f());
+            let at_zero = q + (1.0 / g - 1.0) * q.dot(u) * u;
+            let t_e = r.range(t_a, t_b);
+            let vel = v.beta_vec();
+            let d0 = at_zero + vel * t_e - light;
+            let (vd, b2) = (vel.dot(d0), vel.length_squared());
+            let tau = (vd + (vd * vd + (1.0 - b2) * d0.length_squared()).sqrt()) / (1.0 - b2);
+            let met = d0 + vel * tau + light;
+            assert!(
+                ((met - light).length() - tau).abs() <= 1e-9 * (1.0 + tau),
+                "the meeting point is on the light's cone"
+            );
+            let tol = 1e-7 * (1.0 + met.abs().max_element());
+            assert!(
+                met.cmpge(b.min - tol).all() && met.cmple(b.max + tol).all(),
+                "light from {light} at {t_e} meets the group at {met}, outside {b:?}"
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 20_000);
+}
+
+#[test]
+fn light_tree_visits_every_group_a_shadow_ray_meets() {
+    use rest_embree::render::LightTree;
+    let mut r = Rng(23);
+    let groups: Vec<(Aabb, Velocity)> = (0..500).map(|_| random_group(&mut r, 50.0)).collect();
+    let light = DVec3::new(10.0, -70.0, 30.0);
+    let tree = LightTree::new(groups.clone().into(), light, -200.0, 40.0, 32);
+    let (mut served, mut checked) = (0, 0);
+    for _ in 0..10_000 {
+        // A shadow ray from an event among the groups back to the light.
+        let o = Event::new(
+            r.range(-100.0, 40.0),
+            DVec3::new(
+                r.range(-60.0, 60.0),
+                r.range(-60.0, 60.0),
+                r.range(-60.0, 60.0),
+            ),
+        );
+        let to = light - o.x;
+        let ray = NullRay::new(o, to / to.length());
+        let tmax = to.length() * (1.0 - 1e-9);
+        let mut visited = vec![false; groups.len()];
+        let mark = |g: u32, t: f64| {
+            visited[g as usize] = true;
+            t
+        };
+        if !tree.traverse(&ray, 0.0, tmax, mark) {
+            continue;
+        }
+        served += 1;
+        for (i, (b, v)) in groups.iter().enumerate() {
+            let boost = Boost::to_rest(v);
+            let (d, _) = boost.null_dir(ray.dir);
+            if b.clip(boost.event(ray.origin).x, d.recip(), 0.0, tmax)
+                .is_some()
+            {
+                checked += 1;
+                assert!(visited[i], "group {i} is met by the shadow ray but skipped");
+            }
+        }
+    }
+    // Rays left the light before -200 or after 40 are not served (the kinetic trees take them).
+    assert!(served > 5000, "most rays are served ({served})");
+    assert!(
+        checked > 1500,
+        "enough ray-group meetings were checked ({checked})"
+    );
+    // A ray that does not head for the light is never served.
+    let o = Event::new(0.0, DVec3::ZERO);
+    let off = NullRay::new(o, (light - o.x).normalize() + DVec3::new(0.0, 0.0, 1e-3));
+    assert!(!tree.traverse(&off, 0.0, 10.0, |_, t| t));
+}

@@ -15,8 +15,7 @@ pub struct ApparentTree {
 }
 
 /// x_app = γ(X − β·sqrt(X² + ρ²)) (PHYSICS.md §2.1), without cancellation for X > 0.
-fn x_app(v: &Velocity, x: f64, rho: f64) -> f64 {
-    let (g, b) = (v.gamma(), v.beta());
+fn x_app(g: f64, b: f64, x: f64, rho: f64) -> f64 {
     let s = (x * x + rho * rho).sqrt();
     if x <= 0.0 {
         g * (x - b * s)
@@ -31,31 +30,39 @@ fn x_app(v: &Velocity, x: f64, rho: f64) -> f64 {
 /// distance ρ from the line of motion through the camera; so the apparent shape lies in the
 /// prism "the box's perpendicular section × [x_app(X_min, ρ_max), x_app(X_max, ρ_min)]".
 pub fn apparent_box(rest: &Aabb, v: &Velocity, event: Event) -> Aabb {
-    let now = world_box(rest, v, event.t);
+    apparent_box_of(&world_box(rest, v, event.t), v, event.x)
+}
+
+/// As [`apparent_box`], for whatever moves at `v` and lies within `now` (world frame) at the
+/// time of the viewing event at `eye`: the bound holds point by point, so for any set in that box.
+pub fn apparent_box_of(now: &Aabb, v: &Velocity, eye: DVec3) -> Aabb {
     if v.is_zero() {
-        return now;
+        return *now;
     }
-    let u = v.direction();
-    let corners: Vec<DVec3> = (0..8)
-        .map(|k| {
-            DVec3::new(
-                if k & 1 == 0 { now.min.x } else { now.max.x },
-                if k & 2 == 0 { now.min.y } else { now.max.y },
-                if k & 4 == 0 { now.min.z } else { now.max.z },
-            ) - event.x
-        })
-        .collect();
+    apparent_box_along(now, v.direction(), v.beta(), v.gamma(), eye)
+}
+
+/// [`apparent_box_of`] for a motion given as its direction `u`, speed β > 0 and γ.
+pub fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec3) -> Aabb {
+    let now = *now;
+    let corners: [DVec3; 8] = std::array::from_fn(|k| {
+        DVec3::new(
+            if k & 1 == 0 { now.min.x } else { now.max.x },
+            if k & 2 == 0 { now.min.y } else { now.max.y },
+            if k & 4 == 0 { now.min.z } else { now.max.z },
+        ) - eye
+    });
     // Lab-simultaneous offsets along v, and their rest-frame values X = γ x∥.
-    let along: Vec<f64> = corners.iter().map(|c| c.dot(u)).collect();
-    let x_min = v.gamma() * along.iter().cloned().fold(f64::INFINITY, f64::min);
-    let x_max = v.gamma() * along.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let along = corners.map(|c| c.dot(u));
+    let x_min = gamma * along.iter().cloned().fold(f64::INFINITY, f64::min);
+    let x_max = gamma * along.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     let perp = |c: DVec3| c - c.dot(u) * u;
     let rho_max = corners
         .iter()
         .map(|&c| perp(c).length())
         .fold(0.0, f64::max);
     // |r⊥| is convex: bounded below by its supporting plane at the box centre.
-    let c = now.centroid() - event.x;
+    let c = now.centroid() - eye;
     let cp = perp(c);
     let rho_min = if cp.length() > 0.0 {
         let grad = perp(cp / cp.length());
@@ -63,11 +70,14 @@ pub fn apparent_box(rest: &Aabb, v: &Velocity, event: Event) -> Aabb {
     } else {
         0.0
     };
-    let (lo, hi) = (x_app(v, x_min, rho_max), x_app(v, x_max, rho_min));
+    let (lo, hi) = (
+        x_app(gamma, beta, x_min, rho_max),
+        x_app(gamma, beta, x_max, rho_min),
+    );
     let mut b = Aabb::EMPTY;
     for &c in &corners {
         for x in [lo, hi] {
-            b.grow(event.x + perp(c) + x * u);
+            b.grow(eye + perp(c) + x * u);
         }
     }
     // A little slack for rounding.

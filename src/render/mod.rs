@@ -6,6 +6,7 @@ mod apparent_tree;
 mod camera;
 mod frame;
 mod group_tree;
+mod light_tree;
 mod sampler;
 mod screen_cull;
 mod shade;
@@ -16,6 +17,7 @@ pub use apparent_tree::{apparent_box, ApparentTree};
 pub use camera::CameraRays;
 pub use frame::{Frame, PixelValue, CHANNELS};
 pub use group_tree::{world_box, GroupTree, SlicedGroupTree};
+pub use light_tree::{reach_box, LightTree};
 pub use screen_cull::ScreenCull;
 pub use world::{SurfaceHit, World, WorldOptions, GROUP_TREE_MIN};
 

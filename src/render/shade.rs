@@ -82,7 +82,7 @@ impl<'a> Shader<'a> {
         self.finish(
             &lit,
             &shadows,
-            |_, q| !self.world.occluded(&q.ray, 0.0, q.tmax),
+            |light, q| !self.world.shadowed(light, &q.ray, q.tmax),
             depth,
         )
     }

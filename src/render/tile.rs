@@ -150,7 +150,7 @@ fn shade_hits(
             }
         }
         let mut blocked = vec![false; shadow.len()];
-        world.occluded_many(&shadow, &tmax, &mut blocked);
+        world.shadowed_many(light, &shadow, &tmax, &mut blocked);
         for (&at, b) in which.iter().zip(blocked) {
             visible[at] = !b;
         }

@@ -5,23 +5,28 @@
 //! share a velocity are merged into one rest-frame scene; a ray is tested against a group's
 //! bounds before the group's accelerator, and only from where it enters them; groups of a few
 //! primitives skip the accelerator; with many groups, trees over the groups find the few a ray
-//! can meet (apparent_tree.rs for primary rays, group_tree.rs for the rest), so a ray that misses
+//! can meet (apparent_tree.rs for primary rays, light_tree.rs for shadow rays toward lights at
+//! rest, group_tree.rs for the rest, built only when such a ray comes), so a ray that misses
 //! every group costs a handful of box tests.
 
 use super::apparent_tree::ApparentTree;
 use super::group_tree::SlicedGroupTree;
+use super::light_tree::LightTree;
 use crate::accel::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, Part};
 use crate::scene::Scene;
 use crate::spacetime::{Boost, NullRay, Velocity};
 use glam::DVec3;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// From this many groups on, rays find their groups through the group tree.
 pub const GROUP_TREE_MIN: usize = 8;
 
 /// Kinetic trees per world (reference times), when the group tree is in use.
 const TIME_SLICES: usize = 16;
+
+/// Slices of emission times per light tree (light_tree.rs).
+const LIGHT_SLICES: usize = 128;
 
 /// Groups with at most this many primitives are intersected in f64 directly: an acceleration
 /// structure (and a call into it) costs more than the primitives themselves.
@@ -138,13 +143,33 @@ pub struct World {
     /// The imaging event (world frame), where every primary ray starts.
     event: crate::spacetime::Event,
     pub options: WorldOptions,
-    /// With many groups: every ray's culling (kinetic), and the primary rays' (apparent boxes).
-    tree: Option<SlicedGroupTree>,
+    /// With many groups: every ray's culling (kinetic), the primary rays' (apparent boxes) and,
+    /// per scene light at rest, its shadow rays' (light_tree.rs).
+    tree: Option<Kinetic>,
     primary_tree: Option<ApparentTree>,
+    light_trees: Vec<Option<LightTree>>,
     /// Whether rays are clipped to a group's bounds (and moved to where they enter) before its
     /// accelerator: needed to skip groups and to keep f32 coordinates small when rays come from
     /// afar; pure cost for one group seen from close by, whose rays all start near it.
     clip_rays: bool,
+}
+
+/// The kinetic trees over the groups, made on first use: only rays that neither start at the
+/// imaging event nor head for a light at rest need them (reflections, refractions, shadow rays
+/// toward moving lights), and a scene without such rays never pays for their builds.
+struct Kinetic {
+    groups: Arc<[(Aabb, Velocity)]>,
+    t_first: f64,
+    t_last: f64,
+    trees: OnceLock<SlicedGroupTree>,
+}
+
+impl Kinetic {
+    fn get(&self) -> &SlicedGroupTree {
+        self.trees.get_or_init(|| {
+            SlicedGroupTree::build(&self.groups, self.t_first, self.t_last, TIME_SLICES)
+        })
+    }
 }
 
 /// A masked lane of a batch.
@@ -243,7 +268,7 @@ impl World {
                 epsilon: 1e-7 * bounds.diagonal().max(1e-3) + 1e-12 * bounds.max_abs(),
             });
         }
-        let (mut tree, mut primary_tree) = (None, None);
+        let (mut tree, mut primary_tree, mut light_trees) = (None, None, Vec::new());
         if options.group_tree && groups.len() >= GROUP_TREE_MIN {
             let items: Vec<(Aabb, Velocity)> =
                 groups.iter().map(|g| (g.bounds, g.velocity)).collect();
@@ -258,13 +283,27 @@ impl World {
                 .iter()
                 .map(|b| corner_distance(b, event.x))
                 .fold(0.0, f64::max);
-            tree = Some(SlicedGroupTree::build(
-                &items,
-                event.t - 2.0 * deepest,
-                event.t,
-                TIME_SLICES,
-            ));
             primary_tree = Some(ApparentTree::build(&items, event));
+            let items: Arc<[(Aabb, Velocity)]> = items.into();
+            // Shadow rays of primary hits leave a light at most 2 deepest + its distance from
+            // the imaging event before the imaging event (later hits fall back on the kinetic
+            // trees).
+            light_trees = scene
+                .lights
+                .iter()
+                .map(|l| {
+                    l.velocity.is_zero().then(|| {
+                        let t_first = event.t - 2.0 * deepest - (l.position - event.x).length();
+                        LightTree::new(items.clone(), l.position, t_first, event.t, LIGHT_SLICES)
+                    })
+                })
+                .collect();
+            tree = Some(Kinetic {
+                groups: items,
+                t_first: event.t - 2.0 * deepest,
+                t_last: event.t,
+                trees: OnceLock::new(),
+            });
         }
         // Rays start at the imaging event or on a surface: with one group, all near it unless
         // the imaging event is far (more than 4 diagonals from the bounds' centre).
@@ -279,6 +318,7 @@ impl World {
             options,
             tree,
             primary_tree,
+            light_trees,
             clip_rays,
         })
     }
@@ -456,9 +496,9 @@ impl World {
             (Some(p), _) if p.serves(ray) => {
                 p.traverse(ray, tmin, f64::INFINITY, |g, tmax| visit(g as usize, tmax))
             }
-            (_, Some(tree)) => {
-                tree.traverse(ray, tmin, f64::INFINITY, |g, tmax| visit(g as usize, tmax))
-            }
+            (_, Some(tree)) => tree
+                .get()
+                .traverse(ray, tmin, f64::INFINITY, |g, tmax| visit(g as usize, tmax)),
             _ => {
                 let mut tmax = f64::INFINITY;
                 for gi in 0..self.groups.len() {
@@ -511,6 +551,40 @@ impl World {
         }
     }
 
+    /// Whether the shadow ray toward scene light `light` is blocked before lookback `tmax`.
+    pub fn shadowed(&self, light: usize, ray: &NullRay, tmax: f64) -> bool {
+        if let Some(Some(lt)) = self.light_trees.get(light) {
+            let mut found = false;
+            let served = lt.traverse(ray, 0.0, tmax, |gi, t| {
+                let g = &self.groups[gi as usize];
+                let blocked = self
+                    .rest_ray(g, ray, 0.0, tmax)
+                    .is_some_and(|rr| g.occluded1(&rr.ray));
+                if blocked {
+                    found = true;
+                    f64::NEG_INFINITY
+                } else {
+                    t
+                }
+            });
+            if served {
+                return found;
+            }
+        }
+        self.occluded(ray, 0.0, tmax)
+    }
+
+    /// [`World::shadowed`] for many rays toward one light (lookback from 0 to `tmax[i]`).
+    pub fn shadowed_many(&self, light: usize, rays: &[NullRay], tmax: &[f64], out: &mut [bool]) {
+        if matches!(self.light_trees.get(light), Some(Some(_))) {
+            for ((r, &t), o) in rays.iter().zip(tmax).zip(out.iter_mut()) {
+                *o = self.shadowed(light, r, t);
+            }
+            return;
+        }
+        self.occluded_many(rays, tmax, out);
+    }
+
     /// Whether anything lies on the ray between lookback `tmin` and `tmax`.
     pub fn occluded(&self, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
         let test = |gi: usize| -> bool {
@@ -521,7 +595,7 @@ impl World {
         match &self.tree {
             Some(tree) => {
                 let mut found = false;
-                tree.traverse(ray, tmin, tmax, |g, t| {
+                tree.get().traverse(ray, tmin, tmax, |g, t| {
                     if test(g as usize) {
                         found = true;
                         f64::NEG_INFINITY

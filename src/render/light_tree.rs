@@ -1,0 +1,154 @@
+//! Culling for shadow rays among many groups.
+//!
+//! A shadow ray toward a light at rest (world frame) at L ends at its emission event (t_e, L):
+//! read forward, its spatial track is light going out from L, on the future light cone of
+//! (t_e, L). A group can meet the ray only where that cone meets the group's worldtube: at the
+//! points x with x − v|x − L| ∈ B(t_e), B(t) the group's world-frame box at time t, moving at v.
+//! Time reversed, that is the apparent shape of PHYSICS.md §2.1 seen from L by a body moving at
+//! −v, so [`apparent_box_of`] bounds it; and for emission times in a slice [t_a, t_b] the points
+//! obey x − v|x − L| ∈ B(t_a) ∪ … ∪ B(t_b), inside the box around B(t_a) and B(t_b). So a static
+//! tree per slice of emission times holds every group's reachable shape, and a shadow ray walks
+//! only the slice of its own emission time, with plain slab tests along its track (the kinetic
+//! trees cut a ray into pieces by time and test moving bounds in each).
+//!
+//! Slices are made on first use, so only the emission times a frame's shadow rays have cost
+//! anything; a few consecutive slices share one tree shape (an SAH build at the middle one),
+//! refitted to each slice's boxes.
+
+use super::apparent_tree::apparent_box_along;
+use super::group_tree::world_box;
+use crate::geometry::{Aabb, BoxTree};
+use crate::spacetime::{NullRay, Velocity};
+use glam::DVec3;
+use std::sync::{Arc, OnceLock};
+
+/// Consecutive slices that share one tree shape.
+const SLICES_PER_SHAPE: usize = 8;
+
+pub struct LightTree {
+    light: DVec3,
+    t_first: f64,
+    width: f64,
+    groups: Arc<[(Aabb, Velocity)]>,
+    motions: OnceLock<Vec<Motion>>,
+    shapes: Vec<OnceLock<BoxTree>>,
+    slices: Vec<OnceLock<BoxTree>>,
+}
+
+/// A group's motion, worked out once for the many slices: its world-frame box at time 0, and
+/// its velocity as direction, β, γ and β·direction.
+struct Motion {
+    at_zero: Aabb,
+    u: DVec3,
+    beta: f64,
+    gamma: f64,
+    velocity: DVec3,
+}
+
+impl Motion {
+    fn new(rest: &Aabb, v: &Velocity) -> Motion {
+        Motion {
+            at_zero: world_box(rest, v, 0.0),
+            u: v.direction(),
+            beta: v.beta(),
+            gamma: v.gamma(),
+            velocity: v.beta_vec(),
+        }
+    }
+
+    /// The box holding every point where the group can meet light that left `light` at a
+    /// time in [t_a, t_b].
+    fn reach_box(&self, light: DVec3, t_a: f64, t_b: f64) -> Aabb {
+        let (a, b) = (self.velocity * t_a, self.velocity * t_b);
+        let swept = Aabb::new(self.at_zero.min + a.min(b), self.at_zero.max + a.max(b));
+        if self.beta == 0.0 {
+            return swept;
+        }
+        apparent_box_along(&swept, -self.u, self.beta, self.gamma, light)
+    }
+}
+
+/// The box holding every point where a group (rest-frame bounds `rest`, velocity `v`) can meet
+/// light that left `light` at a time in [t_a, t_b].
+pub fn reach_box(rest: &Aabb, v: &Velocity, light: DVec3, t_a: f64, t_b: f64) -> Aabb {
+    Motion::new(rest, v).reach_box(light, t_a, t_b)
+}
+
+impl LightTree {
+    /// For the light at rest at `light`: `count` slices of emission times covering
+    /// [t_first, t_last].
+    pub fn new(
+        groups: Arc<[(Aabb, Velocity)]>,
+        light: DVec3,
+        t_first: f64,
+        t_last: f64,
+        count: usize,
+    ) -> LightTree {
+        let count = count.max(1);
+        LightTree {
+            light,
+            t_first,
+            width: (t_last - t_first) / count as f64,
+            groups,
+            motions: OnceLock::new(),
+            shapes: (0..count.div_ceil(SLICES_PER_SHAPE))
+                .map(|_| OnceLock::new())
+                .collect(),
+            slices: (0..count).map(|_| OnceLock::new()).collect(),
+        }
+    }
+
+    /// Every group's reach box over slice k, a little wider than the slice for rounding in
+    /// the emission times the rays are given.
+    fn boxes(&self, k: usize) -> Vec<Aabb> {
+        let t_a = self.t_first + k as f64 * self.width;
+        let t_b = t_a + self.width;
+        let pad = 1e-6 * (self.width + t_a.abs() + t_b.abs());
+        let motions = self
+            .motions
+            .get_or_init(|| self.groups.iter().map(|(b, v)| Motion::new(b, v)).collect());
+        motions
+            .iter()
+            .map(|m| m.reach_box(self.light, t_a - pad, t_b + pad))
+            .collect()
+    }
+
+    /// Slice k's tree: the SAH build of its run of slices (at the run's middle slice), or that
+    /// tree refitted to slice k's boxes.
+    fn slice(&self, k: usize) -> &BoxTree {
+        let s = k / SLICES_PER_SHAPE;
+        let middle = (s * SLICES_PER_SHAPE + SLICES_PER_SHAPE / 2).min(self.slices.len() - 1);
+        let shape = self.shapes[s].get_or_init(|| BoxTree::build(&self.boxes(middle)));
+        if k == middle {
+            return shape;
+        }
+        self.slices[k].get_or_init(|| shape.refit(&self.boxes(k)))
+    }
+
+    /// Visit the groups a shadow ray may meet in lookback (tmin, tmax). Returns false, having
+    /// visited nothing, when this tree cannot serve the ray: it does not head for this light,
+    /// would pass it before tmax, or left it at a time outside the slices.
+    pub fn traverse(
+        &self,
+        ray: &NullRay,
+        tmin: f64,
+        tmax: f64,
+        visit: impl FnMut(u32, f64) -> f64,
+    ) -> bool {
+        // Lookback (= distance, the light being at rest) at which the ray reaches the light.
+        let reach = (self.light - ray.origin.x).length();
+        let end = ray.at(reach);
+        let miss = (end.x - self.light).length();
+        let scale = reach + self.light.abs().max_element() + 1.0;
+        if !(miss <= 1e-9 * scale && tmax <= reach) {
+            return false;
+        }
+        let k = ((end.t - self.t_first) / self.width).floor();
+        if !(k >= 0.0 && k < self.slices.len() as f64) {
+            return false;
+        }
+        self.slice(k as usize)
+            .traverse(ray.origin.x, ray.dir, tmin, tmax, visit);
+        true
+    }
+}
