@@ -87,21 +87,24 @@ struct Item {
 }
 
 impl BoxTree {
-    /// This tree's shape over other boxes of the same items: each node's bounds recomputed
-    /// from `boxes` (children come after their parents, so from the last node back). Far
-    /// cheaper than a build; as tight as one while the boxes have not moved much.
-    pub fn refit(&self, boxes: &[Aabb]) -> BoxTree {
+    /// This tree's shape over other boxes of the same items (`box_of(item)`, asked once per
+    /// item, in leaf order): each node's bounds recomputed (children come after their parents,
+    /// so from the last node back). Far cheaper than a build; as tight as one while the boxes
+    /// have not moved much.
+    pub fn refit_with(&self, mut box_of: impl FnMut(u32) -> Aabb) -> BoxTree {
         let mut nodes = self.nodes.clone();
+        for n in nodes.iter_mut().filter(|n| n.count > 0) {
+            let (first, count) = (n.first as usize, n.count as usize);
+            n.bounds = self.indices[first..first + count]
+                .iter()
+                .fold(Aabb::EMPTY, |b, &k| b.union(&box_of(k)));
+        }
         for i in (0..nodes.len()).rev() {
             let n = nodes[i];
-            let (first, count) = (n.first as usize, n.count as usize);
-            nodes[i].bounds = if count > 0 {
-                self.indices[first..first + count]
-                    .iter()
-                    .fold(Aabb::EMPTY, |b, &k| b.union(&boxes[k as usize]))
-            } else {
-                nodes[first].bounds.union(&nodes[first + 1].bounds)
-            };
+            if n.count == 0 {
+                let first = n.first as usize;
+                nodes[i].bounds = nodes[first].bounds.union(&nodes[first + 1].bounds);
+            }
         }
         BoxTree {
             nodes,

@@ -45,22 +45,26 @@ pub fn apparent_box_of(now: &Aabb, v: &Velocity, eye: DVec3) -> Aabb {
 /// [`apparent_box_of`] for a motion given as its direction `u`, speed β > 0 and γ.
 pub fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec3) -> Aabb {
     let now = *now;
-    let corners: [DVec3; 8] = std::array::from_fn(|k| {
-        DVec3::new(
+    // Each corner's offset along v and perpendicular to it (from the eye's line of motion).
+    let (mut a_min, mut a_max, mut rho2_max) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+    let mut perps = Aabb::EMPTY;
+    for k in 0..8 {
+        let c = DVec3::new(
             if k & 1 == 0 { now.min.x } else { now.max.x },
             if k & 2 == 0 { now.min.y } else { now.max.y },
             if k & 4 == 0 { now.min.z } else { now.max.z },
-        ) - eye
-    });
+        ) - eye;
+        let a = c.dot(u);
+        let p = c - a * u;
+        a_min = a_min.min(a);
+        a_max = a_max.max(a);
+        rho2_max = rho2_max.max(p.length_squared());
+        perps.grow(p);
+    }
     // Lab-simultaneous offsets along v, and their rest-frame values X = γ x∥.
-    let along = corners.map(|c| c.dot(u));
-    let x_min = gamma * along.iter().cloned().fold(f64::INFINITY, f64::min);
-    let x_max = gamma * along.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let (x_min, x_max) = (gamma * a_min, gamma * a_max);
+    let rho_max = rho2_max.sqrt();
     let perp = |c: DVec3| c - c.dot(u) * u;
-    let rho_max = corners
-        .iter()
-        .map(|&c| perp(c).length())
-        .fold(0.0, f64::max);
     // |r⊥| is convex: bounded below by its supporting plane at the box centre.
     let c = now.centroid() - eye;
     let cp = perp(c);
@@ -74,12 +78,10 @@ pub fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec
         x_app(gamma, beta, x_min, rho_max),
         x_app(gamma, beta, x_max, rho_min),
     );
-    let mut b = Aabb::EMPTY;
-    for &c in &corners {
-        for x in [lo, hi] {
-            b.grow(eye + perp(c) + x * u);
-        }
-    }
+    // The prism {perpendicular offset of a corner + x u, lo ≤ x ≤ hi}: its box is the corners'
+    // perpendicular offsets' box plus the segment's.
+    let (s0, s1) = (lo * u, hi * u);
+    let b = Aabb::new(eye + perps.min + s0.min(s1), eye + perps.max + s0.max(s1));
     // A little slack for rounding.
     let pad = DVec3::splat(1e-9 * (b.max_abs() + 1.0));
     Aabb::new(b.min - pad, b.max + pad)

@@ -98,19 +98,16 @@ impl LightTree {
         }
     }
 
-    /// Every group's reach box over slice k, a little wider than the slice for rounding in
-    /// the emission times the rays are given.
-    fn boxes(&self, k: usize) -> Vec<Aabb> {
+    /// Group g's reach box over slice k, a little wider than the slice for rounding in the
+    /// emission times the rays are given.
+    fn reach(&self, k: usize) -> impl Fn(u32) -> Aabb + '_ {
         let t_a = self.t_first + k as f64 * self.width;
         let t_b = t_a + self.width;
         let pad = 1e-6 * (self.width + t_a.abs() + t_b.abs());
         let motions = self
             .motions
             .get_or_init(|| self.groups.iter().map(|(b, v)| Motion::new(b, v)).collect());
-        motions
-            .iter()
-            .map(|m| m.reach_box(self.light, t_a - pad, t_b + pad))
-            .collect()
+        move |g| motions[g as usize].reach_box(self.light, t_a - pad, t_b + pad)
     }
 
     /// Slice k's tree: the SAH build of its run of slices (at the run's middle slice), or that
@@ -118,11 +115,16 @@ impl LightTree {
     fn slice(&self, k: usize) -> &BoxTree {
         let s = k / SLICES_PER_SHAPE;
         let middle = (s * SLICES_PER_SHAPE + SLICES_PER_SHAPE / 2).min(self.slices.len() - 1);
-        let shape = self.shapes[s].get_or_init(|| BoxTree::build(&self.boxes(middle)));
+        let shape = self.shapes[s].get_or_init(|| {
+            let boxes: Vec<Aabb> = (0..self.groups.len() as u32)
+                .map(self.reach(middle))
+                .collect();
+            BoxTree::build(&boxes)
+        });
         if k == middle {
             return shape;
         }
-        self.slices[k].get_or_init(|| shape.refit(&self.boxes(k)))
+        self.slices[k].get_or_init(|| shape.refit_with(self.reach(k)))
     }
 
     /// Visit the groups a shadow ray may meet in lookback (tmin, tmax). Returns false, having
