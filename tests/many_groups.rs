@@ -308,49 +308,109 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
     let mut r = Rng(23);
     let groups: Vec<(Aabb, Velocity)> = (0..500).map(|_| random_group(&mut r, 50.0)).collect();
     let light = DVec3::new(10.0, -70.0, 30.0);
-    let tree = LightTree::new(groups.clone().into(), light, -200.0, 40.0, 32);
-    let (mut served, mut checked) = (0, 0);
-    for _ in 0..10_000 {
-        // A shadow ray from an event among the groups back to the light.
-        let o = Event::new(
-            r.range(-100.0, 40.0),
-            DVec3::new(
-                r.range(-60.0, 60.0),
-                r.range(-60.0, 60.0),
-                r.range(-60.0, 60.0),
-            ),
-        );
-        let to = light - o.x;
-        let ray = NullRay::new(o, to / to.length());
-        let tmax = to.length() * (1.0 - 1e-9);
-        let mut visited = vec![false; groups.len()];
-        let mark = |g: u32, t: f64| {
-            visited[g as usize] = true;
-            t
-        };
-        if !tree.traverse(&ray, 0.0, tmax, mark) {
-            continue;
-        }
-        served += 1;
-        for (i, (b, v)) in groups.iter().enumerate() {
-            let boost = Boost::to_rest(v);
-            let (d, _) = boost.null_dir(ray.dir);
-            if b.clip(boost.event(ray.origin).x, d.recip(), 0.0, tmax)
-                .is_some()
-            {
-                checked += 1;
-                assert!(visited[i], "group {i} is met by the shadow ray but skipped");
+    // An imaging event far in the future of every ray (each slice holds every group), and one
+    // close by, whose causal past leaves the later slices only the groups near it.
+    // Thin slices in the second case, so that a run of slices sharing a tree shape is short.
+    for (event, on_cone, slices, min_served) in [
+        (Event::new(400.0, DVec3::ZERO), 0.0, 32, 5000),
+        (
+            Event::new(60.0, DVec3::new(0.0, -40.0, 0.0)),
+            0.5,
+            512,
+            3000,
+        ),
+    ] {
+        let tree = LightTree::new(groups.clone().into(), light, event, -200.0, 40.0, slices);
+        let (mut served, mut checked) = (0, 0);
+        for _ in 0..10_000 {
+            // A shadow ray back to the light from an event among the groups, or (as from a
+            // primary hit) on the imaging event's past light cone.
+            let o = if r.f() >= on_cone {
+                Event::new(
+                    r.range(-100.0, 40.0),
+                    DVec3::new(
+                        r.range(-60.0, 60.0),
+                        r.range(-60.0, 60.0),
+                        r.range(-60.0, 60.0),
+                    ),
+                )
+            } else {
+                let back = r.range(10.0, 120.0);
+                Event::new(event.t - back, event.x + back * r.unit())
+            };
+            let to = light - o.x;
+            let ray = NullRay::new(o, to / to.length());
+            let tmax = to.length() * (1.0 - 1e-9);
+            let mut visited = vec![false; groups.len()];
+            let mark = |g: u32, t: f64| {
+                visited[g as usize] = true;
+                t
+            };
+            let in_past = (o.x - event.x).length() <= (event.t - o.t) * (1.0 + 1e-12);
+            if !tree.traverse(&ray, 0.0, tmax, mark) {
+                continue;
+            }
+            assert!(
+                in_past,
+                "a ray from outside the imaging event's past was served"
+            );
+            served += 1;
+            for (i, (b, v)) in groups.iter().enumerate() {
+                let boost = Boost::to_rest(v);
+                let (d, _) = boost.null_dir(ray.dir);
+                if b.clip(boost.event(ray.origin).x, d.recip(), 0.0, tmax)
+                    .is_some()
+                {
+                    checked += 1;
+                    assert!(visited[i], "group {i} is met by the shadow ray but skipped");
+                }
             }
         }
+        // Rays that left the light before -200 or after 40 are not served (the kinetic trees
+        // take them), nor rays from outside the imaging event's causal past.
+        assert!(served > min_served, "enough rays are served ({served})");
+        assert!(
+            checked > min_served / 4,
+            "enough ray-group meetings were checked ({checked})"
+        );
+        // A ray that does not head for the light is never served.
+        let o = Event::new(0.0, DVec3::ZERO);
+        let off = NullRay::new(o, (light - o.x).normalize() + DVec3::new(0.0, 0.0, 1e-3));
+        assert!(!tree.traverse(&off, 0.0, 10.0, |_, t| t));
     }
-    // Rays left the light before -200 or after 40 are not served (the kinetic trees take them).
-    assert!(served > 5000, "most rays are served ({served})");
-    assert!(
-        checked > 1500,
-        "enough ray-group meetings were checked ({checked})"
-    );
-    // A ray that does not head for the light is never served.
-    let o = Event::new(0.0, DVec3::ZERO);
-    let off = NullRay::new(o, (light - o.x).normalize() + DVec3::new(0.0, 0.0, 1e-3));
-    assert!(!tree.traverse(&off, 0.0, 10.0, |_, t| t));
+}
+
+#[test]
+fn refitted_trees_bound_their_new_boxes() {
+    use rest_embree::geometry::BoxTree;
+    let mut r = Rng(29);
+    let boxes: Vec<Aabb> = (0..300).map(|_| random_group(&mut r, 40.0).0).collect();
+    let tree = BoxTree::build(&boxes);
+    let moved: Vec<Aabb> = boxes
+        .iter()
+        .map(|b| {
+            let d = DVec3::new(r.range(-5.0, 5.0), r.range(-5.0, 5.0), r.range(-5.0, 5.0));
+            Aabb::new(b.min + d, b.max + d)
+        })
+        .collect();
+    let refit = tree.refit_with(|k| moved[k as usize]);
+    assert_eq!(refit.indices, tree.indices);
+    // Every node holds exactly the union of the moved boxes beneath it.
+    fn under(t: &BoxTree, i: usize, boxes: &[Aabb]) -> Aabb {
+        let n = &t.nodes[i];
+        if n.count > 0 {
+            t.indices[n.first as usize..(n.first + n.count) as usize]
+                .iter()
+                .fold(Aabb::EMPTY, |b, &k| b.union(&boxes[k as usize]))
+        } else {
+            under(t, n.first as usize, boxes).union(&under(t, n.first as usize + 1, boxes))
+        }
+    }
+    for i in 0..refit.nodes.len() {
+        let (want, got) = (under(&refit, i, &moved), refit.nodes[i].bounds);
+        assert_eq!((got.min, got.max), (want.min, want.max), "node {i}");
+    }
+    // A tree of nothing refits to a tree of nothing.
+    let empty = BoxTree::build(&[]).refit_with(|_| unreachable!());
+    assert!(empty.indices.is_empty());
 }

@@ -45,6 +45,11 @@ impl Aabb {
         Aabb::new(lower(self.min, o.min), upper(self.max, o.max))
     }
 
+    /// Whether the two boxes share a point.
+    pub fn overlaps(&self, o: &Aabb) -> bool {
+        self.min.cmple(o.max).all() && o.min.cmple(self.max).all()
+    }
+
     pub fn grow(&mut self, p: DVec3) {
         self.min = lower(self.min, p);
         self.max = upper(self.max, p);

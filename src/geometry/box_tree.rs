@@ -93,6 +93,13 @@ impl BoxTree {
     /// have not moved much.
     pub fn refit_with(&self, mut box_of: impl FnMut(u32) -> Aabb) -> BoxTree {
         let mut nodes = self.nodes.clone();
+        if self.indices.is_empty() {
+            // The tree of no items: a lone root that is no interior node.
+            return BoxTree {
+                nodes,
+                indices: Vec::new(),
+            };
+        }
         for n in nodes.iter_mut().filter(|n| n.count > 0) {
             let (first, count) = (n.first as usize, n.count as usize);
             n.bounds = self.indices[first..first + count]

@@ -18,7 +18,7 @@
 use super::apparent_tree::apparent_box_along;
 use super::group_tree::world_box;
 use crate::geometry::{Aabb, BoxTree};
-use crate::spacetime::{NullRay, Velocity};
+use crate::spacetime::{Event, NullRay, Velocity};
 use glam::DVec3;
 use std::sync::{Arc, OnceLock};
 
@@ -27,12 +27,20 @@ const SLICES_PER_SHAPE: usize = 8;
 
 pub struct LightTree {
     light: DVec3,
+    /// The imaging event: every shading point lies in its causal past.
+    event: Event,
     t_first: f64,
     width: f64,
     groups: Arc<[(Aabb, Velocity)]>,
     motions: OnceLock<Vec<Motion>>,
-    shapes: Vec<OnceLock<BoxTree>>,
+    shapes: Vec<OnceLock<Shape>>,
     slices: Vec<OnceLock<BoxTree>>,
+}
+
+/// A run of slices' tree shape, over the groups (`members`) the run's rays can reach.
+struct Shape {
+    members: Vec<u32>,
+    tree: BoxTree,
 }
 
 /// A group's motion, worked out once for the many slices: its world-frame box at time 0, and
@@ -80,6 +88,7 @@ impl LightTree {
     pub fn new(
         groups: Arc<[(Aabb, Velocity)]>,
         light: DVec3,
+        event: Event,
         t_first: f64,
         t_last: f64,
         count: usize,
@@ -87,6 +96,7 @@ impl LightTree {
         let count = count.max(1);
         LightTree {
             light,
+            event,
             t_first,
             width: (t_last - t_first) / count as f64,
             groups,
@@ -98,33 +108,88 @@ impl LightTree {
         }
     }
 
-    /// Group g's reach box over slice k, a little wider than the slice for rounding in the
+    /// Rounding slack: in emission times, and in how far outside the imaging event's causal past
+    /// a shading point may lie (a shadow ray starts a hair off its surface).
+    fn slack(&self) -> f64 {
+        1e-6 * (1.0
+            + self.event.t.abs()
+            + self.event.x.abs().max_element()
+            + (self.event.t - self.t_first).abs()
+            + (self.light - self.event.x).length())
+    }
+
+    /// Group g's reach box for emission times in [t_a, t_b], a little wider for rounding in the
     /// emission times the rays are given.
-    fn reach(&self, k: usize) -> impl Fn(u32) -> Aabb + '_ {
-        let t_a = self.t_first + k as f64 * self.width;
-        let t_b = t_a + self.width;
-        let pad = 1e-6 * (self.width + t_a.abs() + t_b.abs());
+    fn reach(&self, t_a: f64, t_b: f64) -> impl Fn(u32) -> Aabb + '_ {
+        let pad = self.slack();
         let motions = self
             .motions
             .get_or_init(|| self.groups.iter().map(|(b, v)| Motion::new(b, v)).collect());
         move |g| motions[g as usize].reach_box(self.light, t_a - pad, t_b + pad)
     }
 
-    /// Slice k's tree: the SAH build of its run of slices (at the run's middle slice), or that
-    /// tree refitted to slice k's boxes.
-    fn slice(&self, k: usize) -> &BoxTree {
+    /// Slice k's emission times.
+    fn span(&self, k: usize) -> (f64, f64) {
+        let t_a = self.t_first + k as f64 * self.width;
+        (t_a, t_a + self.width)
+    }
+
+    /// The box around everything a shadow ray that left the light at t_e or later can pass:
+    /// its points x (at time t) lie in the imaging event's causal past, and t = t_e + |x − L|,
+    /// so |x − L| + |x − E| ≤ t_E − t_e: an ellipsoid with foci L and E. None when empty.
+    fn causal_box(&self, t_e: f64) -> Option<Aabb> {
+        let sum = self.event.t - t_e + 2.0 * self.slack();
+        let axis = self.event.x - self.light;
+        let focal = axis.length();
+        if sum < focal {
+            return None;
+        }
+        let (a, c) = (0.5 * sum, 0.5 * focal);
+        let b2 = (a * a - c * c).max(0.0);
+        let f = if focal > 0.0 {
+            axis / focal
+        } else {
+            DVec3::ZERO
+        };
+        let half = (a * a * f * f + b2 * (DVec3::ONE - f * f)).map(f64::sqrt);
+        let centre = 0.5 * (self.light + self.event.x);
+        Some(Aabb::new(centre - half, centre + half))
+    }
+
+    /// Slice k's tree: the SAH build of its run of slices (at the run's middle slice, over the
+    /// groups the run's rays can reach), or that tree refitted to slice k's boxes.
+    fn slice(&self, k: usize) -> (&BoxTree, &[u32]) {
         let s = k / SLICES_PER_SHAPE;
-        let middle = (s * SLICES_PER_SHAPE + SLICES_PER_SHAPE / 2).min(self.slices.len() - 1);
+        let first = s * SLICES_PER_SHAPE;
+        let last = (first + SLICES_PER_SHAPE).min(self.slices.len()) - 1;
+        let middle = (first + SLICES_PER_SHAPE / 2).min(last);
         let shape = self.shapes[s].get_or_init(|| {
-            let boxes: Vec<Aabb> = (0..self.groups.len() as u32)
-                .map(self.reach(middle))
-                .collect();
-            BoxTree::build(&boxes)
+            let members: Vec<u32> = match self.causal_box(self.span(first).0) {
+                Some(region) => {
+                    let whole = self.reach(self.span(first).0, self.span(last).1);
+                    (0..self.groups.len() as u32)
+                        .filter(|&g| whole(g).overlaps(&region))
+                        .collect()
+                }
+                None => Vec::new(),
+            };
+            let (t_a, t_b) = self.span(middle);
+            let reach = self.reach(t_a, t_b);
+            let boxes: Vec<Aabb> = members.iter().map(|&g| reach(g)).collect();
+            Shape {
+                tree: BoxTree::build(&boxes),
+                members,
+            }
         });
         if k == middle {
-            return shape;
+            return (&shape.tree, &shape.members);
         }
-        self.slices[k].get_or_init(|| shape.refit_with(self.reach(k)))
+        let tree = self.slices[k].get_or_init(|| {
+            let (t_a, t_b) = self.span(k);
+            let reach = self.reach(t_a, t_b);
+            shape.tree.refit_with(|i| reach(shape.members[i as usize]))
+        });
+        (tree, &shape.members)
     }
 
     /// Visit the groups a shadow ray may meet in lookback (tmin, tmax). Returns false, having
@@ -149,8 +214,16 @@ impl LightTree {
         if !(k >= 0.0 && k < self.slices.len() as f64) {
             return false;
         }
-        self.slice(k as usize)
-            .traverse(ray.origin.x, ray.dir, tmin, tmax, visit);
+        // Only rays from the imaging event's causal past (as every shading point is).
+        let o = ray.origin;
+        if (o.x - self.event.x).length() > self.event.t - o.t + self.slack() {
+            return false;
+        }
+        let (tree, members) = self.slice(k as usize);
+        let mut visit = visit;
+        tree.traverse(ray.origin.x, ray.dir, tmin, tmax, |i, t| {
+            visit(members[i as usize], t)
+        });
         true
     }
 }

@@ -294,7 +294,14 @@ impl World {
                 .map(|l| {
                     l.velocity.is_zero().then(|| {
                         let t_first = event.t - 2.0 * deepest - (l.position - event.x).length();
-                        LightTree::new(items.clone(), l.position, t_first, event.t, LIGHT_SLICES)
+                        LightTree::new(
+                            items.clone(),
+                            l.position,
+                            event,
+                            t_first,
+                            event.t,
+                            LIGHT_SLICES,
+                        )
                     })
                 })
                 .collect();
