@@ -414,3 +414,34 @@ fn refitted_trees_bound_their_new_boxes() {
     let empty = BoxTree::build(&[]).refit_with(|_| unreachable!());
     assert!(empty.indices.is_empty());
 }
+
+#[test]
+fn shadows_toward_a_moving_light_are_the_same_with_the_trees() {
+    // A moving light has no light tree: its shadow rays take the kinetic trees.
+    let text = many_groups_scene(120).replace(
+        "[[light]]\nposition = [0, -20, 30]\n",
+        "[[light]]\nposition = [0, -20, 30]\nvelocity = [0.4, 0, 0.2]\n",
+    );
+    assert!(text.contains("velocity = [0.4, 0, 0.2]"));
+    let s = scene(&text);
+    let backend = rest_embree::accel::backend_by_name("bvh").unwrap();
+    let options = |group_tree| WorldOptions {
+        merge_equal_velocities: false,
+        group_tree,
+        ..Default::default()
+    };
+    let plain = World::build_with(&s, backend.as_ref(), options(false)).unwrap();
+    let fast = World::build_with(&s, backend.as_ref(), options(true)).unwrap();
+    assert!(fast.uses_group_tree());
+    let (a, b) = (render_world(&s, &plain).0, render_world(&s, &fast).0);
+    let lit = a
+        .pixels
+        .iter()
+        .filter(|p| p.color.iter().any(|&c| c > 0.05))
+        .count();
+    assert!(
+        lit > 500,
+        "the light reaches the objects ({lit} lit pixels)"
+    );
+    assert_eq!(a, b, "the trees change no bit");
+}
