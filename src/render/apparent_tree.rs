@@ -139,19 +139,24 @@ impl ApparentTree {
         for (i, d) in dirs.iter().take(n).enumerate() {
             inv[i] = d.recip();
         }
-        let hits_node = |b: &Aabb, tmax: &[f64]| -> u32 {
-            let mut mask = 0u32;
-            for i in 0..n {
+        // Only the rays that met the parent can meet a child: each node tests those alone.
+        let hits_node = |b: &Aabb, tmax: &[f64], parent: u32| -> u32 {
+            let (mut mask, mut rest) = (0u32, parent);
+            while rest != 0 {
+                let i = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
                 mask |= u32::from(b.clip(o, inv[i], tmin, tmax[i]).is_some()) << i;
             }
             mask
         };
-        let mut stack = [0u32; 128];
+        let mut stack = [(0u32, 0u32); 128];
+        stack[0] = (0, (1u32 << n) - 1); // n ≤ PACKET < 32
         let mut sp = 1;
         while sp > 0 {
             sp -= 1;
-            let node = nodes[stack[sp] as usize];
-            let mask = hits_node(&node.bounds, tmax);
+            let (index, parent) = stack[sp];
+            let node = nodes[index as usize];
+            let mask = hits_node(&node.bounds, tmax, parent);
             if mask == 0 {
                 continue;
             }
@@ -159,15 +164,16 @@ impl ApparentTree {
                 for &g in
                     &self.tree.indices[node.first as usize..(node.first + node.count) as usize]
                 {
-                    for (i, t) in tmax.iter_mut().enumerate().take(n) {
-                        if mask & (1 << i) != 0 {
-                            *t = visit(g, i, *t);
-                        }
+                    let mut rest = mask;
+                    while rest != 0 {
+                        let i = rest.trailing_zeros() as usize;
+                        rest &= rest - 1;
+                        tmax[i] = visit(g, i, tmax[i]);
                     }
                 }
             } else if sp + 2 <= stack.len() {
-                stack[sp] = node.first + 1;
-                stack[sp + 1] = node.first;
+                stack[sp] = (node.first + 1, mask);
+                stack[sp + 1] = (node.first, mask);
                 sp += 2;
             } else {
                 // Deeper than any tree built here; fall back to one ray at a time.
