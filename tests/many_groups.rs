@@ -377,6 +377,74 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
         let o = Event::new(0.0, DVec3::ZERO);
         let off = NullRay::new(o, (light - o.x).normalize() + DVec3::new(0.0, 0.0, 1e-3));
         assert!(!tree.traverse(&off, 0.0, 10.0, |_, t| t));
+
+        // In packets: the same rays served, and every group a ray meets offered to the test.
+        let rays: Vec<NullRay> = (0..2000)
+            .map(|_| {
+                let back = r.range(10.0, 120.0);
+                let o = if r.f() >= on_cone {
+                    Event::new(
+                        r.range(-100.0, 40.0),
+                        DVec3::new(
+                            r.range(-60.0, 60.0),
+                            r.range(-60.0, 60.0),
+                            r.range(-60.0, 60.0),
+                        ),
+                    )
+                } else {
+                    Event::new(event.t - back, event.x + back * r.unit())
+                };
+                let to = light - o.x;
+                NullRay::new(o, to / to.length())
+            })
+            .collect();
+        let tmax: Vec<f64> = rays
+            .iter()
+            .map(|ray| (light - ray.origin.x).length() * (1.0 - 1e-9))
+            .collect();
+        let (mut served, mut blocked) = (vec![false; rays.len()], vec![false; rays.len()]);
+        let mut offered = vec![Vec::new(); rays.len()];
+        tree.occluded_many(&rays, &tmax, &mut served, &mut blocked, |g, i| {
+            offered[i].push(g as usize);
+            false
+        });
+        assert!(
+            blocked.iter().all(|&b| !b),
+            "nothing blocks when the test never holds"
+        );
+        let mut met = 0;
+        for (i, ray) in rays.iter().enumerate() {
+            assert_eq!(
+                served[i],
+                tree.traverse(ray, 0.0, tmax[i], |_, t| t),
+                "ray {i}"
+            );
+            if !served[i] {
+                continue;
+            }
+            for (g, (b, v)) in groups.iter().enumerate() {
+                let boost = Boost::to_rest(v);
+                let (d, _) = boost.null_dir(ray.dir);
+                if b.clip(boost.event(ray.origin).x, d.recip(), 0.0, tmax[i])
+                    .is_some()
+                {
+                    met += 1;
+                    assert!(offered[i].contains(&g), "packets skip group {g} on ray {i}");
+                }
+            }
+        }
+        assert!(met > 100, "enough meetings checked in packets ({met})");
+        // A test that holds blocks the ray, and stops offering it groups.
+        let mut offers = vec![0; rays.len()];
+        let (mut served2, mut blocked) = (vec![false; rays.len()], vec![false; rays.len()]);
+        tree.occluded_many(&rays, &tmax, &mut served2, &mut blocked, |_, i| {
+            offers[i] += 1;
+            true
+        });
+        for i in 0..rays.len() {
+            assert_eq!(blocked[i], !offered[i].is_empty(), "ray {i}");
+            assert!(offers[i] <= 1, "ray {i} was tested after it was blocked");
+        }
     }
 }
 

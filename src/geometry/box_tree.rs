@@ -53,6 +53,9 @@ use glam::DVec3;
 
 const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
+
+/// Up to this many rays traverse a tree together in [`BoxTree::traverse_packet`].
+pub const PACKET: usize = 16;
 const TRAVERSAL_COST: f64 = 1.0;
 const INTERSECT_COST: f64 = 1.5;
 
@@ -359,5 +362,81 @@ impl BoxTree {
             tmax,
             visit,
         );
+    }
+
+    /// Traverse with a packet of up to [`PACKET`] rays from one origin `o` (directions `dirs`,
+    /// each searched in (tmin[i], tmax[i])): each node is tested with the rays that met its
+    /// parent, and descended when any meets it. `visit(item, ray, tmax)` returns the ray's new
+    /// tmax; one below its tmin drops the ray.
+    pub fn traverse_packet(
+        &self,
+        o: DVec3,
+        dirs: &[DVec3],
+        tmin: &[f64],
+        tmax: &mut [f64],
+        mut visit: impl FnMut(u32, usize, f64) -> f64,
+    ) {
+        let nodes = &self.nodes;
+        if nodes.is_empty() || self.indices.is_empty() {
+            return;
+        }
+        let n = dirs.len().min(PACKET);
+        let mut inv = [DVec3::ZERO; PACKET];
+        for (i, d) in dirs.iter().take(n).enumerate() {
+            inv[i] = d.recip();
+        }
+        let hits_node = |b: &Aabb, tmax: &[f64], parent: u32| -> u32 {
+            let (mut mask, mut rest) = (0u32, parent);
+            while rest != 0 {
+                let i = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                mask |= u32::from(b.clip(o, inv[i], tmin[i], tmax[i]).is_some()) << i;
+            }
+            mask
+        };
+        let mut stack = [(0u32, 0u32); 128];
+        stack[0] = (0, (1u32 << n) - 1); // n ≤ PACKET < 32
+        let mut sp = 1;
+        while sp > 0 {
+            sp -= 1;
+            let (index, parent) = stack[sp];
+            let node = nodes[index as usize];
+            let mask = hits_node(&node.bounds, tmax, parent);
+            if mask == 0 {
+                continue;
+            }
+            if node.count > 0 {
+                let mut live = mask;
+                for &item in &self.indices[node.first as usize..(node.first + node.count) as usize]
+                {
+                    let mut rest = live;
+                    while rest != 0 {
+                        let i = rest.trailing_zeros() as usize;
+                        rest &= rest - 1;
+                        tmax[i] = visit(item, i, tmax[i]);
+                        if tmax[i] < tmin[i] {
+                            live &= !(1 << i);
+                        }
+                    }
+                }
+            } else if sp + 2 <= stack.len() {
+                stack[sp] = (node.first + 1, mask);
+                stack[sp + 1] = (node.first, mask);
+                sp += 2;
+            } else {
+                // Deeper than any tree built here; fall back to one ray at a time.
+                let mut rest = mask;
+                while rest != 0 {
+                    let i = rest.trailing_zeros() as usize;
+                    rest &= rest - 1;
+                    let mut t = tmax[i];
+                    self.traverse(o, dirs[i], tmin[i], t, |item, tm| {
+                        t = visit(item, i, tm);
+                        t
+                    });
+                    tmax[i] = t;
+                }
+            }
+        }
     }
 }

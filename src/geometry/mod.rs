@@ -8,7 +8,7 @@ mod box_tree;
 mod primitive;
 
 pub use aabb::Aabb;
-pub use box_tree::{walk, BoxTree, TreeNode};
+pub use box_tree::{walk, BoxTree, TreeNode, PACKET};
 #[cfg(feature = "embree")]
 pub(crate) use primitive::{capsule_hit, cuboid_hit};
 pub use primitive::{Geometry, Part, Primitive};

@@ -116,79 +116,21 @@ impl ApparentTree {
 }
 
 /// Up to this many primary rays traverse the apparent tree together.
-pub const PACKET: usize = 16;
+pub const PACKET: usize = crate::geometry::PACKET;
 
 impl ApparentTree {
-    /// Traverse with a packet of primary rays (all starting at the imaging event): each node is
-    /// tested against every ray still active in one loop, and descended when any ray meets it.
-    /// `visit(group, ray, tmax)` returns the ray's new tmax (best hit so far).
+    /// Traverse with a packet of primary rays (all starting at the imaging event): see
+    /// [`BoxTree::traverse_packet`]. `visit(group, ray, tmax)` returns the ray's new tmax (best
+    /// hit so far).
     pub fn traverse_packet(
         &self,
         dirs: &[glam::DVec3],
         tmin: f64,
         tmax: &mut [f64],
-        mut visit: impl FnMut(u32, usize, f64) -> f64,
+        visit: impl FnMut(u32, usize, f64) -> f64,
     ) {
-        let nodes = &self.tree.nodes;
-        if nodes.is_empty() || self.tree.indices.is_empty() {
-            return;
-        }
-        let n = dirs.len().min(PACKET);
-        let o = self.event.x;
-        let mut inv = [glam::DVec3::ZERO; PACKET];
-        for (i, d) in dirs.iter().take(n).enumerate() {
-            inv[i] = d.recip();
-        }
-        // Only the rays that met the parent can meet a child: each node tests those alone.
-        let hits_node = |b: &Aabb, tmax: &[f64], parent: u32| -> u32 {
-            let (mut mask, mut rest) = (0u32, parent);
-            while rest != 0 {
-                let i = rest.trailing_zeros() as usize;
-                rest &= rest - 1;
-                mask |= u32::from(b.clip(o, inv[i], tmin, tmax[i]).is_some()) << i;
-            }
-            mask
-        };
-        let mut stack = [(0u32, 0u32); 128];
-        stack[0] = (0, (1u32 << n) - 1); // n ≤ PACKET < 32
-        let mut sp = 1;
-        while sp > 0 {
-            sp -= 1;
-            let (index, parent) = stack[sp];
-            let node = nodes[index as usize];
-            let mask = hits_node(&node.bounds, tmax, parent);
-            if mask == 0 {
-                continue;
-            }
-            if node.count > 0 {
-                for &g in
-                    &self.tree.indices[node.first as usize..(node.first + node.count) as usize]
-                {
-                    let mut rest = mask;
-                    while rest != 0 {
-                        let i = rest.trailing_zeros() as usize;
-                        rest &= rest - 1;
-                        tmax[i] = visit(g, i, tmax[i]);
-                    }
-                }
-            } else if sp + 2 <= stack.len() {
-                stack[sp] = (node.first + 1, mask);
-                stack[sp + 1] = (node.first, mask);
-                sp += 2;
-            } else {
-                // Deeper than any tree built here; fall back to one ray at a time.
-                for i in 0..n {
-                    if mask & (1 << i) != 0 {
-                        let ray = NullRay::new(self.event, dirs[i]);
-                        let mut t = tmax[i];
-                        self.tree.traverse(ray.origin.x, ray.dir, tmin, t, |g, tm| {
-                            t = visit(g, i, tm);
-                            t
-                        });
-                        tmax[i] = t;
-                    }
-                }
-            }
-        }
+        let tmins = [tmin; PACKET];
+        self.tree
+            .traverse_packet(self.event.x, dirs, &tmins, tmax, visit);
     }
 }

@@ -17,7 +17,7 @@
 
 use super::apparent_tree::apparent_box_along;
 use super::group_tree::world_box;
-use crate::geometry::{Aabb, BoxTree};
+use crate::geometry::{Aabb, BoxTree, PACKET};
 use crate::spacetime::{Event, NullRay, Velocity};
 use glam::DVec3;
 use std::sync::{Arc, OnceLock};
@@ -125,7 +125,12 @@ impl LightTree {
         let motions = self
             .motions
             .get_or_init(|| self.groups.iter().map(|(b, v)| Motion::new(b, v)).collect());
-        move |g| motions[g as usize].reach_box(self.light, t_a - pad, t_b + pad)
+        // Also padded in space: packets walk the rays backwards from the light, which the
+        // rays reach only to within rounding.
+        move |g| {
+            let b = motions[g as usize].reach_box(self.light, t_a - pad, t_b + pad);
+            Aabb::new(b.min - DVec3::splat(pad), b.max + DVec3::splat(pad))
+        }
     }
 
     /// Slice k's emission times.
@@ -192,38 +197,96 @@ impl LightTree {
         (tree, &shape.members)
     }
 
-    /// Visit the groups a shadow ray may meet in lookback (tmin, tmax). Returns false, having
-    /// visited nothing, when this tree cannot serve the ray: it does not head for this light,
-    /// would pass it before tmax, or left it at a time outside the slices.
-    pub fn traverse(
-        &self,
-        ray: &NullRay,
-        tmin: f64,
-        tmax: f64,
-        visit: impl FnMut(u32, f64) -> f64,
-    ) -> bool {
-        // Lookback (= distance, the light being at rest) at which the ray reaches the light.
+    /// The slice a shadow ray left the light in and its lookback to the light (= distance, the
+    /// light being at rest), if this tree serves the ray: it heads for this light, does not
+    /// pass it before tmax, left it within the slices, and starts in the imaging event's causal
+    /// past (as every shading point does).
+    fn serves(&self, ray: &NullRay, tmax: f64) -> Option<(usize, f64)> {
         let reach = (self.light - ray.origin.x).length();
         let end = ray.at(reach);
         let miss = (end.x - self.light).length();
         let scale = reach + self.light.abs().max_element() + 1.0;
         if !(miss <= 1e-9 * scale && tmax <= reach) {
-            return false;
+            return None;
         }
         let k = ((end.t - self.t_first) / self.width).floor();
         if !(k >= 0.0 && k < self.slices.len() as f64) {
-            return false;
+            return None;
         }
-        // Only rays from the imaging event's causal past (as every shading point is).
         let o = ray.origin;
         if (o.x - self.event.x).length() > self.event.t - o.t + self.slack() {
-            return false;
+            return None;
         }
-        let (tree, members) = self.slice(k as usize);
-        let mut visit = visit;
+        Some((k as usize, reach))
+    }
+
+    /// Visit the groups a shadow ray may meet in lookback (tmin, tmax). Returns false, having
+    /// visited nothing, when this tree does not serve the ray.
+    pub fn traverse(
+        &self,
+        ray: &NullRay,
+        tmin: f64,
+        tmax: f64,
+        mut visit: impl FnMut(u32, f64) -> f64,
+    ) -> bool {
+        let Some((k, _)) = self.serves(ray, tmax) else {
+            return false;
+        };
+        let (tree, members) = self.slice(k);
         tree.traverse(ray.origin.x, ray.dir, tmin, tmax, |i, t| {
             visit(members[i as usize], t)
         });
         true
+    }
+
+    /// Many shadow rays toward this light (lookback from 0 to `tmax[i]`), in packets: the
+    /// rays of one slice, read backwards, all start at the light. For each ray this tree
+    /// serves, `served[i]` is set, and `blocked[i]` too when `test(group, i)` holds for a group
+    /// the ray may meet; the others are left alone.
+    pub fn occluded_many(
+        &self,
+        rays: &[NullRay],
+        tmax: &[f64],
+        served: &mut [bool],
+        blocked: &mut [bool],
+        mut test: impl FnMut(u32, usize) -> bool,
+    ) {
+        let mut order: Vec<(usize, usize, f64)> = rays
+            .iter()
+            .zip(tmax)
+            .enumerate()
+            .filter_map(|(i, (r, &t))| self.serves(r, t).map(|(k, reach)| (k, i, reach)))
+            .collect();
+        order.sort_unstable_by_key(|&(k, i, _)| (k, i));
+        for run in order.chunk_by(|a, b| a.0 == b.0) {
+            let (tree, members) = self.slice(run[0].0);
+            for chunk in run.chunks(PACKET) {
+                let m = chunk.len();
+                let (mut dirs, mut near, mut far) =
+                    ([DVec3::ZERO; PACKET], [0.0; PACKET], [0.0; PACKET]);
+                for (j, &(_, i, reach)) in chunk.iter().enumerate() {
+                    // Lookback λ in (0, tmax) is s = reach − λ from the light.
+                    served[i] = true;
+                    dirs[j] = -rays[i].dir;
+                    near[j] = reach - tmax[i];
+                    far[j] = reach;
+                }
+                tree.traverse_packet(
+                    self.light,
+                    &dirs[..m],
+                    &near[..m],
+                    &mut far[..m],
+                    |g, j, t| {
+                        let i = chunk[j].1;
+                        if test(members[g as usize], i) {
+                            blocked[i] = true;
+                            f64::NEG_INFINITY
+                        } else {
+                            t
+                        }
+                    },
+                );
+            }
+        }
     }
 }

@@ -581,15 +581,24 @@ impl World {
         self.occluded(ray, 0.0, tmax)
     }
 
-    /// [`World::shadowed`] for many rays toward one light (lookback from 0 to `tmax[i]`).
+    /// [`World::shadowed`] for many rays toward one light (lookback from 0 to `tmax[i]`): with
+    /// a light tree, in packets per slice of emission times.
     pub fn shadowed_many(&self, light: usize, rays: &[NullRay], tmax: &[f64], out: &mut [bool]) {
-        if matches!(self.light_trees.get(light), Some(Some(_))) {
-            for ((r, &t), o) in rays.iter().zip(tmax).zip(out.iter_mut()) {
-                *o = self.shadowed(light, r, t);
+        let Some(Some(lt)) = self.light_trees.get(light) else {
+            return self.occluded_many(rays, tmax, out);
+        };
+        let mut served = vec![false; rays.len()];
+        out.iter_mut().for_each(|o| *o = false);
+        lt.occluded_many(rays, tmax, &mut served, out, |gi, i| {
+            let g = &self.groups[gi as usize];
+            self.rest_ray(g, &rays[i], 0.0, tmax[i])
+                .is_some_and(|rr| g.occluded1(&rr.ray))
+        });
+        for (i, o) in out.iter_mut().enumerate() {
+            if !served[i] {
+                *o = self.occluded(&rays[i], 0.0, tmax[i]);
             }
-            return;
         }
-        self.occluded_many(rays, tmax, out);
     }
 
     /// Whether anything lies on the ray between lookback `tmin` and `tmax`.
