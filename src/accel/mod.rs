@@ -13,7 +13,7 @@ pub use bvh::{Bvh, BvhBackend};
 #[cfg(feature = "embree")]
 pub use embree::{BareRay, EmbreeAccel, EmbreeBackend};
 
-use crate::geometry::Geometry;
+use crate::geometry::{Aabb, BoxTree, Geometry};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -56,6 +56,52 @@ pub trait Accelerator: Send + Sync {
 pub trait Backend: Send + Sync {
     fn name(&self) -> &'static str;
     fn build(&self, geometry: Arc<Geometry>) -> Result<Box<dyn Accelerator>, String>;
+    /// What builds culling structures over boxes (the trees over many velocity groups), also
+    /// later, on first use; by default the f64 box tree.
+    fn cullers(&self) -> CullerFactory {
+        Arc::new(|boxes| Ok(Box::new(BoxTree::build(boxes)) as Box<dyn BoxCuller>))
+    }
+}
+
+/// Builds a [`BoxCuller`] over boxes.
+pub type CullerFactory = Arc<dyn Fn(&[Aabb]) -> Result<Box<dyn BoxCuller>, String> + Send + Sync>;
+
+/// A culling structure over boxes, one per item, that packets of rays from one origin `o`
+/// traverse (directions `dirs`, each searched in (tmin[i], tmax[i])): `visit(item, ray, tmax)`
+/// tests an item exactly and returns the ray's new tmax; one below the ray's tmin ends the ray.
+/// Every item whose box a ray meets before its tmax is visited (rounding may add others).
+pub trait BoxCuller: Send + Sync {
+    fn traverse_packet(
+        &self,
+        o: DVec3,
+        dirs: &[DVec3],
+        tmin: &[f64],
+        tmax: &mut [f64],
+        visit: &mut dyn FnMut(u32, usize, f64) -> f64,
+    );
+
+    /// The same structure over other boxes of the same items (`box_of(item)`), if it can be
+    /// refitted far more cheaply than built; None: build anew.
+    fn refitted(&self, _box_of: &mut dyn FnMut(u32) -> Aabb) -> Option<Box<dyn BoxCuller>> {
+        None
+    }
+}
+
+impl BoxCuller for BoxTree {
+    fn traverse_packet(
+        &self,
+        o: DVec3,
+        dirs: &[DVec3],
+        tmin: &[f64],
+        tmax: &mut [f64],
+        visit: &mut dyn FnMut(u32, usize, f64) -> f64,
+    ) {
+        BoxTree::traverse_packet(self, o, dirs, tmin, tmax, visit)
+    }
+
+    fn refitted(&self, box_of: &mut dyn FnMut(u32) -> Aabb) -> Option<Box<dyn BoxCuller>> {
+        Some(Box::new(self.refit_with(box_of)))
+    }
 }
 
 /// The names `--backend` accepts in this build, default first.

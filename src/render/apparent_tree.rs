@@ -5,13 +5,15 @@
 //! is the lookback, so it doubles as the distance), finds the groups a primary ray can meet.
 
 use super::group_tree::world_box;
-use crate::geometry::{Aabb, BoxTree};
+use crate::accel::{BoxCuller, CullerFactory};
+use crate::geometry::Aabb;
 use crate::spacetime::{Event, NullRay, Velocity};
 use glam::DVec3;
 
 pub struct ApparentTree {
     event: Event,
-    tree: BoxTree,
+    /// The backend's culling structure over the apparent boxes.
+    tree: Box<dyn BoxCuller>,
 }
 
 /// x_app = γ(X − β·sqrt(X² + ρ²)) (PHYSICS.md §2.1), without cancellation for X > 0.
@@ -88,15 +90,21 @@ pub fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec
 }
 
 impl ApparentTree {
-    pub fn build(groups: &[(Aabb, Velocity)], event: Event) -> ApparentTree {
+    /// Over the apparent boxes of `groups` seen from `event`, in the backend's culling
+    /// structure (Embree's BVH, or the f64 box tree).
+    pub fn build(
+        groups: &[(Aabb, Velocity)],
+        event: Event,
+        cullers: &CullerFactory,
+    ) -> Result<ApparentTree, String> {
         let boxes: Vec<Aabb> = groups
             .iter()
             .map(|(b, v)| apparent_box(b, v, event))
             .collect();
-        ApparentTree {
+        Ok(ApparentTree {
             event,
-            tree: BoxTree::build(&boxes),
-        }
+            tree: cullers(&boxes)?,
+        })
     }
 
     /// Whether this tree serves the ray (it starts at the imaging event).
@@ -104,33 +112,38 @@ impl ApparentTree {
         ray.origin == self.event
     }
 
+    /// One ray (starting at the imaging event): `visit(group, tmax)` returns its new tmax.
     pub fn traverse(
         &self,
         ray: &NullRay,
         tmin: f64,
         tmax: f64,
-        visit: impl FnMut(u32, f64) -> f64,
+        mut visit: impl FnMut(u32, f64) -> f64,
     ) {
-        self.tree.traverse(ray.origin.x, ray.dir, tmin, tmax, visit);
+        let mut t = [tmax];
+        self.tree.traverse_packet(
+            self.event.x,
+            &[ray.dir],
+            &[tmin],
+            &mut t,
+            &mut |g, _, tm| visit(g, tm),
+        );
     }
-}
 
-/// Up to this many primary rays traverse the apparent tree together.
-pub const PACKET: usize = crate::geometry::PACKET;
-
-impl ApparentTree {
-    /// Traverse with a packet of primary rays (all starting at the imaging event): see
-    /// [`BoxTree::traverse_packet`]. `visit(group, ray, tmax)` returns the ray's new tmax (best
-    /// hit so far).
+    /// Traverse with a packet of up to [`PACKET`] primary rays (all starting at the imaging
+    /// event): `visit(group, ray, tmax)` returns the ray's new tmax (best hit so far).
     pub fn traverse_packet(
         &self,
         dirs: &[glam::DVec3],
         tmin: f64,
         tmax: &mut [f64],
-        visit: impl FnMut(u32, usize, f64) -> f64,
+        mut visit: impl FnMut(u32, usize, f64) -> f64,
     ) {
         let tmins = [tmin; PACKET];
         self.tree
-            .traverse_packet(self.event.x, dirs, &tmins, tmax, visit);
+            .traverse_packet(self.event.x, dirs, &tmins, tmax, &mut visit);
     }
 }
+
+/// Up to this many primary rays traverse the apparent tree together.
+pub const PACKET: usize = crate::geometry::PACKET;

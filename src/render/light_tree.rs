@@ -17,7 +17,8 @@
 
 use super::apparent_tree::apparent_box_along;
 use super::group_tree::world_box;
-use crate::geometry::{Aabb, BoxTree, PACKET};
+use crate::accel::{BoxCuller, CullerFactory};
+use crate::geometry::{Aabb, PACKET};
 use crate::spacetime::{Event, NullRay, Velocity};
 use glam::DVec3;
 use std::sync::{Arc, OnceLock};
@@ -32,15 +33,17 @@ pub struct LightTree {
     t_first: f64,
     width: f64,
     groups: Arc<[(Aabb, Velocity)]>,
+    cullers: CullerFactory,
     motions: OnceLock<Vec<Motion>>,
-    shapes: Vec<OnceLock<Shape>>,
-    slices: Vec<OnceLock<BoxTree>>,
+    shapes: Vec<OnceLock<Result<Shape, String>>>,
+    slices: Vec<OnceLock<Result<Box<dyn BoxCuller>, String>>>,
 }
 
-/// A run of slices' tree shape, over the groups (`members`) the run's rays can reach.
+/// A run of slices' tree (at its middle slice), over the groups (`members`) the run's rays can
+/// reach: the other slices refit it where the backend's structure can be refitted.
 struct Shape {
     members: Vec<u32>,
-    tree: BoxTree,
+    tree: Box<dyn BoxCuller>,
 }
 
 /// A group's motion, worked out once for the many slices: its world-frame box at time 0, and
@@ -87,6 +90,7 @@ impl LightTree {
     /// [t_first, t_last].
     pub fn new(
         groups: Arc<[(Aabb, Velocity)]>,
+        cullers: CullerFactory,
         light: DVec3,
         event: Event,
         t_first: f64,
@@ -100,6 +104,7 @@ impl LightTree {
             t_first,
             width: (t_last - t_first) / count as f64,
             groups,
+            cullers,
             motions: OnceLock::new(),
             shapes: (0..count.div_ceil(SLICES_PER_SHAPE))
                 .map(|_| OnceLock::new())
@@ -161,40 +166,55 @@ impl LightTree {
         Some(Aabb::new(centre - half, centre + half))
     }
 
-    /// Slice k's tree: the SAH build of its run of slices (at the run's middle slice, over the
-    /// groups the run's rays can reach), or that tree refitted to slice k's boxes.
-    fn slice(&self, k: usize) -> (&BoxTree, &[u32]) {
+    /// Slice k's culling structure and the groups its items are: the build of its run of
+    /// slices (at the run's middle slice, over the groups the run's rays can reach), refitted to
+    /// slice k's boxes where the backend's structure allows, else built anew.
+    fn slice(&self, k: usize) -> Result<(&dyn BoxCuller, &[u32]), String> {
         let s = k / SLICES_PER_SHAPE;
         let first = s * SLICES_PER_SHAPE;
         let last = (first + SLICES_PER_SHAPE).min(self.slices.len()) - 1;
         let middle = (first + SLICES_PER_SHAPE / 2).min(last);
-        let shape = self.shapes[s].get_or_init(|| {
-            let members: Vec<u32> = match self.causal_box(self.span(first).0) {
-                Some(region) => {
-                    let whole = self.reach(self.span(first).0, self.span(last).1);
-                    (0..self.groups.len() as u32)
-                        .filter(|&g| whole(g).overlaps(&region))
-                        .collect()
-                }
-                None => Vec::new(),
-            };
-            let (t_a, t_b) = self.span(middle);
-            let reach = self.reach(t_a, t_b);
-            let boxes: Vec<Aabb> = members.iter().map(|&g| reach(g)).collect();
-            Shape {
-                tree: BoxTree::build(&boxes),
-                members,
-            }
-        });
+        let shape = self.shapes[s]
+            .get_or_init(|| {
+                let members: Vec<u32> = match self.causal_box(self.span(first).0) {
+                    Some(region) => {
+                        let whole = self.reach(self.span(first).0, self.span(last).1);
+                        (0..self.groups.len() as u32)
+                            .filter(|&g| whole(g).overlaps(&region))
+                            .collect()
+                    }
+                    None => Vec::new(),
+                };
+                let (t_a, t_b) = self.span(middle);
+                let reach = self.reach(t_a, t_b);
+                let boxes: Vec<Aabb> = members.iter().map(|&g| reach(g)).collect();
+                Ok(Shape {
+                    tree: (self.cullers)(&boxes)?,
+                    members,
+                })
+            })
+            .as_ref()
+            .map_err(|e| e.clone())?;
         if k == middle {
-            return (&shape.tree, &shape.members);
+            return Ok((shape.tree.as_ref(), &shape.members));
         }
-        let tree = self.slices[k].get_or_init(|| {
-            let (t_a, t_b) = self.span(k);
-            let reach = self.reach(t_a, t_b);
-            shape.tree.refit_with(|i| reach(shape.members[i as usize]))
-        });
-        (tree, &shape.members)
+        let tree = self.slices[k]
+            .get_or_init(|| {
+                let (t_a, t_b) = self.span(k);
+                let reach = self.reach(t_a, t_b);
+                let mut box_of = |i: u32| reach(shape.members[i as usize]);
+                match shape.tree.refitted(&mut box_of) {
+                    Some(t) => Ok(t),
+                    None => {
+                        let boxes: Vec<Aabb> =
+                            (0..shape.members.len() as u32).map(box_of).collect();
+                        (self.cullers)(&boxes)
+                    }
+                }
+            })
+            .as_ref()
+            .map_err(|e| e.clone())?;
+        Ok((tree.as_ref(), &shape.members))
     }
 
     /// The slice a shadow ray left the light in and its lookback to the light (= distance, the
@@ -220,23 +240,36 @@ impl LightTree {
         Some((k as usize, reach))
     }
 
-    /// Visit the groups a shadow ray may meet in lookback (tmin, tmax). Returns false, having
-    /// visited nothing, when this tree does not serve the ray.
-    pub fn traverse(
+    /// Offer `blocks(group)` the groups a shadow ray may meet in lookback (tmin, tmax), until
+    /// one blocks it: Some(whether one did), or None, having offered nothing, when this tree
+    /// does not serve the ray (or its slice could not be built).
+    pub fn occluded(
         &self,
         ray: &NullRay,
         tmin: f64,
         tmax: f64,
-        mut visit: impl FnMut(u32, f64) -> f64,
-    ) -> bool {
-        let Some((k, _)) = self.serves(ray, tmax) else {
-            return false;
-        };
-        let (tree, members) = self.slice(k);
-        tree.traverse(ray.origin.x, ray.dir, tmin, tmax, |i, t| {
-            visit(members[i as usize], t)
-        });
-        true
+        mut blocks: impl FnMut(u32) -> bool,
+    ) -> Option<bool> {
+        let (k, reach) = self.serves(ray, tmax)?;
+        let (tree, members) = self.slice(k).ok()?;
+        // Read backwards from the light: lookback λ is s = reach − λ.
+        let mut far = [reach - tmin];
+        let mut found = false;
+        tree.traverse_packet(
+            self.light,
+            &[-ray.dir],
+            &[reach - tmax],
+            &mut far,
+            &mut |i, _, s| {
+                if blocks(members[i as usize]) {
+                    found = true;
+                    f64::NEG_INFINITY
+                } else {
+                    s
+                }
+            },
+        );
+        Some(found)
     }
 
     /// Many shadow rays toward this light (lookback from 0 to `tmax[i]`), in packets: the
@@ -259,7 +292,10 @@ impl LightTree {
             .collect();
         order.sort_unstable_by_key(|&(k, i, _)| (k, i));
         for run in order.chunk_by(|a, b| a.0 == b.0) {
-            let (tree, members) = self.slice(run[0].0);
+            // A slice that could not be built serves none of its rays.
+            let Ok((tree, members)) = self.slice(run[0].0) else {
+                continue;
+            };
             for chunk in run.chunks(PACKET) {
                 let m = chunk.len();
                 let (mut dirs, mut near, mut far) =
@@ -276,8 +312,8 @@ impl LightTree {
                     &dirs[..m],
                     &near[..m],
                     &mut far[..m],
-                    |g, j, t| {
-                        let i = chunk[j].1;
+                    &mut |g: u32, j: usize, t: f64| {
+                        let i: usize = chunk[j].1;
                         if test(members[g as usize], i) {
                             blocked[i] = true;
                             f64::NEG_INFINITY

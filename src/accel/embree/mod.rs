@@ -10,6 +10,7 @@
 //! groups are as exact as the f64 BVH's.
 
 mod bare;
+mod culler;
 mod device;
 mod exact;
 mod packet;
@@ -17,8 +18,8 @@ mod scene;
 
 pub use bare::BareRay;
 
-use super::{Accelerator, Backend, Hit, Ray};
-use crate::geometry::Geometry;
+use super::{Accelerator, Backend, BoxCuller, CullerFactory, Hit, Ray};
+use crate::geometry::{Aabb, Geometry};
 use device::Device;
 use std::sync::{Arc, OnceLock};
 
@@ -61,6 +62,14 @@ impl Default for EmbreeBackend {
 impl Backend for EmbreeBackend {
     fn name(&self) -> &'static str {
         "embree"
+    }
+
+    fn cullers(&self) -> CullerFactory {
+        let device = self.device();
+        Arc::new(move |boxes: &[Aabb]| {
+            let device = device.clone()?;
+            Ok(Box::new(culler::EmbreeCuller::build(device, boxes)?) as Box<dyn BoxCuller>)
+        })
     }
 
     fn build(&self, geometry: Arc<Geometry>) -> Result<Box<dyn Accelerator>, String> {

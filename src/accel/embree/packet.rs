@@ -112,7 +112,7 @@ macro_rules! packet_fns {
 /// The valid mask of a packet: Embree reads it with aligned vector loads, so it needs the
 /// packet's alignment (64 bytes covers 8- and 16-wide).
 #[repr(C, align(64))]
-struct Valid<const N: usize>([i32; N]);
+pub(super) struct Valid<const N: usize>(pub [i32; N]);
 
 pub(super) trait Lane {
     fn set(&mut self, i: usize, e: &EmbreeRay);

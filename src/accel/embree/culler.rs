@@ -1,0 +1,252 @@
+//! Embree as a culling structure over boxes: one user primitive per box, whose callback hands
+//! each candidate to the caller's `visit` (the renderer's exact f64 test of a velocity group).
+//! Embree's BVH and packet traversal find the candidates far faster than the f64 box tree; the
+//! boxes are widened and the f32 rays given slack, so rounding can only add candidates, never
+//! lose one.
+
+use super::device::Device;
+use super::packet::flush_denormals;
+use crate::accel::BoxCuller;
+use crate::geometry::{Aabb, PACKET};
+use embree_sys::*;
+use glam::DVec3;
+use std::sync::Arc;
+
+/// A geometry handle released on drop.
+struct GeometryHandle(RTCGeometry);
+
+impl Drop for GeometryHandle {
+    fn drop(&mut self) {
+        unsafe { rtcReleaseGeometry(self.0) };
+    }
+}
+
+pub struct EmbreeCuller {
+    raw: RTCScene,
+    /// Embree points into these (boxes relative to `center`, widened); dropped after the scene.
+    boxes: Box<[Aabb]>,
+    center: DVec3,
+    /// Slack for f32 rounding of rays and boxes, in world units.
+    slack: f64,
+    _device: Arc<Device>,
+}
+
+// The scene is only read after its commit; Embree allows concurrent queries.
+unsafe impl Send for EmbreeCuller {}
+unsafe impl Sync for EmbreeCuller {}
+
+impl Drop for EmbreeCuller {
+    fn drop(&mut self) {
+        unsafe { rtcReleaseScene(self.raw) };
+    }
+}
+
+/// The context of a culling query: Embree's first (repr(C)), then the caller's visit and the
+/// rays' intervals by lane.
+#[repr(C)]
+struct CullContext<'a> {
+    rtc: RTCIntersectContext,
+    visit: &'a mut dyn FnMut(u32, usize, f64) -> f64,
+    tmin: &'a [f64],
+    tmax: &'a mut [f64],
+    /// Embree's t is the caller's times the length of the caller's direction.
+    len: [f64; PACKET],
+    slack: f64,
+}
+
+unsafe extern "C" fn bounds(args: *const RTCBoundsFunctionArguments) {
+    // SAFETY: Embree passes the user pointer we registered (the first of the culler's live
+    // boxes) and a prim index below the primitive count we set.
+    unsafe {
+        let args = &*args;
+        let b = *(args.geometryUserPtr as *const Aabb).add(args.primID as usize);
+        *args.bounds_o = RTCBounds {
+            lower_x: (b.min.x as f32).next_down(),
+            lower_y: (b.min.y as f32).next_down(),
+            lower_z: (b.min.z as f32).next_down(),
+            align0: 0.0,
+            upper_x: (b.max.x as f32).next_up(),
+            upper_y: (b.max.y as f32).next_up(),
+            upper_z: (b.max.z as f32).next_up(),
+            align1: 0.0,
+        };
+    }
+}
+
+/// Offer box `prim` to every valid lane; a lane whose tmax drops below its tmin is done.
+///
+/// # Safety
+/// `context` is a `CullContext` (every query of this culler passes one); `ray` an N-wide SoA
+/// ray (RTCRayN layout: tfar is field 8) with `valid` of N entries.
+unsafe fn offer(
+    context: *mut RTCIntersectContext,
+    prim: u32,
+    ray: *mut f32,
+    valid: *const i32,
+    n: usize,
+) {
+    unsafe {
+        let ctx = &mut *(context as *mut CullContext);
+        for i in 0..n.min(ctx.tmax.len()) {
+            if *valid.add(i) == 0 {
+                continue;
+            }
+            let before = ctx.tmax[i];
+            let t = (ctx.visit)(prim, i, before);
+            ctx.tmax[i] = t;
+            if t < ctx.tmin[i] {
+                *ray.add(8 * n + i) = f32::NEG_INFINITY;
+            } else if t < before {
+                *ray.add(8 * n + i) = (t * ctx.len[i] + ctx.slack) as f32;
+            }
+        }
+    }
+}
+
+unsafe extern "C" fn intersect(args: *const RTCIntersectFunctionNArguments) {
+    // SAFETY: as for `offer`; Embree passes the query's context and N-wide ray.
+    unsafe {
+        let a = &*args;
+        offer(
+            a.context,
+            a.primID,
+            a.rayhit as *mut f32,
+            a.valid,
+            a.N as usize,
+        );
+    }
+}
+
+unsafe extern "C" fn occluded(args: *const RTCOccludedFunctionNArguments) {
+    // SAFETY: as for `intersect`.
+    unsafe {
+        let a = &*args;
+        offer(
+            a.context,
+            a.primID,
+            a.ray as *mut f32,
+            a.valid,
+            a.N as usize,
+        );
+    }
+}
+
+impl EmbreeCuller {
+    pub(super) fn build(device: Arc<Device>, boxes: &[Aabb]) -> Result<EmbreeCuller, String> {
+        let all = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
+        let center = if all.is_empty() {
+            DVec3::ZERO
+        } else {
+            all.centroid()
+        };
+        // f32 keeps ~7 digits of coordinates about the centre: a generous multiple of that.
+        let extent = if all.is_empty() {
+            1.0
+        } else {
+            (all.max - all.min).max_element().max(1e-30)
+        };
+        let slack = 1e-5 * (extent + (all.max - center).abs().max_element());
+        let pad = DVec3::splat(slack);
+        let boxes: Box<[Aabb]> = boxes
+            .iter()
+            .map(|b| Aabb::new(b.min - center - pad, b.max - center + pad))
+            .collect();
+        let raw = unsafe { rtcNewScene(device.raw) };
+        if raw.is_null() {
+            device.check("creating a culling scene")?;
+            return Err("Embree could not create a scene".into());
+        }
+        let culler = EmbreeCuller {
+            raw,
+            boxes,
+            center,
+            slack,
+            _device: device.clone(),
+        };
+
+        if !culler.boxes.is_empty() {
+            let g = GeometryHandle(unsafe { rtcNewGeometry(device.raw, RTC_GEOMETRY_TYPE_USER) });
+            if g.0.is_null() {
+                device.check("creating a culling geometry")?;
+                return Err("Embree could not create a geometry".into());
+            }
+            let ptr = culler.boxes.as_ptr() as *mut std::ffi::c_void;
+            // SAFETY: the boxes (a heap slice that never moves) outlive the scene (dropped after
+            // it is released) and the bounds callback reads them as Aabb by prim index.
+            unsafe {
+                rtcSetGeometryUserPrimitiveCount(g.0, culler.boxes.len() as u32);
+                rtcSetGeometryUserData(g.0, ptr);
+                rtcSetGeometryBoundsFunction(g.0, Some(bounds), ptr);
+                rtcSetGeometryIntersectFunction(g.0, Some(intersect));
+                rtcSetGeometryOccludedFunction(g.0, Some(occluded));
+                rtcCommitGeometry(g.0);
+                rtcAttachGeometry(raw, g.0);
+            }
+            device.check("attaching a culling geometry")?;
+        }
+        unsafe { rtcCommitScene(raw) };
+        device.check("committing a culling scene")?;
+        Ok(culler)
+    }
+}
+
+impl BoxCuller for EmbreeCuller {
+    fn traverse_packet(
+        &self,
+        o: DVec3,
+        dirs: &[DVec3],
+        tmin: &[f64],
+        tmax: &mut [f64],
+        visit: &mut dyn FnMut(u32, usize, f64) -> f64,
+    ) {
+        if self.boxes.is_empty() {
+            return;
+        }
+        flush_denormals();
+        let n = dirs.len().min(PACKET).min(tmax.len());
+        let mut rh = RTCRayHit16::default();
+        let mut valid = super::packet::Valid([0i32; 16]);
+        let org = o - self.center;
+        let mut lens = [1.0; PACKET];
+        for i in 0..n {
+            // Unit directions: Embree's t is then the caller's (dirs are unit or near it).
+            let len = dirs[i].length();
+            if len.is_nan() || len <= 0.0 || tmin[i] > tmax[i] {
+                continue;
+            }
+            lens[i] = len;
+            let d = dirs[i] / len;
+            rh.ray.org_x[i] = org.x as f32;
+            rh.ray.org_y[i] = org.y as f32;
+            rh.ray.org_z[i] = org.z as f32;
+            rh.ray.dir_x[i] = d.x as f32;
+            rh.ray.dir_y[i] = d.y as f32;
+            rh.ray.dir_z[i] = d.z as f32;
+            rh.ray.tnear[i] = ((tmin[i] * len - self.slack).max(0.0)) as f32;
+            let far = tmax[i] * len + self.slack;
+            rh.ray.tfar[i] = if far.is_finite() {
+                far as f32
+            } else {
+                f32::INFINITY
+            };
+            rh.ray.mask[i] = u32::MAX;
+            rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+            valid.0[i] = -1;
+        }
+        let mut ctx = CullContext {
+            rtc: RTCIntersectContext::default(),
+            visit,
+            tmin: &tmin[..n],
+            tmax: &mut tmax[..n],
+            len: lens,
+            slack: self.slack,
+        };
+        // SAFETY: initialises the plain struct in place.
+        unsafe { rtcInitIntersectContext(&mut ctx.rtc) };
+        ctx.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        let raw = (&mut ctx as *mut CullContext).cast::<RTCIntersectContext>();
+        // SAFETY: a committed scene, a 64-byte aligned valid mask of 16, the context above
+        // (which the callbacks read as a CullContext) outliving the call.
+        unsafe { rtcIntersect16(valid.0.as_ptr(), self.raw, raw, &mut rh) };
+    }
+}
