@@ -302,6 +302,24 @@ fn reach_boxes_hold_every_point_light_from_the_slice_meets() {
     assert_eq!(checked, 20_000);
 }
 
+/// Where a shadow ray starts: an event among the groups, or (a share `on_cone` of the time, as
+/// from a primary hit) on the imaging event's past light cone.
+fn shadow_origin(r: &mut Rng, event: Event, on_cone: f64) -> Event {
+    if r.f() >= on_cone {
+        Event::new(
+            r.range(-100.0, 40.0),
+            DVec3::new(
+                r.range(-60.0, 60.0),
+                r.range(-60.0, 60.0),
+                r.range(-60.0, 60.0),
+            ),
+        )
+    } else {
+        let back = r.range(10.0, 120.0);
+        Event::new(event.t - back, event.x + back * r.unit())
+    }
+}
+
 #[test]
 fn light_tree_visits_every_group_a_shadow_ray_meets() {
     use rest_embree::render::LightTree;
@@ -337,21 +355,7 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
         );
         let (mut served, mut checked) = (0, 0);
         for _ in 0..10_000 {
-            // A shadow ray back to the light from an event among the groups, or (as from a
-            // primary hit) on the imaging event's past light cone.
-            let o = if r.f() >= on_cone {
-                Event::new(
-                    r.range(-100.0, 40.0),
-                    DVec3::new(
-                        r.range(-60.0, 60.0),
-                        r.range(-60.0, 60.0),
-                        r.range(-60.0, 60.0),
-                    ),
-                )
-            } else {
-                let back = r.range(10.0, 120.0);
-                Event::new(event.t - back, event.x + back * r.unit())
-            };
+            let o = shadow_origin(&mut r, event, on_cone);
             let to = light - o.x;
             let ray = NullRay::new(o, to / to.length());
             let tmax = to.length() * (1.0 - 1e-9);
@@ -395,19 +399,7 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
         // In packets: the same rays served, and every group a ray meets offered to the test.
         let rays: Vec<NullRay> = (0..2000)
             .map(|_| {
-                let back = r.range(10.0, 120.0);
-                let o = if r.f() >= on_cone {
-                    Event::new(
-                        r.range(-100.0, 40.0),
-                        DVec3::new(
-                            r.range(-60.0, 60.0),
-                            r.range(-60.0, 60.0),
-                            r.range(-60.0, 60.0),
-                        ),
-                    )
-                } else {
-                    Event::new(event.t - back, event.x + back * r.unit())
-                };
+                let o = shadow_origin(&mut r, event, on_cone);
                 let to = light - o.x;
                 NullRay::new(o, to / to.length())
             })

@@ -6,20 +6,12 @@
 
 use super::device::Device;
 use super::packet::flush_denormals;
+use super::scene::GeometryHandle;
 use crate::accel::BoxCuller;
 use crate::geometry::{Aabb, PACKET};
 use embree_sys::*;
 use glam::DVec3;
 use std::sync::Arc;
-
-/// A geometry handle released on drop.
-struct GeometryHandle(RTCGeometry);
-
-impl Drop for GeometryHandle {
-    fn drop(&mut self) {
-        unsafe { rtcReleaseGeometry(self.0) };
-    }
-}
 
 pub struct EmbreeCuller {
     raw: RTCScene,

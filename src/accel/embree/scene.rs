@@ -10,7 +10,7 @@ use glam::DVec3;
 use std::sync::Arc;
 
 /// An Embree geometry handle, released on drop (the scene keeps its own reference).
-struct GeometryHandle(RTCGeometry);
+pub(super) struct GeometryHandle(pub(super) RTCGeometry);
 
 impl Drop for GeometryHandle {
     fn drop(&mut self) {
