@@ -261,63 +261,19 @@ impl World {
                 event_rest: boost.event(event).x,
                 velocity,
                 boost,
-
                 bounds,
                 geometry,
                 accel,
                 epsilon: 1e-7 * bounds.diagonal().max(1e-3) + 1e-12 * bounds.max_abs(),
             });
         }
-        let (mut tree, mut primary_tree, mut light_trees) = (None, None, Vec::new());
-        if options.group_tree && groups.len() >= GROUP_TREE_MIN {
-            let items: Vec<(Aabb, Velocity)> =
-                groups.iter().map(|g| (g.bounds, g.velocity)).collect();
-            // Kinetic trees are tight near their reference times: spread them over the window in
-            // which primary rays meet the groups, twice as deep as the farthest emission seen
-            // from the imaging event (secondary rays reach further back).
-            let apparent: Vec<Aabb> = items
-                .iter()
-                .map(|(b, v)| super::apparent_box(b, v, event))
-                .collect();
-            let deepest = apparent
-                .iter()
-                .map(|b| corner_distance(b, event.x))
-                .fold(0.0, f64::max);
-            let cullers = backend.cullers();
-            primary_tree = Some(ApparentTree::build(&items, event, &cullers)?);
-            let items: Arc<[(Aabb, Velocity)]> = items.into();
-            // Shadow rays of primary hits leave a light at most 2 deepest + its distance from
-            // the imaging event before the imaging event (later hits fall back on the kinetic
-            // trees). Their slices are f64 box trees on every backend: most are refitted, not
-            // built, and a frame reaches dozens of them (10,000 groups, 256², Embree's culler
-            // per slice: warm render 2.4x one group instead of 3.6x, but build + first render
-            // 14x instead of 10x).
-            let slice_cullers = BvhBackend.cullers();
-            light_trees = scene
-                .lights
-                .iter()
-                .map(|l| {
-                    l.velocity.is_zero().then(|| {
-                        let t_first = event.t - 2.0 * deepest - (l.position - event.x).length();
-                        LightTree::new(
-                            items.clone(),
-                            slice_cullers.clone(),
-                            l.position,
-                            event,
-                            t_first,
-                            event.t,
-                            LIGHT_SLICES,
-                        )
-                    })
-                })
-                .collect();
-            tree = Some(Kinetic {
-                groups: items,
-                t_first: event.t - 2.0 * deepest,
-                t_last: event.t,
-                trees: OnceLock::new(),
-            });
-        }
+        let (tree, primary_tree, light_trees) =
+            if options.group_tree && groups.len() >= GROUP_TREE_MIN {
+                let (k, a, l) = Self::group_trees(scene, &groups, backend)?;
+                (Some(k), Some(a), l)
+            } else {
+                (None, None, Vec::new())
+            };
         // Rays start at the imaging event or on a surface: with one group, all near it unless
         // the imaging event is far (more than 4 diagonals from the bounds' centre).
         let clip_rays = options.bounds_cull
@@ -334,6 +290,63 @@ impl World {
             light_trees,
             clip_rays,
         })
+    }
+
+    /// The trees over many groups: kinetic (built on first use), apparent boxes for primary
+    /// rays, and a light tree per light at rest for shadow rays.
+    fn group_trees(
+        scene: &Scene,
+        groups: &[GroupRt],
+        backend: &dyn Backend,
+    ) -> Result<(Kinetic, ApparentTree, Vec<Option<LightTree>>), String> {
+        let event = scene.camera.imaging_event();
+        let items: Vec<(Aabb, Velocity)> = groups.iter().map(|g| (g.bounds, g.velocity)).collect();
+        // Kinetic trees are tight near their reference times: spread them over the window in
+        // which primary rays meet the groups, twice as deep as the farthest emission seen
+        // from the imaging event (secondary rays reach further back).
+        let apparent: Vec<Aabb> = items
+            .iter()
+            .map(|(b, v)| super::apparent_box(b, v, event))
+            .collect();
+        let deepest = apparent
+            .iter()
+            .map(|b| corner_distance(b, event.x))
+            .fold(0.0, f64::max);
+        let cullers = backend.cullers();
+        let primary = ApparentTree::build(&items, event, &cullers)?;
+        let items: Arc<[(Aabb, Velocity)]> = items.into();
+        // Shadow rays of primary hits leave a light at most 2 deepest + its distance from
+        // the imaging event before the imaging event (later hits fall back on the kinetic
+        // trees). Their slices are f64 box trees on every backend: most are refitted, not
+        // built, and a frame reaches dozens of them (10,000 groups, 256², Embree's culler
+        // per slice: warm render 2.4x one group instead of 3.6x, but build + first render
+        // 14x instead of 10x).
+        let slice_cullers = BvhBackend.cullers();
+        let lights = scene
+            .lights
+            .iter()
+            .map(|l| {
+                l.velocity.is_zero().then(|| {
+                    let t_first = event.t - 2.0 * deepest - (l.position - event.x).length();
+                    LightTree::new(
+                        items.clone(),
+                        slice_cullers.clone(),
+                        l.position,
+                        event,
+                        t_first,
+                        event.t,
+                        LIGHT_SLICES,
+                    )
+                })
+            })
+            .collect();
+        let kinetic = Kinetic {
+            groups: items,
+            t_first: event.t - 2.0 * deepest,
+            t_last: event.t,
+            trees: OnceLock::new(),
+        };
+        Ok((kinetic, primary, lights))
     }
 
     /// The imaging event (world frame), where every primary ray starts.
@@ -564,13 +577,18 @@ impl World {
         }
     }
 
+    /// Whether group gi has anything on the ray between lookback `tmin` and `tmax`.
+    fn group_blocks(&self, gi: usize, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
+        let g = &self.groups[gi];
+        self.rest_ray(g, ray, tmin, tmax)
+            .is_some_and(|rr| g.occluded1(&rr.ray))
+    }
+
     /// Whether the shadow ray toward scene light `light` is blocked before lookback `tmax`.
     pub fn shadowed(&self, light: usize, ray: &NullRay, tmax: f64) -> bool {
         if let Some(Some(lt)) = self.light_trees.get(light) {
             let found = lt.occluded(ray, 0.0, tmax, |gi| {
-                let g = &self.groups[gi as usize];
-                self.rest_ray(g, ray, 0.0, tmax)
-                    .is_some_and(|rr| g.occluded1(&rr.ray))
+                self.group_blocks(gi as usize, ray, 0.0, tmax)
             });
             if let Some(found) = found {
                 return found;
@@ -588,9 +606,7 @@ impl World {
         let mut served = vec![false; rays.len()];
         out.iter_mut().for_each(|o| *o = false);
         lt.occluded_many(rays, tmax, &mut served, out, |gi, i| {
-            let g = &self.groups[gi as usize];
-            self.rest_ray(g, &rays[i], 0.0, tmax[i])
-                .is_some_and(|rr| g.occluded1(&rr.ray))
+            self.group_blocks(gi as usize, &rays[i], 0.0, tmax[i])
         });
         for (i, o) in out.iter_mut().enumerate() {
             if !served[i] {
@@ -601,11 +617,7 @@ impl World {
 
     /// Whether anything lies on the ray between lookback `tmin` and `tmax`.
     pub fn occluded(&self, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
-        let test = |gi: usize| -> bool {
-            let g = &self.groups[gi];
-            self.rest_ray(g, ray, tmin, tmax)
-                .is_some_and(|rr| g.occluded1(&rr.ray))
-        };
+        let test = |gi: usize| self.group_blocks(gi, ray, tmin, tmax);
         match &self.tree {
             Some(tree) => {
                 let mut found = false;
