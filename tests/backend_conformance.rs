@@ -11,6 +11,16 @@ conformance_suite!(
     }
 );
 
+// The same tree with f32 nodes: leaves are opened conservatively, so hits are the f64 BVH's.
+conformance_suite!(
+    bvh_f32,
+    rest_embree::accel::backend_by_name("bvh-f32").unwrap(),
+    Tolerance {
+        t_rel: 1e-9,
+        mismatch: 0.0
+    }
+);
+
 // Embree intersects in f32 (about each group's centre) and the hit is refined in f64 on the
 // primitive it found, so t is as exact as the BVH's; grazing rays may still disagree.
 #[cfg(feature = "embree")]

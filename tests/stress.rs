@@ -227,3 +227,48 @@ fn where_f32_limits_embree() {
         );
     }
 }
+
+#[test]
+fn the_f32_bvh_renders_the_f64_bvh_picture() {
+    // Its f32 nodes only decide which leaves to open, conservatively; the hits are the same
+    // f64 tests. Also where f32 is coarse: objects 1e7 apart in one group.
+    let far = |l: f64| {
+        scene(&format!(
+            "[camera]\nposition = [0.1234567, -10, 0.0765432]\ndirection = [0, 1, 0]\nfov_y = 15\n\
+             [image]\nwidth = 160\nheight = 160\n[[light]]\nposition = [0, -10, 10]\n\
+             [[group]]\nname = \"g\"\n{}",
+            [0.0, 3.1, -3.1, l + 0.3456789, l + 3.4, l - 2.8]
+                .iter()
+                .map(|&x| format!(
+                    "[[group.object]]\ntype = \"sphere\"\ncenter = [{x:?}, 0, 0]\nradius = 1\n"
+                ))
+                .collect::<String>()
+        ))
+    };
+    let cases = [
+        (
+            "lattice 0.9",
+            paper("lattice", &["group.lattice.velocity=[-0.9,0,0]"]),
+        ),
+        (
+            "lattice 0.9 moved by 1e6",
+            paper("lattice", &["group.lattice.velocity=[-0.9,0,0]"])
+                .translated(Event::new(1e6, DVec3::new(-1e6, 3e5, 1e6))),
+        ),
+        ("spheres 1e6 apart", far(1e6)),
+        ("spheres 1e7 apart", far(1e7)),
+    ];
+    for (name, s) in cases {
+        let (a, b) = (render_with(&s, "bvh"), render_with(&s, "bvh-f32"));
+        let c = compare(&a, &b);
+        report(
+            &format!("bvh-f32 vs bvh, {name}: share of differing pixels"),
+            "bvh-f32",
+            0.0,
+            c.differing_share(),
+            0.0,
+            "share",
+        );
+        assert_eq!(c.differing_share(), 0.0, "{name}");
+    }
+}

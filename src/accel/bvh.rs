@@ -32,72 +32,89 @@ impl Bvh {
         }
     }
 
-    /// Walks the tree; `visit` returns a new tmax when a leaf primitive is hit, and traversal
-    /// stops early when `any` is set.
-    #[inline]
     fn traverse(&self, ray: &Ray, any: bool) -> Option<Hit> {
-        if self.geometry.prims.is_empty() || !ray.is_active() {
-            return None;
-        }
         let inv = ray.dir.recip();
-        let mut tmax = ray.tmax;
-        let mut best = None;
-        let mut stack = [0u32; 64];
-        let mut sp = 0usize;
-        let root = &self.nodes[0];
-        root.bounds.clip(ray.origin, inv, ray.tmin, tmax)?;
-        let mut node = 0u32;
-        loop {
-            let n = &self.nodes[node as usize];
-            if n.count > 0 {
-                for &i in &self.indices[n.first as usize..(n.first + n.count) as usize] {
-                    if let Some(t) = self.geometry.prims[i as usize]
-                        .intersect(ray.origin, ray.dir, ray.tmin, tmax)
-                    {
-                        tmax = t;
-                        best = Some(Hit { t, prim: i });
-                        if any {
-                            return best;
-                        }
-                    }
-                }
-            } else {
-                let (l, r) = (n.first, n.first + 1);
-                let hl = self.nodes[l as usize]
-                    .bounds
-                    .clip(ray.origin, inv, ray.tmin, tmax);
-                let hr = self.nodes[r as usize]
-                    .bounds
-                    .clip(ray.origin, inv, ray.tmin, tmax);
-                match (hl, hr) {
-                    (Some((tl, _)), Some((tr, _))) => {
-                        let (near, far) = if tl <= tr { (l, r) } else { (r, l) };
-                        if sp < stack.len() {
-                            stack[sp] = far;
-                            sp += 1;
-                        }
-                        node = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        node = l;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        node = r;
-                        continue;
-                    }
-                    (None, None) => {}
-                }
-            }
-            if sp == 0 {
-                break;
-            }
-            sp -= 1;
-            node = stack[sp];
-        }
-        best
+        nearest_first(
+            &self.nodes,
+            |n| (n.first, n.count),
+            |n, tmax| n.bounds.clip(ray.origin, inv, ray.tmin, tmax).map(|x| x.0),
+            &self.indices,
+            &self.geometry,
+            ray,
+            any,
+        )
     }
+}
+
+/// The BVH walk for one ray, nearer child first, over nodes of any precision: `link(node)` is
+/// its (first, count) (interior when count is 0, children at first and first + 1) and
+/// `enter(node, tmax)` where the ray enters its box before tmax (None: it does not); leaves run
+/// the exact f64 primitive tests. `any`: stop at the first hit (occlusion).
+pub(super) fn nearest_first<N>(
+    nodes: &[N],
+    link: impl Fn(&N) -> (u32, u32),
+    enter: impl Fn(&N, f64) -> Option<f64>,
+    indices: &[u32],
+    geometry: &Geometry,
+    ray: &Ray,
+    any: bool,
+) -> Option<Hit> {
+    if geometry.prims.is_empty() || !ray.is_active() {
+        return None;
+    }
+    let mut tmax = ray.tmax;
+    let mut best = None;
+    let mut stack = [0u32; 64];
+    let mut sp = 0usize;
+    enter(&nodes[0], tmax)?;
+    let mut node = 0u32;
+    loop {
+        let (first, count) = link(&nodes[node as usize]);
+        if count > 0 {
+            for &i in &indices[first as usize..(first + count) as usize] {
+                if let Some(t) =
+                    geometry.prims[i as usize].intersect(ray.origin, ray.dir, ray.tmin, tmax)
+                {
+                    tmax = t;
+                    best = Some(Hit { t, prim: i });
+                    if any {
+                        return best;
+                    }
+                }
+            }
+        } else {
+            let (l, r) = (first, first + 1);
+            match (
+                enter(&nodes[l as usize], tmax),
+                enter(&nodes[r as usize], tmax),
+            ) {
+                (Some(tl), Some(tr)) => {
+                    let (near, far) = if tl <= tr { (l, r) } else { (r, l) };
+                    if sp < stack.len() {
+                        stack[sp] = far;
+                        sp += 1;
+                    }
+                    node = near;
+                    continue;
+                }
+                (Some(_), None) => {
+                    node = l;
+                    continue;
+                }
+                (None, Some(_)) => {
+                    node = r;
+                    continue;
+                }
+                (None, None) => {}
+            }
+        }
+        if sp == 0 {
+            break;
+        }
+        sp -= 1;
+        node = stack[sp];
+    }
+    best
 }
 
 impl Accelerator for Bvh {

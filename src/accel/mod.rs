@@ -6,10 +6,12 @@
 //! groups compare directly (DESIGN.md, "the one trick").
 
 mod bvh;
+mod bvh32;
 #[cfg(feature = "embree")]
 mod embree;
 
 pub use bvh::{Bvh, BvhBackend};
+pub use bvh32::{Bvh32, Bvh32Backend};
 #[cfg(feature = "embree")]
 pub use embree::{BareRay, EmbreeAccel, EmbreeBackend};
 
@@ -121,6 +123,8 @@ pub fn default_backend_name() -> &'static str {
 pub fn backend_by_name(name: &str) -> Result<Box<dyn Backend>, String> {
     match name {
         "bvh" => Ok(Box::new(BvhBackend)),
+        // The f64 BVH's tree with f32 nodes, for comparisons.
+        "bvh-f32" => Ok(Box::new(Bvh32Backend)),
         #[cfg(feature = "embree")]
         "embree" => Ok(Box::new(EmbreeBackend::new())),
         // Fixed packet widths, for comparisons (`embree` picks 16 or 8 from the CPU).

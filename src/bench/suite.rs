@@ -119,11 +119,12 @@ pub fn bars_as_groups(beta: f64) -> Result<crate::scene::Scene, SceneError> {
 }
 
 /// Settings measured on every lattice speed.
-const LATTICE_SETTINGS: [&str; 5] = [
+const LATTICE_SETTINGS: [&str; 6] = [
     "embree",
     "embree-8",
     "embree-single",
     "bvh",
+    "bvh-f32",
     "embree no-cull",
 ];
 
