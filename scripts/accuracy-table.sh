@@ -9,7 +9,7 @@ out=$(mktemp)
 tests=(calibration physics_render orthographic extreme stress)
 args=()
 for t in "${tests[@]}"; do args+=(--test "$t"); done
-cargo test -q "${args[@]}" -- --nocapture --test-threads 1 2>/dev/null | grep '^ACCURACY|' > /tmp/accuracy-rows.txt
+cargo test -q "${args[@]}" -- --nocapture --test-threads 1 2>/dev/null | grep -o 'ACCURACY|.*' > /tmp/accuracy-rows.txt
 awk -F'|' '
   {
     key = $2; unit[key] = $8; want[key] = $4; tol[key] = $7; cmd[key] = "cargo test --test " $9 " " $10 " -- --nocapture"

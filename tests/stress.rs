@@ -263,7 +263,7 @@ fn the_f32_bvh_renders_the_f64_bvh_picture() {
         let c = compare(&a, &b);
         report(
             &format!("bvh-f32 vs bvh, {name}: share of differing pixels"),
-            "bvh-f32",
+            "bvh",
             0.0,
             c.differing_share(),
             0.0,
