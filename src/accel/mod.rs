@@ -4,6 +4,10 @@
 //! only ever sees static geometry and static rays `o + t d`. `d` is unnormalised: its length is
 //! the boost's lookback factor, so `t` is already the world-frame lookback time and hits of all
 //! groups compare directly (DESIGN.md, "the one trick").
+//!
+//! A backend also builds the culling structures over many velocity groups (`BoxCuller`): boxes
+//! in the world frame that rays from one origin traverse, the renderer testing each candidate
+//! group exactly.
 
 mod bvh;
 mod bvh32;

@@ -4,10 +4,11 @@
 //!
 //! Precision (DESIGN.md): the renderer hands over f64 rays (rebased to the near side of the
 //! group's bounds when they come from afar); here they are made relative to the scene's centre,
-//! given a unit direction, and only then cast to f32. Spheres and rods are user geometry tested
-//! in f64 on the caller's f64 ray (round.rs); a triangle hit's t is converted back and refined in
-//! f64 on the triangle Embree found. Either way the lookback times that decide the merge between
-//! groups are as exact as the f64 BVH's.
+//! given a unit direction, and only then cast to f32. Spheres, rods and boxes are user geometry
+//! tested in f64 on the caller's f64 ray (exact.rs); a triangle hit's t is converted back and
+//! refined in f64 on the triangle Embree found. Either way the lookback times that decide the
+//! merge between groups are as exact as the f64 BVH's. culler.rs makes Embree the culling
+//! structure over many groups.
 
 mod bare;
 mod culler;
