@@ -5,15 +5,18 @@
 //! (t_e, L). A group can meet the ray only where that cone meets the group's worldtube: at the
 //! points x with x − v|x − L| ∈ B(t_e), B(t) the group's world-frame box at time t, moving at v.
 //! Time reversed, that is the apparent shape of PHYSICS.md §2.1 seen from L by a body moving at
-//! −v, so [`apparent_box_of`] bounds it; and for emission times in a slice [t_a, t_b] the points
+//! −v, so [`apparent_box_along`] bounds it; and for emission times in a slice [t_a, t_b] the points
 //! obey x − v|x − L| ∈ B(t_a) ∪ … ∪ B(t_b), inside the box around B(t_a) and B(t_b). So a static
 //! tree per slice of emission times holds every group's reachable shape, and a shadow ray walks
 //! only the slice of its own emission time, with plain slab tests along its track (the kinetic
 //! trees cut a ray into pieces by time and test moving bounds in each).
 //!
 //! Slices are made on first use, so only the emission times a frame's shadow rays have cost
-//! anything; a few consecutive slices share one tree shape (an SAH build at the middle one),
-//! refitted to each slice's boxes.
+//! anything; a few consecutive slices share one tree shape (built at the middle one), refitted
+//! to each slice's boxes, and hold only the groups the imaging event's causal past can reach
+//! (every shading point lies in it, so a ray that left L at t_e stays in the ellipsoid
+//! |x − L| + |x − E| ≤ t_E − t_e). Read backwards, a slice's rays all start at L: a tile's shadow
+//! rays go through it in packets.
 
 use super::apparent_tree::apparent_box_along;
 use super::group_tree::world_box;
