@@ -73,7 +73,7 @@ pub trait Backend: Send + Sync {
 pub type CullerFactory = Arc<dyn Fn(&[Aabb]) -> Result<Box<dyn BoxCuller>, String> + Send + Sync>;
 
 /// A culling structure over boxes, one per item, that packets of rays from one origin `o`
-/// traverse (directions `dirs`, each searched in (tmin[i], tmax[i])): `visit(item, ray, tmax)`
+/// traverse (directions `dirs`, each searched in `(tmin[i], tmax[i])`): `visit(item, ray, tmax)`
 /// tests an item exactly and returns the ray's new tmax; one below the ray's tmin ends the ray.
 /// Every item whose box a ray meets before its tmax is visited (rounding may add others).
 pub trait BoxCuller: Send + Sync {

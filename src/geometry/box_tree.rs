@@ -365,7 +365,7 @@ impl BoxTree {
     }
 
     /// Traverse with a packet of up to [`PACKET`] rays from one origin `o` (directions `dirs`,
-    /// each searched in (tmin[i], tmax[i])): each node is tested with the rays that met its
+    /// each searched in `(tmin[i], tmax[i])`): each node is tested with the rays that met its
     /// parent, and descended when any meets it. `visit(item, ray, tmax)` returns the ray's new
     /// tmax; one below its tmin drops the ray.
     pub fn traverse_packet(

@@ -130,7 +130,7 @@ impl ApparentTree {
         );
     }
 
-    /// Traverse with a packet of up to [`PACKET`] primary rays (all starting at the imaging
+    /// Traverse with a packet of up to `PACKET` primary rays (all starting at the imaging
     /// event): `visit(group, ray, tmax)` returns the ray's new tmax (best hit so far).
     pub fn traverse_packet(
         &self,
