@@ -53,11 +53,11 @@ use glam::DVec3;
 
 const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
+const TRAVERSAL_COST: f64 = 1.0;
+const INTERSECT_COST: f64 = 1.5;
 
 /// Up to this many rays traverse a tree together in [`BoxTree::traverse_packet`].
 pub const PACKET: usize = 16;
-const TRAVERSAL_COST: f64 = 1.0;
-const INTERSECT_COST: f64 = 1.5;
 
 /// A node: an interior node has `count == 0` and children at `first` and `first + 1`; a leaf
 /// holds `indices[first .. first + count]`.
@@ -224,8 +224,9 @@ fn find_split(items: &mut [Item], bounds: &Aabb, cbounds: &Aabb) -> Option<usize
     // Fewer bins for few items: the sweep over the bins is the whole cost of a small node.
     let bins = BINS.min(2 * count).max(2);
     let ext = cbounds.extent();
-    let mut best: Option<(f64, usize, usize)> = None; // cost, axis, bin
-                                                      // Every axis's bins in one pass over the items (a flat axis puts all in bin 0).
+    // The best split so far: cost, axis, bin.
+    let mut best: Option<(f64, usize, usize)> = None;
+    // Every axis's bins in one pass over the items (a flat axis puts all in bin 0).
     let scale = ext.map(|e| if e > 0.0 { bins as f64 / e } else { 0.0 });
     let mut bins_box = [[Aabb::EMPTY; BINS]; 3];
     let mut bins_n = [[0usize; BINS]; 3];
