@@ -1,13 +1,21 @@
-//! A pure-Rust bounding volume hierarchy in f64, built with binned SAH: the reference backend.
+//! A pure-Rust bounding volume hierarchy in f64, built with binned SAH: the reference backend;
+//! with its nodes in f32 (bvh32.rs), the benchmark's f32-against-f64 BVH.
 
+use super::bvh32::Nodes32;
 use super::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, BoxTree, Geometry, TreeNode};
 use std::sync::Arc;
 
 pub struct Bvh {
     geometry: Arc<Geometry>,
-    nodes: Vec<TreeNode>,
+    nodes: Nodes,
     indices: Vec<u32>,
+}
+
+/// The tree's nodes in f64, or in f32 about the geometry's centre.
+enum Nodes {
+    F64(Vec<TreeNode>),
+    F32(Nodes32),
 }
 
 pub struct BvhBackend;
@@ -27,22 +35,36 @@ impl Bvh {
         let BoxTree { nodes, indices } = BoxTree::build(&boxes);
         Bvh {
             geometry,
-            nodes,
+            nodes: Nodes::F64(nodes),
             indices,
         }
     }
 
+    /// The same tree with its nodes in f32 (see bvh32.rs).
+    pub fn with_f32_nodes(geometry: Arc<Geometry>) -> Bvh {
+        let mut bvh = Bvh::build(geometry);
+        if let Nodes::F64(nodes) = &bvh.nodes {
+            bvh.nodes = Nodes::F32(Nodes32::new(nodes, &bvh.geometry.bounds()));
+        }
+        bvh
+    }
+
     fn traverse(&self, ray: &Ray, any: bool) -> Option<Hit> {
-        let inv = ray.dir.recip();
-        nearest_first(
-            &self.nodes,
-            |n| (n.first, n.count),
-            |n, tmax| n.bounds.clip(ray.origin, inv, ray.tmin, tmax).map(|x| x.0),
-            &self.indices,
-            &self.geometry,
-            ray,
-            any,
-        )
+        match &self.nodes {
+            Nodes::F64(nodes) => {
+                let inv = ray.dir.recip();
+                nearest_first(
+                    nodes,
+                    |n| (n.first, n.count),
+                    |n, tmax| n.bounds.clip(ray.origin, inv, ray.tmin, tmax).map(|x| x.0),
+                    &self.indices,
+                    &self.geometry,
+                    ray,
+                    any,
+                )
+            }
+            Nodes::F32(nodes) => nodes.traverse(&self.indices, &self.geometry, ray, any),
+        }
     }
 }
 

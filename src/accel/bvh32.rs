@@ -4,9 +4,9 @@
 //! them, so its hits are the f64 BVH's; what it changes is the memory a node takes (32 bytes
 //! instead of 56) and the width of its arithmetic.
 
-use super::bvh::nearest_first;
+use super::bvh::{nearest_first, Bvh};
 use super::{Accelerator, Backend, Hit, Ray};
-use crate::geometry::{Aabb, BoxTree, Geometry};
+use crate::geometry::{Aabb, Geometry, TreeNode};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -18,10 +18,9 @@ struct Node32 {
     count: u32,
 }
 
-pub struct Bvh32 {
-    geometry: Arc<Geometry>,
+/// A tree's nodes in f32, relative to `center`.
+pub(super) struct Nodes32 {
     nodes: Vec<Node32>,
-    indices: Vec<u32>,
     center: DVec3,
 }
 
@@ -32,7 +31,7 @@ impl Backend for Bvh32Backend {
         "bvh-f32"
     }
     fn build(&self, geometry: Arc<Geometry>) -> Result<Box<dyn Accelerator>, String> {
-        Ok(Box::new(Bvh32::build(geometry)))
+        Ok(Box::new(Bvh::with_f32_nodes(geometry)))
     }
 }
 
@@ -55,10 +54,9 @@ fn clip32(n: &Node32, o: [f32; 3], inv: [f32; 3], tmin: f32, tmax: f32) -> Optio
     (t0 <= t1).then_some(t0)
 }
 
-impl Bvh32 {
-    pub fn build(geometry: Arc<Geometry>) -> Bvh32 {
-        let boxes: Vec<Aabb> = geometry.prims.iter().map(|p| p.bounds()).collect();
-        let all = geometry.bounds();
+impl Nodes32 {
+    /// The f64 tree's nodes over geometry with these bounds, in f32.
+    pub(super) fn new(nodes: &[TreeNode], all: &Aabb) -> Nodes32 {
         let center = if all.is_empty() {
             DVec3::ZERO
         } else {
@@ -71,7 +69,6 @@ impl Bvh32 {
         } else {
             1e-5 * (all.max - all.min).max_element()
         };
-        let BoxTree { nodes, indices } = BoxTree::build(&boxes);
         let nodes = nodes
             .iter()
             .map(|n| {
@@ -84,16 +81,17 @@ impl Bvh32 {
                 }
             })
             .collect();
-        Bvh32 {
-            geometry,
-            nodes,
-            indices,
-            center,
-        }
+        Nodes32 { nodes, center }
     }
 
     /// As the f64 BVH's walk, with the node tests in f32 (limits widened by rounding).
-    fn traverse(&self, ray: &Ray, any: bool) -> Option<Hit> {
+    pub(super) fn traverse(
+        &self,
+        indices: &[u32],
+        geometry: &Geometry,
+        ray: &Ray,
+        any: bool,
+    ) -> Option<Hit> {
         let o = ray.origin - self.center;
         let o32 = [o.x as f32, o.y as f32, o.z as f32];
         let inv = [
@@ -113,32 +111,10 @@ impl Bvh32 {
             &self.nodes,
             |n| (n.first, n.count),
             |n, tmax| clip32(n, o32, inv, tmin32, hi32(tmax)).map(f64::from),
-            &self.indices,
-            &self.geometry,
+            indices,
+            geometry,
             ray,
             any,
         )
-    }
-}
-
-impl Accelerator for Bvh32 {
-    fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        for (r, h) in rays.iter().zip(hits.iter_mut()) {
-            *h = self.traverse(r, false);
-        }
-    }
-
-    fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
-        for (r, o) in rays.iter().zip(out.iter_mut()) {
-            *o = self.traverse(r, true).is_some();
-        }
-    }
-
-    fn geometry(&self) -> &Arc<Geometry> {
-        &self.geometry
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }

@@ -15,7 +15,7 @@ mod bvh32;
 mod embree;
 
 pub use bvh::{Bvh, BvhBackend};
-pub use bvh32::{Bvh32, Bvh32Backend};
+pub use bvh32::Bvh32Backend;
 #[cfg(feature = "embree")]
 pub use embree::{BareRay, EmbreeAccel, EmbreeBackend};
 
