@@ -55,6 +55,17 @@ impl Aabb {
         self.max = upper(self.max, p);
     }
 
+    /// The eight corners (bit 0, 1, 2 of the index: max rather than min in x, y, z).
+    pub fn corners(&self) -> [DVec3; 8] {
+        std::array::from_fn(|k| {
+            DVec3::new(
+                if k & 1 == 0 { self.min.x } else { self.max.x },
+                if k & 2 == 0 { self.min.y } else { self.max.y },
+                if k & 4 == 0 { self.min.z } else { self.max.z },
+            )
+        })
+    }
+
     pub fn centroid(&self) -> DVec3 {
         0.5 * (self.min + self.max)
     }

@@ -50,12 +50,8 @@ pub fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec
     // Each corner's offset along v and perpendicular to it (from the eye's line of motion).
     let (mut a_min, mut a_max, mut rho2_max) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
     let mut perps = Aabb::EMPTY;
-    for k in 0..8 {
-        let c = DVec3::new(
-            if k & 1 == 0 { now.min.x } else { now.max.x },
-            if k & 2 == 0 { now.min.y } else { now.max.y },
-            if k & 4 == 0 { now.min.z } else { now.max.z },
-        ) - eye;
+    for corner in now.corners() {
+        let c = corner - eye;
         let a = c.dot(u);
         let p = c - a * u;
         a_min = a_min.min(a);

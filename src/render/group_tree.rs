@@ -119,16 +119,11 @@ impl SlicedGroupTree {
 /// The world-frame box at world time `t` of rest-frame bounds moving at `v` (whose rest-frame
 /// origin passes the world origin at t = 0): the corners contracted along v, then carried.
 pub fn world_box(rest: &Aabb, v: &Velocity, t: f64) -> Aabb {
-    let (dir, g) = (v.direction(), v.gamma());
+    // Per group, not per corner: the speed is a tanh and γ a cosh of the rapidity.
+    let (dir, shrink, shift) = (v.direction(), 1.0 / v.gamma() - 1.0, v.beta_vec() * t);
     let mut b = Aabb::EMPTY;
-    for k in 0..8 {
-        let p = DVec3::new(
-            if k & 1 == 0 { rest.min.x } else { rest.max.x },
-            if k & 2 == 0 { rest.min.y } else { rest.max.y },
-            if k & 4 == 0 { rest.min.z } else { rest.max.z },
-        );
-        let contracted = p + (1.0 / g - 1.0) * p.dot(dir) * dir;
-        b.grow(contracted + v.beta_vec() * t);
+    for p in rest.corners() {
+        b.grow(p + shrink * p.dot(dir) * dir + shift);
     }
     b
 }

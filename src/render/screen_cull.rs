@@ -75,15 +75,10 @@ impl ScreenCull {
             // The box's looking directions lie in the spherical hull of its corners', so in
             // the cap around the direction to its centre that holds all eight corners.
             let axis = (b.centroid() - g.event_rest).normalize();
-            let theta = (0..8)
-                .map(|k| {
-                    let corner = DVec3::new(
-                        if k & 1 == 0 { b.min.x } else { b.max.x },
-                        if k & 2 == 0 { b.min.y } else { b.max.y },
-                        if k & 4 == 0 { b.min.z } else { b.max.z },
-                    );
-                    angle(axis, (corner - g.event_rest).normalize())
-                })
+            let theta = b
+                .corners()
+                .iter()
+                .map(|&corner| angle(axis, (corner - g.event_rest).normalize()))
                 .fold(0.0, f64::max);
             // A cap reaching to 90 degrees is of no use.
             if theta.is_nan() || theta >= std::f64::consts::FRAC_PI_2 - 1e-6 {
