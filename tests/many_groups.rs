@@ -8,6 +8,15 @@ use rest_embree::geometry::Aabb;
 use rest_embree::render::{render_world, GroupTree, SlicedGroupTree, World, WorldOptions};
 use rest_embree::spacetime::{Boost, Event, NullRay, Velocity};
 
+/// Exact: whether the ray meets a group's bounds in lookback (0, tmax), tested in the group's
+/// rest frame against its rest-frame bounds.
+fn meets(b: &Aabb, v: &Velocity, ray: &NullRay, tmax: f64) -> bool {
+    let boost = Boost::to_rest(v);
+    let (d, _) = boost.null_dir(ray.dir);
+    b.clip(boost.event(ray.origin).x, d.recip(), 0.0, tmax)
+        .is_some()
+}
+
 #[test]
 fn group_tree_visits_every_group_a_ray_meets() {
     let mut r = Rng(3);
@@ -55,12 +64,7 @@ fn group_tree_visits_every_group_a_ray_meets() {
             sliced.traverse(&ray, 0.0, tmax, mark);
         }
         for (i, (b, v)) in groups.iter().enumerate() {
-            // Exact: the ray in the group's rest frame against its rest-frame bounds.
-            let boost = Boost::to_rest(v);
-            let (d, _) = boost.null_dir(ray.dir);
-            if b.clip(boost.event(ray.origin).x, d.recip(), 0.0, tmax)
-                .is_some()
-            {
+            if meets(b, v, &ray, tmax) {
                 checked += 1;
                 assert!(
                     visited[i],
@@ -374,11 +378,7 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
             );
             served += 1;
             for (i, (b, v)) in groups.iter().enumerate() {
-                let boost = Boost::to_rest(v);
-                let (d, _) = boost.null_dir(ray.dir);
-                if b.clip(boost.event(ray.origin).x, d.recip(), 0.0, tmax)
-                    .is_some()
-                {
+                if meets(b, v, &ray, tmax) {
                     checked += 1;
                     assert!(visited[i], "group {i} is met by the shadow ray but skipped");
                 }
@@ -443,11 +443,7 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
             // (Candidates may be more than the groups met: Embree offers a packet's lanes
             // every box of a leaf the packet reaches.)
             for (g, (b, v)) in groups.iter().enumerate() {
-                let boost = Boost::to_rest(v);
-                let (d, _) = boost.null_dir(ray.dir);
-                if b.clip(boost.event(ray.origin).x, d.recip(), 0.0, tmax[i])
-                    .is_some()
-                {
+                if meets(b, v, ray, tmax[i]) {
                     met += 1;
                     assert!(
                         offered[i].contains(&g),
