@@ -362,6 +362,13 @@ fn retarded_position_2_1_both_branches() {
         1e-15,
         "receding: Δ = d/(1+β)",
     );
+        // Abeam (r0 ⟂ v): |r0 − βΔ| = Δ gives 1 + β²Δ² = Δ², Δ = γ |r0| — where r0² − |β × r0|²
+    // would be 1 − β², lost to cancellation (PHYSICS.md §8).
+    for one_minus in [1e-6, 1e-9, 1e-12] {
+        let v = Velocity::from_one_minus_beta(DVec3::X, one_minus).unwrap();
+        let abeam = retarded_delay(DVec3::new(0.0, 3.0, -4.0), &v);
+        assert_rel(abeam, 5.0 * v.gamma(), 1e-12, "abeam: Δ = γ|r0|");
+    }
     // The rest-frame form x_app = γ(X − β sqrt(X² + ρ²)) agrees (PHYSICS.md §2.1).
     let v = Velocity::from_beta(DVec3::X, 0.9).unwrap();
     for (x0, rho) in [(5.0, 10.0), (-5.0, 10.0), (0.0, 3.0), (40.0, 1.0)] {

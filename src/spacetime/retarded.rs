@@ -11,14 +11,13 @@ pub fn retarded_delay(r0: DVec3, v: &Velocity) -> f64 {
     if v.is_zero() {
         return r0.length();
     }
-    let b = v.beta_vec();
+        let b = v.beta_vec();
     let br = b.dot(r0);
-    let root = (r0.length_squared() - b.cross(r0).length_squared())
-        .max(0.0)
-        .sqrt();
+    let g = v.gamma();
+    // sqrt((β·r0)² + r0²/γ²): both terms ≥ 0, where r0² − |β × r0|² would cancel near β → 1.
+    let root = (br * br + r0.length_squared() / (g * g)).sqrt();
     if br <= 0.0 {
         // γ² = cosh²φ, no cancellation: root and −β·r0 are both ≥ 0.
-        let g = v.gamma();
         g * g * (root - br)
     } else {
         r0.length_squared() / (br + root)
