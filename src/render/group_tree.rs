@@ -119,8 +119,10 @@ impl SlicedGroupTree {
 /// The world-frame box at world time `t` of rest-frame bounds moving at `v` (whose rest-frame
 /// origin passes the world origin at t = 0): the corners contracted along v, then carried.
 pub fn world_box(rest: &Aabb, v: &Velocity, t: f64) -> Aabb {
-    // Per group, not per corner: the speed is a tanh and γ a cosh of the rapidity.
-    let (dir, shrink, shift) = (v.direction(), 1.0 / v.gamma() - 1.0, v.beta_vec() * t);
+    // Per group, not per corner: the speed is a tanh and γ a cosh of the rapidity. The
+    // contraction 1/γ − 1 = −(γ − 1)/γ, exact at small speeds (PHYSICS.md §8.1).
+    let (dir, shift) = (v.direction(), v.beta_vec() * t);
+    let shrink = -v.gamma_minus_one() / v.gamma();
     let mut b = Aabb::EMPTY;
     for p in rest.corners() {
         b.grow(p + shrink * p.dot(dir) * dir + shift);

@@ -158,7 +158,8 @@ impl LightTree {
             return None;
         }
         let (a, c) = (0.5 * sum, 0.5 * focal);
-        let b2 = (a * a - c * c).max(0.0);
+        // a ≥ c: (a − c)(a + c) keeps b² exact where the ellipsoid is thin (a ≈ c).
+        let b2 = ((a - c) * (a + c)).max(0.0);
         let f = if focal > 0.0 {
             axis / focal
         } else {

@@ -11,7 +11,7 @@ pub fn retarded_delay(r0: DVec3, v: &Velocity) -> f64 {
     if v.is_zero() {
         return r0.length();
     }
-        let b = v.beta_vec();
+    let b = v.beta_vec();
     let br = b.dot(r0);
     let g = v.gamma();
     // sqrt((β·r0)² + r0²/γ²): both terms ≥ 0, where r0² − |β × r0|² would cancel near β → 1.
