@@ -525,3 +525,61 @@ fn shadows_toward_a_moving_light_are_the_same_with_the_trees() {
     );
     assert_eq!(a, b, "the trees change no bit");
 }
+
+#[test]
+fn a_far_camera_sees_the_same_groups_with_the_trees() {
+    // 300 slow groups (so their apparent boxes stay ~30 across) seen from 1e7 away, off every
+    // axis, through a long lens: f32 coordinates of the camera about the groups' centre are
+    // then off by ~0.5, and must not lose a group the f64 test finds, on any backend's culler.
+    let mut r = Rng(31);
+    let mut text = String::from(
+        "[camera]\nposition = [7000000.37, -7000000, 0.21]\nlook_at = [0, 0, 0]\n\
+         fov_y = 0.0002\ntime = 10000000\n[image]\nwidth = 120\nheight = 90\n",
+    );
+    for i in 0..300 {
+        let c = DVec3::new(
+            r.range(-15.0, 15.0),
+            r.range(-10.0, 10.0),
+            r.range(-12.0, 12.0),
+        );
+        let v = r.unit() * r.range(1e-9, 1e-7);
+        text += &format!(
+            "[[group]]\nname = \"g{i}\"\nvelocity = [{:?}, {:?}, {:?}]\n[[group.object]]\n\
+             type = \"box\"\nmin = [{:?}, {:?}, {:?}]\nmax = [{:?}, {:?}, {:?}]\n",
+            v.x,
+            v.y,
+            v.z,
+            c.x - 0.4,
+            c.y - 0.4,
+            c.z - 0.4,
+            c.x + 0.4,
+            c.y + 0.4,
+            c.z + 0.4
+        );
+    }
+    let s = scene(&text);
+    for name in backends() {
+        let backend = rest_embree::accel::backend_by_name(name).unwrap();
+        let options = |group_tree| WorldOptions {
+            group_tree,
+            ..Default::default()
+        };
+        let plain = World::build_with(&s, backend.as_ref(), options(false)).unwrap();
+        let fast = World::build_with(&s, backend.as_ref(), options(true)).unwrap();
+        assert!(fast.uses_group_tree());
+        let (a, b) = (render_world(&s, &plain).0, render_world(&s, &fast).0);
+        let hit = a.pixels.iter().filter(|p| p.object_id != 0).count();
+        assert!(hit > 1000, "{name}: the objects are in view ({hit})");
+        let ids = a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .filter(|(p, q)| p.object_id != q.object_id)
+            .count();
+        assert_eq!(
+            ids, 0,
+            "{name}: {ids} pixels see another object with the trees"
+        );
+        assert!(a == b, "{name}: the trees change no bit");
+    }
+}

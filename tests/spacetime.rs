@@ -362,7 +362,7 @@ fn retarded_position_2_1_both_branches() {
         1e-15,
         "receding: Δ = d/(1+β)",
     );
-        // Abeam (r0 ⟂ v): |r0 − βΔ| = Δ gives 1 + β²Δ² = Δ², Δ = γ |r0| — where r0² − |β × r0|²
+    // Abeam (r0 ⟂ v): |r0 − βΔ| = Δ gives 1 + β²Δ² = Δ², Δ = γ |r0| — where r0² − |β × r0|²
     // would be 1 − β², lost to cancellation (PHYSICS.md §8).
     for one_minus in [1e-6, 1e-9, 1e-12] {
         let v = Velocity::from_one_minus_beta(DVec3::X, one_minus).unwrap();

@@ -64,7 +64,6 @@ impl Default for WorldOptions {
 pub struct GroupRt {
     /// The imaging event's position in this group's rest frame.
     pub event_rest: DVec3,
-
     pub velocity: Velocity,
     /// Into the group's rest frame (its inverse leads out).
     pub boost: Boost,

@@ -18,6 +18,9 @@ pub struct EmbreeCuller {
     /// Embree points into these (boxes relative to `center`, widened); dropped after the scene.
     boxes: Box<[Aabb]>,
     center: DVec3,
+    /// All the (widened) boxes together, relative to `center`: rays start on it, so f32 sees
+    /// only coordinates of the boxes' size however far the rays come from.
+    all: Aabb,
     /// Slack for f32 rounding of rays and boxes, in world units.
     slack: f64,
     _device: Arc<Device>,
@@ -41,8 +44,10 @@ struct CullContext<'a> {
     visit: &'a mut dyn FnMut(u32, usize, f64) -> f64,
     tmin: &'a [f64],
     tmax: &'a mut [f64],
-    /// Embree's t is the caller's times the length of the caller's direction.
+    /// Embree's t is the caller's t times the length of the caller's direction, less the
+    /// distance the ray's origin was moved along it.
     len: [f64; PACKET],
+    shift: [f64; PACKET],
     slack: f64,
 }
 
@@ -89,7 +94,7 @@ unsafe fn offer(
             if t < ctx.tmin[i] {
                 *ray.add(8 * n + i) = f32::NEG_INFINITY;
             } else if t < before {
-                *ray.add(8 * n + i) = (t * ctx.len[i] + ctx.slack) as f32;
+                *ray.add(8 * n + i) = (t * ctx.len[i] - ctx.shift[i] + ctx.slack) as f32;
             }
         }
     }
@@ -148,10 +153,12 @@ impl EmbreeCuller {
             device.check("creating a culling scene")?;
             return Err("Embree could not create a scene".into());
         }
+        let all = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
         let culler = EmbreeCuller {
             raw,
             boxes,
             center,
+            all,
             slack,
             _device: device.clone(),
         };
@@ -198,24 +205,30 @@ impl BoxCuller for EmbreeCuller {
         let n = dirs.len().min(PACKET).min(tmax.len());
         let mut rh = RTCRayHit16::default();
         let mut valid = super::packet::Valid([0i32; 16]);
-        let org = o - self.center;
-        let mut lens = [1.0; PACKET];
+        let o = o - self.center;
+        let (mut lens, mut shifts) = ([1.0; PACKET], [0.0; PACKET]);
         for i in 0..n {
-            // Unit directions: Embree's t is then the caller's (dirs are unit or near it).
+            // Unit directions, and the origin moved (in f64) to where the ray enters all the
+            // boxes: f32 then rounds coordinates of the boxes' size, which the slack covers.
             let len = dirs[i].length();
             if len.is_nan() || len <= 0.0 || tmin[i] > tmax[i] {
                 continue;
             }
-            lens[i] = len;
             let d = dirs[i] / len;
+            let Some((enter, _)) = self.all.clip(o, d.recip(), tmin[i] * len, tmax[i] * len) else {
+                continue;
+            };
+            let shift = enter.max(0.0);
+            let org = o + shift * d;
+            (lens[i], shifts[i]) = (len, shift);
             rh.ray.org_x[i] = org.x as f32;
             rh.ray.org_y[i] = org.y as f32;
             rh.ray.org_z[i] = org.z as f32;
             rh.ray.dir_x[i] = d.x as f32;
             rh.ray.dir_y[i] = d.y as f32;
             rh.ray.dir_z[i] = d.z as f32;
-            rh.ray.tnear[i] = ((tmin[i] * len - self.slack).max(0.0)) as f32;
-            let far = tmax[i] * len + self.slack;
+            rh.ray.tnear[i] = ((tmin[i] * len - shift - self.slack).max(0.0)) as f32;
+            let far = tmax[i] * len - shift + self.slack;
             rh.ray.tfar[i] = if far.is_finite() {
                 far as f32
             } else {
@@ -231,6 +244,7 @@ impl BoxCuller for EmbreeCuller {
             tmin: &tmin[..n],
             tmax: &mut tmax[..n],
             len: lens,
+            shift: shifts,
             slack: self.slack,
         };
         // SAFETY: initialises the plain struct in place.
