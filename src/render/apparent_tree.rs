@@ -46,29 +46,42 @@ pub fn apparent_box_of(now: &Aabb, v: &Velocity, eye: DVec3) -> Aabb {
 
 /// [`apparent_box_of`] for a motion given as its direction `u`, speed β > 0 and γ.
 pub fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec3) -> Aabb {
-    let now = *now;
-    // Each corner's offset along v and perpendicular to it (from the eye's line of motion).
-    let (mut a_min, mut a_max, mut rho2_max) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
-    let mut perps = Aabb::EMPTY;
-    for corner in now.corners() {
-        let c = corner - eye;
-        let a = c.dot(u);
-        let p = c - a * u;
-        a_min = a_min.min(a);
-        a_max = a_max.max(a);
-        rho2_max = rho2_max.max(p.length_squared());
-        perps.grow(p);
+    // The box about the eye: centre c and half-widths h.
+    let c = now.centroid() - eye;
+    let h = 0.5 * now.extent();
+    // Offsets along v (a = x·u) and perpendicular to it (p = x − (x·u)u) are linear in x, so
+    // over the box they range over the centre's value ± the half-widths through |u| and |I − uuᵀ|.
+    let a_mid = c.dot(u);
+    let a_half = h.dot(u.abs());
+    let (a_min, a_max) = (a_mid - a_half, a_mid + a_half);
+    let cp = c - a_mid * u;
+    let row = |k: usize| {
+        let m = DVec3::new(-u[k] * u.x, -u[k] * u.y, -u[k] * u.z);
+        let mut m = m.abs();
+        m[k] = (1.0 - u[k] * u[k]).abs();
+        m.dot(h)
+    };
+    let ph = DVec3::new(row(0), row(1), row(2));
+    // |p|² = |x|² − (x·u)² is convex: largest at a corner.
+    let mut rho2_max = 0.0f64;
+    for k in 0..8 {
+        let s = DVec3::new(
+            if k & 1 == 0 { -h.x } else { h.x },
+            if k & 2 == 0 { -h.y } else { h.y },
+            if k & 4 == 0 { -h.z } else { h.z },
+        );
+        let x = c + s;
+        let a = x.dot(u);
+        rho2_max = rho2_max.max(x.length_squared() - a * a);
     }
     // Lab-simultaneous offsets along v, and their rest-frame values X = γ x∥.
     let (x_min, x_max) = (gamma * a_min, gamma * a_max);
     let rho_max = rho2_max.sqrt();
-    let perp = |c: DVec3| c - c.dot(u) * u;
     // |r⊥| is convex: bounded below by its supporting plane at the box centre.
-    let c = now.centroid() - eye;
-    let cp = perp(c);
-    let rho_min = if cp.length() > 0.0 {
-        let grad = perp(cp / cp.length());
-        (cp.length() - grad.abs().dot(0.5 * now.extent())).max(0.0)
+    let cp_len = cp.length();
+    let rho_min = if cp_len > 0.0 {
+        let grad = cp / cp_len;
+        (cp_len - grad.abs().dot(h)).max(0.0)
     } else {
         0.0
     };
@@ -76,10 +89,10 @@ pub fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec
         x_app(gamma, beta, x_min, rho_max),
         x_app(gamma, beta, x_max, rho_min),
     );
-    // The prism {perpendicular offset of a corner + x u, lo ≤ x ≤ hi}: its box is the corners'
+    // The prism {perpendicular offset of a point + x u, lo ≤ x ≤ hi}: its box is the
     // perpendicular offsets' box plus the segment's.
     let (s0, s1) = (lo * u, hi * u);
-    let b = Aabb::new(eye + perps.min + s0.min(s1), eye + perps.max + s0.max(s1));
+    let b = Aabb::new(eye + cp - ph + s0.min(s1), eye + cp + ph + s0.max(s1));
     // A little slack for rounding.
     let pad = DVec3::splat(1e-9 * (b.max_abs() + 1.0));
     Aabb::new(b.min - pad, b.max + pad)
