@@ -1,5 +1,5 @@
 //! Where primary rays spend their time among many velocity groups (diagnostics):
-//! `cargo run --release --example group_visits -- 10000`.
+//! `cargo run --release --example group_visits -- 10000 [backend]` (one thread).
 use rest_embree::render::{trace_primary, World};
 use std::time::Instant;
 
@@ -10,7 +10,8 @@ fn main() {
         .unwrap_or(10000);
     let s = rest_embree::bench::many_groups(n, false, 256).unwrap();
     let one = rest_embree::bench::many_groups(n, true, 256).unwrap();
-    let backend = rest_embree::accel::backend_by_name("bvh").unwrap();
+    let name = std::env::args().nth(2).unwrap_or_else(|| "embree".into());
+    let backend = rest_embree::accel::backend_by_name(&name).unwrap();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -23,7 +24,7 @@ fn main() {
             let t = Instant::now();
             let (rays, hits) = trace_primary(scene, &w);
             let tp = t.elapsed().as_secs_f64();
-                        // The first render also builds what is built on first use; the second is warm.
+            // The first render also builds what is built on first use; the second is warm.
             let t = Instant::now();
             let _ = rest_embree::render::render_world(scene, &w);
             let first = t.elapsed().as_secs_f64();

@@ -333,8 +333,10 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
     // An imaging event far in the future of every ray (each slice holds every group), and one
     // close by, whose causal past leaves the later slices only the groups near it.
     // Thin slices in the second case, so that a run of slices sharing a tree shape is short.
-    // Every backend's culling structure (the f64 box tree refitted, Embree's built per slice).
-    let cases = backends().into_iter().flat_map(|name| {
+    // Every backend's culling structure (the f64 box tree refitted, Embree's built per slice),
+    // and light buffers around the light (what the renderer uses).
+    let names = backends().into_iter().chain(["light-buffer"]);
+    let cases = names.flat_map(|name| {
         [
             (name, Event::new(400.0, DVec3::ZERO), 0.0, 32, 5000),
             (
@@ -347,7 +349,10 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
         ]
     });
     for (name, event, on_cone, slices, min_served) in cases {
-        let cullers = rest_embree::accel::backend_by_name(name).unwrap().cullers();
+        let cullers = match name {
+            "light-buffer" => rest_embree::accel::light_buffers(light),
+            _ => rest_embree::accel::backend_by_name(name).unwrap().cullers(),
+        };
         let tree = LightTree::new(
             groups.clone().into(),
             cullers,

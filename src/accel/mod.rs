@@ -19,7 +19,7 @@ pub use bvh32::Bvh32Backend;
 #[cfg(feature = "embree")]
 pub use embree::{BareRay, EmbreeAccel, EmbreeBackend};
 
-use crate::geometry::{Aabb, BoxTree, Geometry};
+use crate::geometry::{Aabb, BoxTree, Geometry, LightBuffer};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -108,6 +108,25 @@ impl BoxCuller for BoxTree {
     fn refitted(&self, box_of: &mut dyn FnMut(u32) -> Aabb) -> Option<Box<dyn BoxCuller>> {
         Some(Box::new(self.refit_with(box_of)))
     }
+}
+
+impl BoxCuller for LightBuffer {
+    fn traverse_packet(
+        &self,
+        o: DVec3,
+        dirs: &[DVec3],
+        tmin: &[f64],
+        tmax: &mut [f64],
+        visit: &mut dyn FnMut(u32, usize, f64) -> f64,
+    ) {
+        self.traverse(o, dirs, tmin, tmax, visit)
+    }
+}
+
+/// Light buffers around `origin` as culling structures (for rays from it, as shadow rays read
+/// backwards from a light are), on every backend.
+pub fn light_buffers(origin: DVec3) -> CullerFactory {
+    Arc::new(move |boxes| Ok(Box::new(LightBuffer::build(origin, boxes)) as Box<dyn BoxCuller>))
 }
 
 /// The names `--backend` accepts in this build, default first.

@@ -5,10 +5,12 @@
 
 mod aabb;
 mod box_tree;
+mod light_buffer;
 mod primitive;
 
 pub use aabb::Aabb;
 pub use box_tree::{walk, BoxTree, TreeNode, PACKET};
+pub use light_buffer::LightBuffer;
 #[cfg(feature = "embree")]
 pub(crate) use primitive::{capsule_hit, cuboid_hit};
 pub use primitive::{Geometry, Part, Primitive};

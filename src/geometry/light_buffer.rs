@@ -1,0 +1,311 @@
+//! A light buffer (Haines & Greenberg, "The Light Buffer: A Shadow-Testing Accelerator", IEEE
+//! CG&A 6(9), 1986): culling over boxes for rays that all start at one point, a light. The
+//! directions around the light are the six faces of a cube; each face carries a grid of cells
+//! over the part of it the boxes cover, and each cell lists the boxes whose directions from the
+//! light meet it, nearest first. A ray looks up the one cell its direction falls in and tests
+//! that cell's boxes until they lie beyond its far end: no tree walk, and no box that does not
+//! lie in the ray's direction.
+//!
+//! Conservative by construction: a box seen from the light projects onto a face (central
+//! projection) inside the rectangle of its corners' projections when every corner lies in front
+//! of the face's plane; a box that crosses that plane is listed on the whole face; a box that
+//! holds the light is tested by every ray. Cell indices of rays and of rectangles come from one
+//! monotone function, so a ray always finds the boxes whose rectangles hold its direction.
+
+use super::Aabb;
+use glam::DVec3;
+
+/// Grid cells per box listed on a face, about: finer cells list each box in more of them.
+const CELLS_PER_BOX: f64 = 0.5;
+/// The most cells along a face's side.
+const MAX_RES: usize = 1024;
+/// Rectangles grow by this much (in face coordinates) for rounding in the projections.
+const PAD: f64 = 1e-9;
+
+/// One face's grid: over [lo, lo + res / inv_w] in both face coordinates.
+#[derive(Clone, Copy, Debug, Default)]
+struct Face {
+    lo: [f64; 2],
+    inv_w: [f64; 2],
+    res: usize,
+    /// Its first cell in the buffer's cell list.
+    first: usize,
+}
+
+impl Face {
+    /// The cell column (k = 0) or row (k = 1) of face coordinate x: monotone in x.
+    #[inline]
+    fn cell(&self, k: usize, x: f64) -> usize {
+        // Truncation is floor from 0 up (and a NaN goes to cell 0).
+        let c = (x - self.lo[k]) * self.inv_w[k];
+        if c >= 0.0 {
+            (c as usize).min(self.res - 1)
+        } else {
+            0
+        }
+    }
+}
+
+/// Boxes around one point, for rays from it.
+pub struct LightBuffer {
+    /// The boxes in the order of `cells.items`.
+    boxes: Vec<Aabb>,
+    cells: Cells,
+}
+
+/// Where a light buffer's boxes are listed.
+struct Cells {
+    origin: DVec3,
+    /// The items nearest first (to the origin), and their boxes' distances from it.
+    items: Vec<u32>,
+    near: Vec<f64>,
+    faces: [Face; 6],
+    /// Per cell (faces one after the other), its range in `entries`: `start[c]..start[c + 1]`.
+    start: Vec<u32>,
+    /// Indices into `items`, nearest first within each cell.
+    entries: Vec<u32>,
+    /// Boxes that hold the origin: every ray tests them.
+    everywhere: Vec<u32>,
+}
+
+/// The face a direction lies on: its major axis a and sign, and its coordinates there.
+#[inline]
+fn face_of(d: DVec3) -> Option<(usize, [f64; 2])> {
+    let m = d.abs();
+    let a = if m.x >= m.y && m.x >= m.z {
+        0
+    } else if m.y >= m.z {
+        1
+    } else {
+        2
+    };
+    let depth = d[a];
+    if depth == 0.0 || !depth.is_finite() {
+        return None;
+    }
+    let face = 2 * a + usize::from(depth < 0.0);
+    let inv = 1.0 / depth.abs();
+    Some((face, [d[(a + 1) % 3] * inv, d[(a + 2) % 3] * inv]))
+}
+
+/// The rectangles (u0, v0, u1, v1), face by face, that hold the directions of box b's points
+/// from `o`: None on a face no such direction lies on.
+fn footprints(b: &Aabb, o: DVec3) -> [Option<[f64; 4]>; 6] {
+    let (lo, hi) = (b.min - o, b.max - o);
+    // How close to 0 each coordinate of the box's points comes.
+    let gap = lo.max(-hi).max(DVec3::ZERO);
+    let corners = Aabb::new(lo, hi).corners();
+    std::array::from_fn(|f| {
+        let (a, sign) = (f / 2, if f % 2 == 0 { 1.0 } else { -1.0 });
+        let (b1, b2) = ((a + 1) % 3, (a + 2) % 3);
+        // A direction on this face has sign · p[a] ≥ |p[b1]|, |p[b2]| > 0.
+        let reach = if sign > 0.0 { hi[a] } else { -lo[a] };
+        if reach <= 0.0 || reach < gap[b1] || reach < gap[b2] {
+            return None;
+        }
+        let mut r = [f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY];
+        for c in &corners {
+            let depth = sign * c[a];
+            if depth <= 0.0 {
+                // The box crosses the face's plane: its directions may reach any of the face.
+                return Some([-1.0 - PAD, -1.0 - PAD, 1.0 + PAD, 1.0 + PAD]);
+            }
+            let inv = 1.0 / depth;
+            let (u, v) = (c[b1] * inv, c[b2] * inv);
+            r = [r[0].min(u), r[1].min(v), r[2].max(u), r[3].max(v)];
+        }
+        let r = [
+            (r[0] - PAD).max(-1.0 - PAD),
+            (r[1] - PAD).max(-1.0 - PAD),
+            (r[2] + PAD).min(1.0 + PAD),
+            (r[3] + PAD).min(1.0 + PAD),
+        ];
+        (r[0] <= r[2] && r[1] <= r[3]).then_some(r)
+    })
+}
+
+/// The distance from `o` to the box (0 inside).
+fn distance(b: &Aabb, o: DVec3) -> f64 {
+    (b.min - o).max(o - b.max).max(DVec3::ZERO).length()
+}
+
+impl LightBuffer {
+    /// Over `boxes` (item i is boxes[i]), for rays from `origin`.
+    pub fn build(origin: DVec3, boxes: &[Aabb]) -> LightBuffer {
+        // Nearest first: distances are ≥ 0, so their bits sort as they do.
+        let mut keyed: Vec<(u64, u32)> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (distance(b, origin).to_bits(), i as u32))
+            .collect();
+        keyed.sort_unstable();
+        let order: Vec<u32> = keyed.iter().map(|&(_, i)| i).collect();
+        let sorted: Vec<Aabb> = order.iter().map(|&i| boxes[i as usize]).collect();
+        let mut lb = Cells {
+            origin,
+            near: keyed.iter().map(|&(d, _)| f64::from_bits(d)).collect(),
+            items: order,
+            faces: [Face::default(); 6],
+            start: Vec::new(),
+            entries: Vec::new(),
+            everywhere: Vec::new(),
+        };
+        // Each box's rectangles, face by face, nearest box first.
+        let mut rects: Vec<(u32, u8, [f64; 4])> = Vec::with_capacity(2 * sorted.len());
+        for (k, b) in sorted.iter().enumerate() {
+            let holds = (0..3).all(|a| b.min[a] <= origin[a] && origin[a] <= b.max[a]);
+            if holds || lb.near[k] == 0.0 {
+                lb.everywhere.push(k as u32);
+                continue;
+            }
+            for (f, r) in footprints(b, origin).into_iter().enumerate() {
+                if let Some(r) = r {
+                    rects.push((k as u32, f as u8, r));
+                }
+            }
+        }
+        // Each face's grid over the rectangles on it.
+        let mut first = 0;
+        for (f, face) in lb.faces.iter_mut().enumerate() {
+            let (mut span, mut count) = (
+                [f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY],
+                0usize,
+            );
+            for (_, rf, r) in &rects {
+                if *rf as usize == f {
+                    span = [
+                        span[0].min(r[0]),
+                        span[1].min(r[1]),
+                        span[2].max(r[2]),
+                        span[3].max(r[3]),
+                    ];
+                    count += 1;
+                }
+            }
+            if count == 0 {
+                *face = Face {
+                    lo: [0.0; 2],
+                    inv_w: [0.0; 2],
+                    res: 1,
+                    first,
+                };
+                first += 1;
+                continue;
+            }
+            let res = ((count as f64 * CELLS_PER_BOX).sqrt().ceil() as usize).clamp(1, MAX_RES);
+            let inv_w = |lo: f64, hi: f64| {
+                let w = (hi - lo) / res as f64;
+                if w > 0.0 {
+                    1.0 / w
+                } else {
+                    0.0
+                }
+            };
+            *face = Face {
+                lo: [span[0], span[1]],
+                inv_w: [inv_w(span[0], span[2]), inv_w(span[1], span[3])],
+                res,
+                first,
+            };
+            first += res * res;
+        }
+        // Cells' lists (counted, then filled in nearest-first order).
+        let cells_of = |faces: &[Face; 6], f: usize, r: &[f64; 4]| {
+            let face = &faces[f];
+            let (u0, u1) = (face.cell(0, r[0]), face.cell(0, r[2]));
+            let (v0, v1) = (face.cell(1, r[1]), face.cell(1, r[3]));
+            (face.first, face.res, u0, u1, v0, v1)
+        };
+        let mut start = vec![0u32; first + 1];
+        for (_, f, r) in &rects {
+            let (base, res, u0, u1, v0, v1) = cells_of(&lb.faces, *f as usize, r);
+            for v in v0..=v1 {
+                for u in u0..=u1 {
+                    start[base + v * res + u + 1] += 1;
+                }
+            }
+        }
+        for c in 0..first {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut entries = vec![0u32; start[first] as usize];
+        for (k, f, r) in &rects {
+            let (base, res, u0, u1, v0, v1) = cells_of(&lb.faces, *f as usize, r);
+            for v in v0..=v1 {
+                for u in u0..=u1 {
+                    let c = base + v * res + u;
+                    entries[fill[c] as usize] = *k;
+                    fill[c] += 1;
+                }
+            }
+        }
+        lb.start = start;
+        lb.entries = entries;
+        LightBuffer {
+            boxes: sorted,
+            cells: lb,
+        }
+    }
+
+    /// How many boxes it holds.
+    pub fn len(&self) -> usize {
+        self.boxes.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.boxes.is_empty()
+    }
+
+    /// The rays from `o` along `dirs` (each searched in `(tmin[i], tmax[i])`), one by one:
+    /// `visit(item, ray, tmax)` for every item whose box the ray meets before its tmax (nearest
+    /// boxes first), returning the ray's new tmax; one below its tmin ends the ray. Rays from
+    /// elsewhere than the buffer's origin test every box.
+    pub fn traverse(
+        &self,
+        o: DVec3,
+        dirs: &[DVec3],
+        tmin: &[f64],
+        tmax: &mut [f64],
+        visit: &mut dyn FnMut(u32, usize, f64) -> f64,
+    ) {
+        let cells = &self.cells;
+        for (i, &d) in dirs.iter().enumerate() {
+            let inv = d.recip();
+            let mut test = |k: u32, tmax: &mut f64| {
+                let k = k as usize;
+                if self.boxes[k].clip(o, inv, tmin[i], *tmax).is_some() {
+                    *tmax = visit(cells.items[k], i, *tmax);
+                }
+            };
+            if o != cells.origin {
+                for k in 0..self.boxes.len() as u32 {
+                    if tmax[i] < tmin[i] {
+                        break;
+                    }
+                    test(k, &mut tmax[i]);
+                }
+                continue;
+            }
+            for &k in &cells.everywhere {
+                if tmax[i] < tmin[i] {
+                    break;
+                }
+                test(k, &mut tmax[i]);
+            }
+            let Some((f, uv)) = face_of(d) else {
+                continue;
+            };
+            let face = &cells.faces[f];
+            let c = face.first + face.cell(1, uv[1]) * face.res + face.cell(0, uv[0]);
+            // Beyond this distance from the origin the ray has ended (with rounding slack).
+            let len = d.length();
+            for &k in &cells.entries[cells.start[c] as usize..cells.start[c + 1] as usize] {
+                if tmax[i] < tmin[i] || cells.near[k as usize] > tmax[i] * len * (1.0 + 1e-12) {
+                    break;
+                }
+                test(k, &mut tmax[i]);
+            }
+        }
+    }
+}
