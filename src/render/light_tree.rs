@@ -7,16 +7,17 @@
 //! Time reversed, that is the apparent shape of PHYSICS.md §2.1 seen from L by a body moving at
 //! −v, so [`apparent_box_along`] bounds it; and for emission times in a slice [t_a, t_b] the points
 //! obey x − v|x − L| ∈ B(t_a) ∪ … ∪ B(t_b), inside the box around B(t_a) and B(t_b). So a static
-//! tree per slice of emission times holds every group's reachable shape, and a shadow ray walks
-//! only the slice of its own emission time, with plain slab tests along its track (the kinetic
-//! trees cut a ray into pieces by time and test moving bounds in each).
+//! culling structure per slice of emission times holds every group's reachable shape, and a shadow
+//! ray tests only the slice of its own emission time, with plain slab tests along its track (the
+//! kinetic trees cut a ray into pieces by time and test moving bounds in each).
 //!
 //! Slices are made on first use, so only the emission times a frame's shadow rays have cost
-//! anything; a few consecutive slices share one tree shape (built at the middle one), refitted
-//! to each slice's boxes, and hold only the groups the imaging event's causal past can reach
-//! (every shading point lies in it, so a ray that left L at t_e stays in the ellipsoid
-//! |x − L| + |x − E| ≤ t_E − t_e). Read backwards, a slice's rays all start at L: a tile's shadow
-//! rays go through it in packets.
+//! anything. A run of consecutive slices holds only the groups the imaging event's causal past
+//! can reach (every shading point lies in it, so a ray that left L at t_e stays in the ellipsoid
+//! |x − L| + |x − E| ≤ t_E − t_e), and shares one structure built at its middle slice, refitted
+//! to each other slice's boxes where the structure can be (the f64 box tree), else built anew.
+//! Read backwards, a slice's rays all start at L: the renderer's structure is a light buffer
+//! around L (geometry/light_buffer.rs), and a tile's shadow rays of one slice go in together.
 
 use super::apparent_tree::apparent_box_along;
 use super::group_tree::world_box;
