@@ -532,6 +532,50 @@ fn shadows_toward_a_moving_light_are_the_same_with_the_trees() {
 }
 
 #[test]
+fn a_light_among_the_groups_casts_the_same_shadows_with_the_light_buffers() {
+    // The light in the middle of the groups: shadow rays leave it on every face of its light
+    // buffers' cubes, and some groups' reach holds the light itself.
+    let text = many_groups_scene(200).replace(
+        "[[light]]\nposition = [0, -20, 30]\n",
+        "[[light]]\nposition = [0.5, 0.3, -0.2]\n",
+    );
+    assert!(text.contains("position = [0.5, 0.3, -0.2]"));
+    let s = scene(&text);
+    for name in backends() {
+        let backend = rest_embree::accel::backend_by_name(name).unwrap();
+        let options = |group_tree| WorldOptions {
+            merge_equal_velocities: false,
+            group_tree,
+            ..Default::default()
+        };
+        let plain = World::build_with(&s, backend.as_ref(), options(false)).unwrap();
+        let fast = World::build_with(&s, backend.as_ref(), options(true)).unwrap();
+        assert!(fast.uses_group_tree());
+        let (a, b) = (render_world(&s, &plain).0, render_world(&s, &fast).0);
+        let hit = a.pixels.iter().filter(|p| p.object_id != 0).count();
+        let lit = a
+            .pixels
+            .iter()
+            .filter(|p| p.object_id != 0 && p.color.iter().any(|&c| c > 0.05))
+            .count();
+        assert!(
+            lit > 300 && hit - lit > 300,
+            "{name}: lit and shadowed surfaces in view ({lit} lit of {hit})"
+        );
+        let differ = a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .filter(|(p, q)| p != q)
+            .count();
+        assert_eq!(
+            differ, 0,
+            "{name}: the light buffers change {differ} pixels"
+        );
+    }
+}
+
+#[test]
 fn a_far_camera_sees_the_same_groups_with_the_trees() {
     // 300 slow groups (so their apparent boxes stay ~30 across) seen from 1e7 away, off every
     // axis, through a long lens: f32 coordinates of the camera about the groups' centre are
