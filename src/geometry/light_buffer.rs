@@ -48,23 +48,17 @@ impl Face {
 
 /// Boxes around one point, for rays from it.
 pub struct LightBuffer {
-    /// The boxes in the order of `cells.items`.
-    boxes: Vec<Aabb>,
-    cells: Cells,
-}
-
-/// Where a light buffer's boxes are listed.
-struct Cells {
     origin: DVec3,
-    /// The items nearest first (to the origin), and their boxes' distances from it.
+    /// The boxes nearest first (to the origin), their items, and their distances from it.
+    boxes: Vec<Aabb>,
     items: Vec<u32>,
     near: Vec<f64>,
     faces: [Face; 6],
     /// Per cell (faces one after the other), its range in `entries`: `start[c]..start[c + 1]`.
     start: Vec<u32>,
-    /// Indices into `items`, nearest first within each cell.
+    /// Indices into `boxes`, nearest first within each cell.
     entries: Vec<u32>,
-    /// Boxes that hold the origin: every ray tests them.
+    /// Boxes that hold the origin (or touch it): every ray tests them.
     everywhere: Vec<u32>,
 }
 
@@ -139,49 +133,43 @@ impl LightBuffer {
             .map(|(i, b)| (distance(b, origin).to_bits(), i as u32))
             .collect();
         keyed.sort_unstable();
-        let order: Vec<u32> = keyed.iter().map(|&(_, i)| i).collect();
-        let sorted: Vec<Aabb> = order.iter().map(|&i| boxes[i as usize]).collect();
-        let mut lb = Cells {
+        let mut lb = LightBuffer {
             origin,
+            boxes: keyed.iter().map(|&(_, i)| boxes[i as usize]).collect(),
+            items: keyed.iter().map(|&(_, i)| i).collect(),
             near: keyed.iter().map(|&(d, _)| f64::from_bits(d)).collect(),
-            items: order,
             faces: [Face::default(); 6],
             start: Vec::new(),
             entries: Vec::new(),
             everywhere: Vec::new(),
         };
-        // Each box's rectangles, face by face, nearest box first.
-        let mut rects: Vec<(u32, u8, [f64; 4])> = Vec::with_capacity(2 * sorted.len());
-        for (k, b) in sorted.iter().enumerate() {
-            let holds = (0..3).all(|a| b.min[a] <= origin[a] && origin[a] <= b.max[a]);
-            if holds || lb.near[k] == 0.0 {
+        // Each box's rectangles, face by face, nearest box first; and each face's span of
+        // rectangles and how many it has.
+        let mut rects: Vec<(u32, u8, [f64; 4])> = Vec::with_capacity(2 * lb.boxes.len());
+        let mut spans = [[f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY]; 6];
+        let mut counts = [0usize; 6];
+        for (k, b) in lb.boxes.iter().enumerate() {
+            if lb.near[k] == 0.0 {
                 lb.everywhere.push(k as u32);
                 continue;
             }
             for (f, r) in footprints(b, origin).into_iter().enumerate() {
                 if let Some(r) = r {
                     rects.push((k as u32, f as u8, r));
-                }
-            }
-        }
-        // Each face's grid over the rectangles on it.
-        let mut first = 0;
-        for (f, face) in lb.faces.iter_mut().enumerate() {
-            let (mut span, mut count) = (
-                [f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY],
-                0usize,
-            );
-            for (_, rf, r) in &rects {
-                if *rf as usize == f {
-                    span = [
+                    let span = &mut spans[f];
+                    *span = [
                         span[0].min(r[0]),
                         span[1].min(r[1]),
                         span[2].max(r[2]),
                         span[3].max(r[3]),
                     ];
-                    count += 1;
+                    counts[f] += 1;
                 }
             }
+        }
+        // Each face's grid over the rectangles on it.
+        let mut first = 0;
+        for ((face, span), count) in lb.faces.iter_mut().zip(spans).zip(counts) {
             if count == 0 {
                 *face = Face {
                     lo: [0.0; 2],
@@ -242,10 +230,7 @@ impl LightBuffer {
         }
         lb.start = start;
         lb.entries = entries;
-        LightBuffer {
-            boxes: sorted,
-            cells: lb,
-        }
+        lb
     }
 
     /// How many boxes it holds.
@@ -269,16 +254,15 @@ impl LightBuffer {
         tmax: &mut [f64],
         visit: &mut dyn FnMut(u32, usize, f64) -> f64,
     ) {
-        let cells = &self.cells;
         for (i, &d) in dirs.iter().enumerate() {
             let inv = d.recip();
             let mut test = |k: u32, tmax: &mut f64| {
                 let k = k as usize;
                 if self.boxes[k].clip(o, inv, tmin[i], *tmax).is_some() {
-                    *tmax = visit(cells.items[k], i, *tmax);
+                    *tmax = visit(self.items[k], i, *tmax);
                 }
             };
-            if o != cells.origin {
+            if o != self.origin {
                 for k in 0..self.boxes.len() as u32 {
                     if tmax[i] < tmin[i] {
                         break;
@@ -287,7 +271,7 @@ impl LightBuffer {
                 }
                 continue;
             }
-            for &k in &cells.everywhere {
+            for &k in &self.everywhere {
                 if tmax[i] < tmin[i] {
                     break;
                 }
@@ -296,12 +280,12 @@ impl LightBuffer {
             let Some((f, uv)) = face_of(d) else {
                 continue;
             };
-            let face = &cells.faces[f];
+            let face = &self.faces[f];
             let c = face.first + face.cell(1, uv[1]) * face.res + face.cell(0, uv[0]);
             // Beyond this distance from the origin the ray has ended (with rounding slack).
             let len = d.length();
-            for &k in &cells.entries[cells.start[c] as usize..cells.start[c + 1] as usize] {
-                if tmax[i] < tmin[i] || cells.near[k as usize] > tmax[i] * len * (1.0 + 1e-12) {
+            for &k in &self.entries[self.start[c] as usize..self.start[c + 1] as usize] {
+                if tmax[i] < tmin[i] || self.near[k as usize] > tmax[i] * len * (1.0 + 1e-12) {
                     break;
                 }
                 test(k, &mut tmax[i]);
