@@ -5,8 +5,9 @@
 //! lose one.
 
 use super::device::Device;
+use super::exact::{self, Shapes};
 use super::packet::flush_denormals;
-use super::scene::GeometryHandle;
+use super::scene::new_geometry;
 use crate::accel::BoxCuller;
 use crate::geometry::{Aabb, PACKET};
 use embree_sys::*;
@@ -16,7 +17,7 @@ use std::sync::Arc;
 pub struct EmbreeCuller {
     raw: RTCScene,
     /// Embree points into these (boxes relative to `center`, widened); dropped after the scene.
-    boxes: Box<[Aabb]>,
+    boxes: Box<Shapes<Aabb>>,
     center: DVec3,
     /// All the (widened) boxes together, relative to `center`: rays start on it, so f32 sees
     /// only coordinates of the boxes' size however far the rays come from.
@@ -49,25 +50,6 @@ struct CullContext<'a> {
     len: [f64; PACKET],
     shift: [f64; PACKET],
     slack: f64,
-}
-
-unsafe extern "C" fn bounds(args: *const RTCBoundsFunctionArguments) {
-    // SAFETY: Embree passes the user pointer we registered (the first of the culler's live
-    // boxes) and a prim index below the primitive count we set.
-    unsafe {
-        let args = &*args;
-        let b = *(args.geometryUserPtr as *const Aabb).add(args.primID as usize);
-        *args.bounds_o = RTCBounds {
-            lower_x: (b.min.x as f32).next_down(),
-            lower_y: (b.min.y as f32).next_down(),
-            lower_z: (b.min.z as f32).next_down(),
-            align0: 0.0,
-            upper_x: (b.max.x as f32).next_up(),
-            upper_y: (b.max.y as f32).next_up(),
-            upper_z: (b.max.z as f32).next_up(),
-            align1: 0.0,
-        };
-    }
 }
 
 /// Offer box `prim` to every valid lane; a lane whose tmax drops below its tmin is done.
@@ -144,16 +126,18 @@ impl EmbreeCuller {
         };
         let slack = 1e-5 * (extent + (all.max - center).abs().max_element());
         let pad = DVec3::splat(slack);
-        let boxes: Box<[Aabb]> = boxes
-            .iter()
-            .map(|b| Aabb::new(b.min - center - pad, b.max - center + pad))
-            .collect();
+        let boxes = Box::new(Shapes(
+            boxes
+                .iter()
+                .map(|b| Aabb::new(b.min - center - pad, b.max - center + pad))
+                .collect::<Vec<_>>(),
+        ));
         let raw = unsafe { rtcNewScene(device.raw) };
         if raw.is_null() {
             device.check("creating a culling scene")?;
             return Err("Embree could not create a scene".into());
         }
-        let all = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
+        let all = boxes.0.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
         let culler = EmbreeCuller {
             raw,
             boxes,
@@ -163,19 +147,15 @@ impl EmbreeCuller {
             _device: device.clone(),
         };
 
-        if !culler.boxes.is_empty() {
-            let g = GeometryHandle(unsafe { rtcNewGeometry(device.raw, RTC_GEOMETRY_TYPE_USER) });
-            if g.0.is_null() {
-                device.check("creating a culling geometry")?;
-                return Err("Embree could not create a geometry".into());
-            }
-            let ptr = culler.boxes.as_ptr() as *mut std::ffi::c_void;
-            // SAFETY: the boxes (a heap slice that never moves) outlive the scene (dropped after
-            // it is released) and the bounds callback reads them as Aabb by prim index.
+        if !culler.boxes.0.is_empty() {
+            let g = new_geometry(&device, RTC_GEOMETRY_TYPE_USER)?;
+            let ptr = &*culler.boxes as *const Shapes<Aabb> as *mut std::ffi::c_void;
+            // SAFETY: the boxes (boxed, so they never move) outlive the scene (dropped after it
+            // is released), and the bounds callback reads them as `Shapes<Aabb>`.
             unsafe {
-                rtcSetGeometryUserPrimitiveCount(g.0, culler.boxes.len() as u32);
+                rtcSetGeometryUserPrimitiveCount(g.0, culler.boxes.0.len() as u32);
                 rtcSetGeometryUserData(g.0, ptr);
-                rtcSetGeometryBoundsFunction(g.0, Some(bounds), ptr);
+                rtcSetGeometryBoundsFunction(g.0, Some(exact::bounds::<Aabb>), ptr);
                 rtcSetGeometryIntersectFunction(g.0, Some(intersect));
                 rtcSetGeometryOccludedFunction(g.0, Some(occluded));
                 rtcCommitGeometry(g.0);
@@ -198,7 +178,7 @@ impl BoxCuller for EmbreeCuller {
         tmax: &mut [f64],
         visit: &mut dyn FnMut(u32, usize, f64) -> f64,
     ) {
-        if self.boxes.is_empty() {
+        if self.boxes.0.is_empty() {
             return;
         }
         flush_denormals();

@@ -1,4 +1,4 @@
-//! Spheres, rods (capsules) and boxes as Embree user geometry: Embree's BVH over their bounds
+//! Spheres, rods (capsules) and boxes as Embree user geometry (also the boxes of culler.rs): Embree's BVH over their bounds
 //! finds the candidates, and the exact f64 tests of the f64 BVH decide the hit, on the caller's
 //! f64 ray (passed in the intersect context) rather than Embree's f32 copy, so these hits need
 //! no refinement. Embree's own round curves and sphere points are built for hair and particles
@@ -7,7 +7,7 @@
 //! triangles each, refined in f64 after, were slower than one exact slab test.
 
 use crate::accel::Ray;
-use crate::geometry::{capsule_hit, cuboid_hit};
+use crate::geometry::{capsule_hit, cuboid_hit, Aabb};
 use embree_sys::*;
 use glam::DVec3;
 use std::cell::Cell;
@@ -40,13 +40,7 @@ impl Shape for Round {
 }
 
 /// An axis-aligned box.
-#[derive(Clone, Copy, Debug)]
-pub struct Cuboid {
-    pub min: DVec3,
-    pub max: DVec3,
-}
-
-impl Shape for Cuboid {
+impl Shape for Aabb {
     #[inline]
     fn hit(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64> {
         cuboid_hit(self.min, self.max, o, d, tmin, tmax)

@@ -3,8 +3,8 @@
 //! user geometry running the exact f64 tests (exact.rs).
 
 use super::device::Device;
-use super::exact::{self, Cuboid, Round, Shape, Shapes};
-use crate::geometry::{Geometry as SceneGeometry, Primitive};
+use super::exact::{self, Round, Shape, Shapes};
+use crate::geometry::{Aabb, Geometry as SceneGeometry, Primitive};
 use embree_sys::*;
 use glam::DVec3;
 use std::sync::Arc;
@@ -33,7 +33,7 @@ pub struct Scene {
     pub center: DVec3,
     /// What Embree's user geometry points into; dropped after the scene is released.
     rounds: Option<Box<Shapes<Round>>>,
-    cuboids: Option<Box<Shapes<Cuboid>>>,
+    cuboids: Option<Box<Shapes<Aabb>>>,
     _device: Arc<Device>,
 }
 
@@ -44,6 +44,19 @@ impl Drop for Scene {
     fn drop(&mut self) {
         unsafe { rtcReleaseScene(self.raw) };
     }
+}
+
+/// A new Embree geometry of this kind.
+pub(super) fn new_geometry(
+    device: &Device,
+    kind: RTCGeometryType,
+) -> Result<GeometryHandle, String> {
+    let g = unsafe { rtcNewGeometry(device.raw, kind) };
+    if g.is_null() {
+        device.check("creating a geometry")?;
+        return Err("Embree could not create a geometry".into());
+    }
+    Ok(GeometryHandle(g))
 }
 
 fn f3(p: DVec3) -> [f32; 3] {
@@ -76,7 +89,7 @@ impl Scene {
             rtcSetSceneFlags(raw, RTC_SCENE_FLAG_ROBUST);
         }
         let (mut tris, mut tri_map): (Vec<[[f32; 3]; 3]>, Vec<u32>) = (Vec::new(), Vec::new());
-        let (mut cuboids, mut cuboid_map): (Vec<Cuboid>, Vec<u32>) = (Vec::new(), Vec::new());
+        let (mut cuboids, mut cuboid_map): (Vec<Aabb>, Vec<u32>) = (Vec::new(), Vec::new());
         let (mut rounds, mut round_map): (Vec<Round>, Vec<u32>) = (Vec::new(), Vec::new());
         for (i, p) in geo.prims.iter().enumerate() {
             let i = i as u32;
@@ -98,10 +111,7 @@ impl Scene {
                     round_map.push(i);
                 }
                 Primitive::Cuboid { min, max } => {
-                    cuboids.push(Cuboid {
-                        min: min - center,
-                        max: max - center,
-                    });
+                    cuboids.push(Aabb::new(min - center, max - center));
                     cuboid_map.push(i);
                 }
                 Primitive::Triangle { v } => {
@@ -111,7 +121,7 @@ impl Scene {
             }
         }
         if !tris.is_empty() {
-            let g = scene.new_geometry(&device, RTC_GEOMETRY_TYPE_TRIANGLE)?;
+            let g = new_geometry(&device, RTC_GEOMETRY_TYPE_TRIANGLE)?;
             let verts = scene.buffer::<[f32; 3]>(
                 &g,
                 RTC_BUFFER_TYPE_VERTEX,
@@ -150,7 +160,7 @@ impl Scene {
         if shapes.is_empty() {
             return Ok(None);
         }
-        let g = self.new_geometry(device, RTC_GEOMETRY_TYPE_USER)?;
+        let g = new_geometry(device, RTC_GEOMETRY_TYPE_USER)?;
         let data = Box::new(Shapes(shapes));
         let ptr = &*data as *const Shapes<S> as *mut std::ffi::c_void;
         // SAFETY: `data` outlives the Embree scene (the scene drops it after releasing the
@@ -164,19 +174,6 @@ impl Scene {
         }
         self.attach(device, g, map, true)?;
         Ok(Some(data))
-    }
-
-    fn new_geometry(
-        &self,
-        device: &Device,
-        kind: RTCGeometryType,
-    ) -> Result<GeometryHandle, String> {
-        let g = unsafe { rtcNewGeometry(device.raw, kind) };
-        if g.is_null() {
-            device.check("creating a geometry")?;
-            return Err("Embree could not create a geometry".into());
-        }
-        Ok(GeometryHandle(g))
     }
 
     /// A new buffer of `count` items of T on the geometry, as a slice to fill.
