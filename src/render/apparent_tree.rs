@@ -63,17 +63,11 @@ pub fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec
     };
     let ph = DVec3::new(row(0), row(1), row(2));
     // |p|² = |x|² − (x·u)² is convex: largest at a corner.
-    let mut rho2_max = 0.0f64;
-    for k in 0..8 {
-        let s = DVec3::new(
-            if k & 1 == 0 { -h.x } else { h.x },
-            if k & 2 == 0 { -h.y } else { h.y },
-            if k & 4 == 0 { -h.z } else { h.z },
-        );
-        let x = c + s;
-        let a = x.dot(u);
-        rho2_max = rho2_max.max(x.length_squared() - a * a);
-    }
+    let rho2_max = Aabb::new(c - h, c + h)
+        .corners()
+        .iter()
+        .map(|x| x.length_squared() - x.dot(u).powi(2))
+        .fold(0.0, f64::max);
     // Lab-simultaneous offsets along v, and their rest-frame values X = γ x∥.
     let (x_min, x_max) = (gamma * a_min, gamma * a_max);
     let rho_max = rho2_max.sqrt();
@@ -99,20 +93,16 @@ pub fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec
 }
 
 impl ApparentTree {
-    /// Over the apparent boxes of `groups` seen from `event`, in the backend's culling
-    /// structure (Embree's BVH, or the f64 box tree).
+    /// Over the groups' apparent boxes (see [`apparent_box`]) seen from `event`, in the
+    /// backend's culling structure (Embree's BVH, or the f64 box tree).
     pub fn build(
-        groups: &[(Aabb, Velocity)],
+        apparent: &[Aabb],
         event: Event,
         cullers: &CullerFactory,
     ) -> Result<ApparentTree, String> {
-        let boxes: Vec<Aabb> = groups
-            .iter()
-            .map(|(b, v)| apparent_box(b, v, event))
-            .collect();
         Ok(ApparentTree {
             event,
-            tree: cullers(&boxes)?,
+            tree: cullers(apparent)?,
         })
     }
 
@@ -139,7 +129,7 @@ impl ApparentTree {
         );
     }
 
-    /// Traverse with a packet of up to `PACKET` primary rays (all starting at the imaging
+    /// Traverse with a packet of up to [`crate::geometry::PACKET`] primary rays (all starting at the imaging
     /// event): `visit(group, ray, tmax)` returns the ray's new tmax (best hit so far).
     pub fn traverse_packet(
         &self,
@@ -148,11 +138,8 @@ impl ApparentTree {
         tmax: &mut [f64],
         mut visit: impl FnMut(u32, usize, f64) -> f64,
     ) {
-        let tmins = [tmin; PACKET];
+        let tmins = [tmin; crate::geometry::PACKET];
         self.tree
             .traverse_packet(self.event.x, dirs, &tmins, tmax, &mut visit);
     }
 }
-
-/// Up to this many primary rays traverse the apparent tree together.
-pub const PACKET: usize = crate::geometry::PACKET;
