@@ -184,12 +184,10 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
     // One untimed pass first: thread pools, page faults and caches are warm for every row.
     let mut primary_rays = trace_primary(&scene, &world).0;
     let primary_s = fastest(repeat, || primary_rays = trace_primary(&scene, &world).0);
-    // Renders of a few milliseconds vary by tens of percent from run to run: the fastest of
-    // `repeat` counts, as for the primary rays.
     // The first render also builds whatever is built on first use (the time slices of many
-    // groups): the cold cost of a frame is build + first render.
-    // Then the fastest render, as for primary passes: short renders right after a backend is
-    // built were measured 1.5x slow while its threads wind down.
+    // groups): the cold cost of a frame is build + first render. Then the fastest render, as
+    // for primary passes: renders of a few milliseconds vary by tens of percent, and right
+    // after a backend is built they were measured 1.5x slow while its threads wind down.
     let t = Instant::now();
     let (frame, _) = render_world(&scene, &world);
     let first_render_s = t.elapsed().as_secs_f64();

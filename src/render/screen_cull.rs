@@ -84,10 +84,8 @@ impl ScreenCull {
             if theta.is_nan() || theta >= std::f64::consts::FRAC_PI_2 - 1e-6 {
                 return None;
             }
-            let (u, v) = (
-                axis.any_orthonormal_vector(),
-                axis.cross(axis.any_orthonormal_vector()),
-            );
+            let u = axis.any_orthonormal_vector();
+            let v = axis.cross(u);
             // Three boundary directions, seen in the world frame, then by the camera.
             let seen = |side: DVec3| {
                 let rest = theta.cos() * axis + theta.sin() * side;
