@@ -5,7 +5,7 @@ mod common;
 use common::*;
 use glam::DVec3;
 use rest_embree::geometry::Aabb;
-use rest_embree::render::{render_world, GroupTree, SlicedGroupTree, World, WorldOptions};
+use rest_embree::render::{render_world, Frame, GroupTree, SlicedGroupTree, World, WorldOptions};
 use rest_embree::spacetime::{Boost, Event, NullRay, Velocity};
 
 /// Exact: whether the ray meets a group's bounds in lookback (0, tmax), tested in the group's
@@ -500,6 +500,25 @@ fn refitted_trees_bound_their_new_boxes() {
     assert!(empty.indices.is_empty());
 }
 
+/// The scene rendered on `backend` without the group trees and with them (the picture they
+/// must not change), equal velocities merged or not as `merge` says.
+fn without_and_with_trees(
+    s: &rest_embree::scene::Scene,
+    backend: &str,
+    merge: bool,
+) -> (Frame, Frame) {
+    let backend = rest_embree::accel::backend_by_name(backend).unwrap();
+    let options = |group_tree| WorldOptions {
+        merge_equal_velocities: merge,
+        group_tree,
+        ..Default::default()
+    };
+    let plain = World::build_with(s, backend.as_ref(), options(false)).unwrap();
+    let fast = World::build_with(s, backend.as_ref(), options(true)).unwrap();
+    assert!(fast.uses_group_tree() && !plain.uses_group_tree());
+    (render_world(s, &plain).0, render_world(s, &fast).0)
+}
+
 #[test]
 fn shadows_toward_a_moving_light_are_the_same_with_the_trees() {
     // A moving light has no light tree: its shadow rays take the kinetic trees.
@@ -509,16 +528,7 @@ fn shadows_toward_a_moving_light_are_the_same_with_the_trees() {
     );
     assert!(text.contains("velocity = [0.4, 0, 0.2]"));
     let s = scene(&text);
-    let backend = rest_embree::accel::backend_by_name("bvh").unwrap();
-    let options = |group_tree| WorldOptions {
-        merge_equal_velocities: false,
-        group_tree,
-        ..Default::default()
-    };
-    let plain = World::build_with(&s, backend.as_ref(), options(false)).unwrap();
-    let fast = World::build_with(&s, backend.as_ref(), options(true)).unwrap();
-    assert!(fast.uses_group_tree());
-    let (a, b) = (render_world(&s, &plain).0, render_world(&s, &fast).0);
+    let (a, b) = without_and_with_trees(&s, "bvh", false);
     let lit = a
         .pixels
         .iter()
@@ -542,16 +552,7 @@ fn a_light_among_the_groups_casts_the_same_shadows_with_the_light_buffers() {
     assert!(text.contains("position = [0.5, 0.3, -0.2]"));
     let s = scene(&text);
     for name in backends() {
-        let backend = rest_embree::accel::backend_by_name(name).unwrap();
-        let options = |group_tree| WorldOptions {
-            merge_equal_velocities: false,
-            group_tree,
-            ..Default::default()
-        };
-        let plain = World::build_with(&s, backend.as_ref(), options(false)).unwrap();
-        let fast = World::build_with(&s, backend.as_ref(), options(true)).unwrap();
-        assert!(fast.uses_group_tree());
-        let (a, b) = (render_world(&s, &plain).0, render_world(&s, &fast).0);
+        let (a, b) = without_and_with_trees(&s, name, false);
         let hit = a.pixels.iter().filter(|p| p.object_id != 0).count();
         let lit = a
             .pixels
@@ -608,15 +609,7 @@ fn a_far_camera_sees_the_same_groups_with_the_trees() {
     }
     let s = scene(&text);
     for name in backends() {
-        let backend = rest_embree::accel::backend_by_name(name).unwrap();
-        let options = |group_tree| WorldOptions {
-            group_tree,
-            ..Default::default()
-        };
-        let plain = World::build_with(&s, backend.as_ref(), options(false)).unwrap();
-        let fast = World::build_with(&s, backend.as_ref(), options(true)).unwrap();
-        assert!(fast.uses_group_tree());
-        let (a, b) = (render_world(&s, &plain).0, render_world(&s, &fast).0);
+        let (a, b) = without_and_with_trees(&s, name, true);
         let hit = a.pixels.iter().filter(|p| p.object_id != 0).count();
         assert!(hit > 1000, "{name}: the objects are in view ({hit})");
         let ids = a
