@@ -143,11 +143,8 @@ impl LightBuffer {
             entries: Vec::new(),
             everywhere: Vec::new(),
         };
-        // Each box's rectangles, face by face, nearest box first; and each face's span of
-        // rectangles and how many it has.
+        // Each box's rectangles, face by face, nearest box first.
         let mut rects: Vec<(u32, u8, [f64; 4])> = Vec::with_capacity(2 * lb.boxes.len());
-        let mut spans = [[f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY]; 6];
-        let mut counts = [0usize; 6];
         for (k, b) in lb.boxes.iter().enumerate() {
             if lb.near[k] == 0.0 {
                 lb.everywhere.push(k as u32);
@@ -156,16 +153,21 @@ impl LightBuffer {
             for (f, r) in footprints(b, origin).into_iter().enumerate() {
                 if let Some(r) = r {
                     rects.push((k as u32, f as u8, r));
-                    let span = &mut spans[f];
-                    *span = [
-                        span[0].min(r[0]),
-                        span[1].min(r[1]),
-                        span[2].max(r[2]),
-                        span[3].max(r[3]),
-                    ];
-                    counts[f] += 1;
                 }
             }
+        }
+        // Each face's span of rectangles and how many it has.
+        let mut spans = [[f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY]; 6];
+        let mut counts = [0usize; 6];
+        for &(_, f, r) in &rects {
+            let span = &mut spans[f as usize];
+            *span = [
+                span[0].min(r[0]),
+                span[1].min(r[1]),
+                span[2].max(r[2]),
+                span[3].max(r[3]),
+            ];
+            counts[f as usize] += 1;
         }
         // Each face's grid over the rectangles on it.
         let mut first = 0;

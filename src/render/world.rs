@@ -493,6 +493,7 @@ impl World {
     }
 
     /// Group gi's hit on the ray in lookback (tmin, tmax), if it has one.
+    #[inline(always)]
     fn hit_before(&self, gi: usize, ray: &NullRay, tmin: f64, tmax: f64) -> Option<SurfaceHit> {
         let g = &self.groups[gi];
         let rr = self.rest_ray(g, ray, tmin, tmax)?;
