@@ -136,8 +136,9 @@ impl ApparentTree {
         );
     }
 
-    /// Traverse with a packet of up to [`crate::geometry::PACKET`] primary rays (all starting at the imaging
-    /// event): `visit(group, ray, tmax)` returns the ray's new tmax (best hit so far).
+    /// Traverse with a packet of up to [`crate::geometry::PACKET`] primary rays (all starting at
+    /// the imaging event): `visit(group, ray, tmax)` returns the ray's new tmax (best hit so
+    /// far).
     pub fn traverse_packet(
         &self,
         dirs: &[glam::DVec3],
