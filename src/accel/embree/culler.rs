@@ -5,7 +5,8 @@
 //! lose one.
 
 use super::device::Device;
-use super::exact::{self, Shapes};
+use super::exact::{self, Shape, Shapes};
+use super::lane_cull::lanes_near;
 use super::packet::flush_denormals;
 use super::scene::new_geometry;
 use crate::accel::BoxCuller;
@@ -52,13 +53,15 @@ struct CullContext<'a> {
     slack: f64,
 }
 
-/// Offer box `prim` to every valid lane; a lane whose tmax drops below its tmin is done.
+/// Offer box `prim` to every valid lane that may meet it (lane_cull.rs); a lane whose tmax
+/// drops below its tmin is done.
 ///
 /// # Safety
-/// `context` is a `CullContext` (every query of this culler passes one); `ray` an N-wide SoA
-/// ray (RTCRayN layout: tfar is field 8) with `valid` of N entries.
+/// `context` is a `CullContext` (every query of this culler passes one); `user` the culler's
+/// boxes; `ray` an N-wide SoA ray (RTCRayN layout: tfar is field 8) with `valid` of N entries.
 unsafe fn offer(
     context: *mut RTCIntersectContext,
+    user: *mut std::ffi::c_void,
     prim: u32,
     ray: *mut f32,
     valid: *const i32,
@@ -66,10 +69,10 @@ unsafe fn offer(
 ) {
     unsafe {
         let ctx = &mut *(context as *mut CullContext);
-        for i in 0..n.min(ctx.tmax.len()) {
-            if *valid.add(i) == 0 {
-                continue;
-            }
+        let boxes = &*(user as *const Shapes<Aabb>);
+        let (lo, hi) = boxes.0[prim as usize].bounds();
+        let lanes = ctx.tmax.len();
+        for i in lanes_near(valid, ray, n, lo, hi).filter(|&i| i < lanes) {
             let before = ctx.tmax[i];
             let t = (ctx.visit)(prim, i, before);
             ctx.tmax[i] = t;
@@ -88,6 +91,7 @@ unsafe extern "C" fn intersect(args: *const RTCIntersectFunctionNArguments) {
         let a = &*args;
         offer(
             a.context,
+            a.geometryUserPtr,
             a.primID,
             a.rayhit as *mut f32,
             a.valid,
@@ -102,6 +106,7 @@ unsafe extern "C" fn occluded(args: *const RTCOccludedFunctionNArguments) {
         let a = &*args;
         offer(
             a.context,
+            a.geometryUserPtr,
             a.primID,
             a.ray as *mut f32,
             a.valid,

@@ -14,6 +14,7 @@ mod bare;
 mod culler;
 mod device;
 mod exact;
+mod lane_cull;
 mod packet;
 mod scene;
 
