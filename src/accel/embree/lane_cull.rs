@@ -102,26 +102,34 @@ unsafe fn near_box<const N: usize>(ray: *const f32, lo: DVec3, hi: DVec3) -> u32
     let reach = (c.abs().element_sum() + e.element_sum()) as f32;
     let (cx, cy, cz) = (c.x as f32, c.y as f32, c.z as f32);
     let (ex, ey, ez) = (e.x as f32, e.y as f32, e.z as f32);
-    let mut near = [false; N];
-    for i in 0..N {
-        let (x, y, z) = (dx[i], dy[i], dz[i]);
-        let pad = PAD * (reach + ox[i].abs() + oy[i].abs() + oz[i].abs());
-        let (ax, ay, az) = (ex + pad, ey + pad, ez + pad);
-        let (wx, wy, wz) = (ox[i] - cx, oy[i] - cy, oz[i] - cz);
-        // Non-short-circuit operators throughout, so the lanes stay in vectors.
-        let away = ((wx > ax) & (x >= 0.0))
-            | ((wx < -ax) & (x <= 0.0))
-            | ((wy > ay) & (y >= 0.0))
-            | ((wy < -ay) & (y <= 0.0))
-            | ((wz > az) & (z >= 0.0))
-            | ((wz < -az) & (z <= 0.0));
-        let (ux, uy, uz) = (x.abs(), y.abs(), z.abs());
-        let apart = ((wy * z - wz * y).abs() > ay * uz + az * uy)
-            | ((wz * x - wx * z).abs() > az * ux + ax * uz)
-            | ((wx * y - wy * x).abs() > ax * uy + ay * ux);
-        near[i] = !(away | apart);
+    let mut bits = 0u32;
+    // Eight lanes at a time: one AVX vector, few enough values to stay in registers.
+    for k in (0..N).step_by(8) {
+        let mut near = [0u8; 8];
+        for (j, v) in near.iter_mut().enumerate() {
+            let i = k + j;
+            let (x, y, z) = (dx[i], dy[i], dz[i]);
+            let pad = PAD * (reach + ox[i].abs() + oy[i].abs() + oz[i].abs());
+            let (ax, ay, az) = (ex + pad, ey + pad, ez + pad);
+            let (wx, wy, wz) = (ox[i] - cx, oy[i] - cy, oz[i] - cz);
+            // Non-short-circuit operators throughout, so the lanes stay in vectors.
+            let away = ((wx > ax) & (x >= 0.0))
+                | ((wx < -ax) & (x <= 0.0))
+                | ((wy > ay) & (y >= 0.0))
+                | ((wy < -ay) & (y <= 0.0))
+                | ((wz > az) & (z >= 0.0))
+                | ((wz < -az) & (z <= 0.0));
+            let (ux, uy, uz) = (x.abs(), y.abs(), z.abs());
+            let apart = ((wy * z - wz * y).abs() > ay * uz + az * uy)
+                | ((wz * x - wx * z).abs() > az * ux + ax * uz)
+                | ((wx * y - wy * x).abs() > ax * uy + ay * ux);
+            *v = u8::from(!(away | apart));
+        }
+        let byte = near
+            .iter()
+            .enumerate()
+            .fold(0u32, |b, (j, &v)| b | (u32::from(v) << j));
+        bits |= byte << k;
     }
-    near.iter()
-        .enumerate()
-        .fold(0, |bits, (i, &b)| bits | (u32::from(b) << i))
+    bits
 }
