@@ -91,9 +91,8 @@ fn footprints(b: &Aabb, o: DVec3) -> [Option<[f64; 4]>; 6] {
     let (lo, hi) = (b.min - o, b.max - o);
     // How close to 0 each coordinate of the box's points comes.
     let gap = lo.max(-hi).max(DVec3::ZERO);
-    let corners = Aabb::new(lo, hi).corners();
     let mut out = [None; 6];
-    'faces: for (f, slot) in out.iter_mut().enumerate() {
+    for (f, slot) in out.iter_mut().enumerate() {
         let (a, sign) = (f / 2, if f % 2 == 0 { 1.0 } else { -1.0 });
         let (b1, b2) = ((a + 1) % 3, (a + 2) % 3);
         // A direction on this face has sign · p[a] ≥ |p[b1]|, |p[b2]| > 0.
@@ -101,18 +100,30 @@ fn footprints(b: &Aabb, o: DVec3) -> [Option<[f64; 4]>; 6] {
         if reach <= 0.0 || reach < gap[b1] || reach < gap[b2] {
             continue;
         }
-        let mut r = [f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY];
-        for c in &corners {
-            let depth = sign * c[a];
-            if depth <= 0.0 {
-                // The box crosses the face's plane: its directions may reach any of the face.
-                *slot = Some([-1.0 - PAD, -1.0 - PAD, 1.0 + PAD, 1.0 + PAD]);
-                continue 'faces;
-            }
-            let inv = 1.0 / depth;
-            let (u, v) = (c[b1] * inv, c[b2] * inv);
-            r = [r[0].min(u), r[1].min(v), r[2].max(u), r[3].max(v)];
+        // The corners' depths below the face take two values, so two divisions serve all
+        // eight corners (each corner's u = p[b1] · (1 / depth) as before, bit for bit).
+        let (d0, d1) = (sign * lo[a], sign * hi[a]);
+        if d0 <= 0.0 || d1 <= 0.0 {
+            // The box crosses the face's plane: its directions may reach any of the face.
+            *slot = Some([-1.0 - PAD, -1.0 - PAD, 1.0 + PAD, 1.0 + PAD]);
+            continue;
         }
+        let (i0, i1) = (1.0 / d0, 1.0 / d1);
+        let span = |k: usize| {
+            let q = [lo[k] * i0, lo[k] * i1, hi[k] * i0, hi[k] * i1];
+            let (mut min, mut max) = (q[0], q[0]);
+            for x in &q[1..] {
+                if *x < min {
+                    min = *x;
+                }
+                if *x > max {
+                    max = *x;
+                }
+            }
+            (min, max)
+        };
+        let ((u0, u1), (v0, v1)) = (span(b1), span(b2));
+        let r = [u0, v0, u1, v1];
         let r = [
             (r[0] - PAD).max(-1.0 - PAD),
             (r[1] - PAD).max(-1.0 - PAD),
@@ -205,19 +216,23 @@ impl LightBuffer {
             };
             first += res * res;
         }
-        // Cells' lists (counted, then filled in nearest-first order).
-        let cells_of = |faces: &[Face; 6], f: usize, r: &[f64; 4]| {
-            let face = &faces[f];
-            let (u0, u1) = (face.cell(0, r[0]), face.cell(0, r[2]));
-            let (v0, v1) = (face.cell(1, r[1]), face.cell(1, r[3]));
-            (face.first, face.res, u0, u1, v0, v1)
-        };
+        // Cells' lists (counted, then filled in nearest-first order). Each rectangle's cells are
+        // worked out once for both passes: its face's first cell and width, and its columns
+        // u0..u1 and rows v0..v1 (ends excluded).
+        let spans: Vec<(u32, [usize; 6])> = rects
+            .iter()
+            .map(|&(k, f, r)| {
+                let face = &lb.faces[f as usize];
+                let (u0, u1) = (face.cell(0, r[0]), face.cell(0, r[2]) + 1);
+                let (v0, v1) = (face.cell(1, r[1]), face.cell(1, r[3]) + 1);
+                (k, [face.first, face.res, u0, u1, v0, v1])
+            })
+            .collect();
         let mut start = vec![0u32; first + 1];
-        for (_, f, r) in &rects {
-            let (base, res, u0, u1, v0, v1) = cells_of(&lb.faces, *f as usize, r);
-            for v in v0..=v1 {
-                for u in u0..=u1 {
-                    start[base + v * res + u + 1] += 1;
+        for (_, [base, res, u0, u1, v0, v1]) in &spans {
+            for v in *v0..*v1 {
+                for c in &mut start[base + v * res + u0 + 1..base + v * res + u1 + 1] {
+                    *c += 1;
                 }
             }
         }
@@ -226,11 +241,9 @@ impl LightBuffer {
         }
         let mut fill = start.clone();
         let mut entries = vec![0u32; start[first] as usize];
-        for (k, f, r) in &rects {
-            let (base, res, u0, u1, v0, v1) = cells_of(&lb.faces, *f as usize, r);
-            for v in v0..=v1 {
-                for u in u0..=u1 {
-                    let c = base + v * res + u;
+        for (k, [base, res, u0, u1, v0, v1]) in &spans {
+            for v in *v0..*v1 {
+                for c in base + v * res + u0..base + v * res + u1 {
                     entries[fill[c] as usize] = *k;
                     fill[c] += 1;
                 }
