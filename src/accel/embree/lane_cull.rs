@@ -90,9 +90,10 @@ unsafe fn near8_avx2(ray: *const f32, lo: DVec3, hi: DVec3) -> u32 {
 /// well measured no faster.
 ///
 /// # Safety
-/// `ray` points to an N-wide SoA ray.
+/// `ray` points to an N-wide SoA ray, N a multiple of 8 (at most 32).
 #[inline(always)]
 unsafe fn near_box<const N: usize>(ray: *const f32, lo: DVec3, hi: DVec3) -> u32 {
+    const { assert!(N.is_multiple_of(8) && N <= 32) };
     // SAFETY: fields ORG.. and DIR.. of an N-wide SoA ray are N floats each.
     let field = |k: usize| unsafe { &*(ray.add(k * N) as *const [f32; N]) };
     let (ox, oy, oz) = (field(ORG), field(ORG + 1), field(ORG + 2));
