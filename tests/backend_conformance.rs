@@ -32,3 +32,15 @@ conformance_suite!(
         mismatch: 0.002
     }
 );
+
+// The same with 8-wide packets (Embree's own choice on CPUs without 16-wide support): its
+// callbacks see eight lanes (lane_cull.rs has a path of its own for them).
+#[cfg(feature = "embree")]
+conformance_suite!(
+    embree_8,
+    rest_embree::accel::backend_by_name("embree-8").unwrap(),
+    Tolerance {
+        t_rel: 1e-9,
+        mismatch: 0.002
+    }
+);
