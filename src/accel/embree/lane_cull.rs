@@ -22,7 +22,7 @@ const PAD: f32 = 1e-5;
 /// in order.
 ///
 /// # Safety
-/// `ray` points to an N-wide SoA ray (`RTCRayN` or `RTCRayHitN`), `valid` to its N entries.
+/// `ray` points to an n-wide SoA ray (`RTCRayN` or `RTCRayHitN`), `valid` to its n entries.
 #[inline(always)]
 pub(super) unsafe fn lanes_near(
     valid: *const i32,
@@ -33,8 +33,8 @@ pub(super) unsafe fn lanes_near(
 ) -> impl Iterator<Item = usize> {
     let near = unsafe {
         match n {
-            16 => near16(ray, lo, hi),
-            8 => near8(ray, lo, hi),
+            16 => near::<16>(ray, lo, hi),
+            8 => near::<8>(ray, lo, hi),
             // Single rays come from Embree's per-ray traversal, which tested the box already.
             _ => u32::MAX,
         }
@@ -55,32 +55,18 @@ pub(super) unsafe fn lanes_near(
 
 /// `near_box` in the widest vectors this CPU has: AVX2 runs eight lanes at once, the baseline
 /// x86-64 target four.
-unsafe fn near16(ray: *const f32, lo: DVec3, hi: DVec3) -> u32 {
+unsafe fn near<const N: usize>(ray: *const f32, lo: DVec3, hi: DVec3) -> u32 {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
-        return unsafe { near16_avx2(ray, lo, hi) };
+        return unsafe { near_avx2::<N>(ray, lo, hi) };
     }
-    unsafe { near_box::<16>(ray, lo, hi) }
-}
-
-unsafe fn near8(ray: *const f32, lo: DVec3, hi: DVec3) -> u32 {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        return unsafe { near8_avx2(ray, lo, hi) };
-    }
-    unsafe { near_box::<8>(ray, lo, hi) }
+    unsafe { near_box::<N>(ray, lo, hi) }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn near16_avx2(ray: *const f32, lo: DVec3, hi: DVec3) -> u32 {
-    unsafe { near_box::<16>(ray, lo, hi) }
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn near8_avx2(ray: *const f32, lo: DVec3, hi: DVec3) -> u32 {
-    unsafe { near_box::<8>(ray, lo, hi) }
+unsafe fn near_avx2<const N: usize>(ray: *const f32, lo: DVec3, hi: DVec3) -> u32 {
+    unsafe { near_box::<N>(ray, lo, hi) }
 }
 
 /// Bit i set unless lane i's line provably misses the box (padded): one of the three axes
