@@ -7,10 +7,13 @@ mod aabb;
 mod box_tree;
 mod light_buffer;
 mod primitive;
+mod real;
 
 pub use aabb::Aabb;
 pub use box_tree::{walk, BoxTree, TreeNode, PACKET};
 pub use light_buffer::LightBuffer;
 #[cfg(feature = "embree")]
-pub(crate) use primitive::{capsule_hit, cuboid_hit};
+pub(crate) use primitive::{ball_crossings, capsule_hit, cuboid_hit, cylinder_crossings};
 pub use primitive::{Geometry, Part, Primitive};
+#[cfg(feature = "embree")]
+pub(crate) use real::Real;

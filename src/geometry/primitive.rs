@@ -1,5 +1,6 @@
+use super::real::Real;
 use super::Aabb;
-use glam::DVec3;
+use glam::{DVec3, Vec3Swizzles};
 
 /// One rest-frame primitive. Boxes are axis-aligned; rods are capsules (a cylinder with round
 /// caps).
@@ -78,21 +79,38 @@ impl Geometry {
 /// The discriminant is a²(r² − l²) with l the closest approach, computed from a·l = a·oc − b·d
 /// (nothing lost when the ray passes close by) and tested before any division or root.
 fn round_roots(oc: DVec3, d: DVec3, r: f64) -> Option<(f64, f64)> {
-    let a = d.length_squared();
-    if a == 0.0 {
+    if d.length_squared() == 0.0 {
         return None;
     }
-    let b = oc.dot(d);
-    let l = a * oc - b * d;
-    let h = r * r * a * a - l.length_squared();
-    if h < 0.0 {
-        return None;
-    }
-    let inv = 1.0 / a;
+    let (h, t0, t1) = ball_crossings(oc.to_array(), d.to_array(), r);
+    (h >= 0.0).then_some((t0, t1))
+}
+
+/// The line oc + t d (oc relative to the ball's centre, d ≠ 0) against the ball of radius r:
+/// (h, t0, t1), crossings t0 ≤ t1 where h ≥ 0, none where h < 0. Without branches, so the
+/// Embree backend runs it on four rays at once (`lane_hits`).
+#[inline(always)]
+pub(crate) fn ball_crossings<T: Real>(oc: [T; 3], d: [T; 3], r: T) -> (T, T, T) {
+    let dot = |u: [T; 3], v: [T; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let a = dot(d, d);
+    let b = dot(oc, d);
+    // The closest approach scaled by a (no large-number cancellation for distant origins).
+    let l = [
+        a * oc[0] - b * d[0],
+        a * oc[1] - b * d[1],
+        a * oc[2] - b * d[2],
+    ];
+    let h = r * r * a * a - dot(l, l);
+    let inv = T::splat(1.0) / a;
     let q = -(b + b.signum() * (h * inv).sqrt());
-    let cc = oc.length_squared() - r * r;
-    let (t0, t1) = (q * inv, if q != 0.0 { cc / q } else { q * inv });
-    Some((t0.min(t1), t0.max(t1)))
+    let cc = dot(oc, oc) - r * r;
+    // cc/q where q ≠ 0, else q/a again, as one division of selected operands.
+    let m = q.ne_zero();
+    let (t0, t1) = (
+        q * inv,
+        T::select(m, cc, q * inv) / T::select(m, q, T::splat(1.0)),
+    );
+    (h, t0.min(t1), t0.max(t1))
 }
 
 fn sphere_hit(c: DVec3, r: f64, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64> {
@@ -180,7 +198,108 @@ impl Primitive {
 /// The capsule (points within r of the segment ab) is convex, so the ray meets it on one
 /// interval: it enters where it enters the infinite cylinder if that point lies beside the
 /// segment, else where it enters the end ball on that side; likewise for the exit.
+///
+/// A rod along x, y or z (every rod of a lattice) takes [`aligned_capsule_hit`]: the same
+/// arithmetic with the axis's components known to be zero, a third of the operations.
+#[inline]
 pub(crate) fn capsule_hit(
+    a: DVec3,
+    b: DVec3,
+    r: f64,
+    o: DVec3,
+    d: DVec3,
+    tmin: f64,
+    tmax: f64,
+) -> Option<f64> {
+    let ba = b - a;
+    let axis = match (ba.x != 0.0, ba.y != 0.0, ba.z != 0.0) {
+        (true, false, false) => 0,
+        (false, true, false) => 1,
+        (false, false, true) => 2,
+        _ => return any_capsule_hit(a, b, r, o, d, tmin, tmax),
+    };
+    aligned_capsule_hit(a, b, axis, r, o, d, tmin, tmax)
+}
+
+/// [`capsule_hit`] for a rod along coordinate axis `k` (a and b differ only in component k).
+/// It is the general test with ba = L e_k: there dp = L² d⊥, op = L² o⊥ and every quantity
+/// carries a power of L that cancels in the roots, so the values are the same up to rounding.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn aligned_capsule_hit(
+    a: DVec3,
+    b: DVec3,
+    k: usize,
+    r: f64,
+    o: DVec3,
+    d: DVec3,
+    tmin: f64,
+    tmax: f64,
+) -> Option<f64> {
+    // Components rotated so the axis is x (swizzles stay in registers; indexing by k would not).
+    let (lo, hi, ro, dr) = match k {
+        0 => (a, b, o, d),
+        1 => (a.yzx(), b.yzx(), o.yzx(), d.yzx()),
+        _ => (a.zxy(), b.zxy(), o.zxy(), d.zxy()),
+    };
+    // The segment runs from lo to lo + len x̂, len > 0 (a capsule is symmetric in a and b).
+    let (lo, hi) = if lo.x < hi.x { (lo, hi) } else { (hi, lo) };
+    let len = hi.x - lo.x;
+    let oa = ro - lo;
+    let rr = r * r;
+    if dr.y * dr.y + dr.z * dr.z == 0.0 {
+        return any_capsule_hit(a, b, r, o, d, tmin, tmax);
+    }
+    let (h, c0, c1) = cylinder_crossings(oa.y, oa.z, dr.y, dr.z, rr);
+    if h < 0.0 {
+        return None;
+    }
+    // Where along the axis the cylinder's crossing lies; beyond an end, the end ball's.
+    let ball = |t: f64| {
+        let y = oa.x + t * dr.x;
+        (y <= 0.0 || y >= len).then(|| round_roots(ro - if y <= 0.0 { lo } else { hi }, dr, r))
+    };
+    let t_in = match ball(c0) {
+        None => c0,
+        Some(roots) => roots?.0,
+    };
+    if t_in > tmin {
+        return (t_in < tmax).then_some(t_in);
+    }
+    let t_out = match ball(c1) {
+        None => c1,
+        Some(roots) => roots?.1,
+    };
+    [t_in, t_out].into_iter().find(|&t| t > tmin && t < tmax)
+}
+
+/// The line (ou, ov) + t (du, dv) in the plane across a rod's axis (relative to the axis,
+/// (du, dv) ≠ 0) against the circle of radius² rr, that is the line against the rod's infinite
+/// cylinder: (h, c0, c1), crossings c0 ≤ c1 where h ≥ 0, none where h < 0. Without branches,
+/// so the Embree backend runs it on several rays at once (`lane_hits`).
+#[inline(always)]
+pub(crate) fn cylinder_crossings<T: Real>(ou: T, ov: T, du: T, dv: T, rr: T) -> (T, T, T) {
+    let qa = du * du + dv * dv;
+    let qb = ou * du + ov * dv;
+    // The closest approach scaled by qa; its discriminant qa·(rr − distance²) comes first.
+    let (lu, lv) = (qa * ou - qb * du, qa * ov - qb * dv);
+    let h = rr * qa * qa - (lu * lu + lv * lv);
+    // The roots q/qa and c/q with q = -(qb ± sqrt(h/qa)), here multiplied through by sqrt(qa)
+    // so the square roots come first and one division follows them (not division, root,
+    // division in a chain).
+    let s = qa.sqrt();
+    let qs = -(qb * s + qb.signum() * h.sqrt());
+    let t0 = qs / (qa * s);
+    // c/q where q ≠ 0, else t0 again; as one division of selected operands (a select between
+    // two divisions would be compiled as a branch).
+    let m = qs.ne_zero();
+    let t1 = T::select(m, (ou * ou + ov * ov - rr) * s, qs) / T::select(m, qs, qa * s);
+    (h, t0.min(t1), t0.max(t1))
+}
+
+/// [`capsule_hit`] for a rod in any direction.
+#[inline(always)]
+pub(crate) fn any_capsule_hit(
     a: DVec3,
     b: DVec3,
     r: f64,

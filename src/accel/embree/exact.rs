@@ -7,6 +7,7 @@
 //! triangles each, refined in f64 after, were slower than one exact slab test.
 
 use super::lane_cull::lanes_near;
+use super::lane_hits::{round_hits, Answers, LaneRays, MAX};
 use crate::accel::Ray;
 use crate::geometry::{capsule_hit, cuboid_hit, Aabb};
 use embree_sys::*;
@@ -19,6 +20,11 @@ pub trait Shape: Copy {
     fn hit(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64>;
     /// Its bounds (min, max).
     fn bounds(&self) -> (DVec3, DVec3);
+    /// Its hits on several rays at once (`lane_hits`); by default none decided.
+    #[inline]
+    fn hits(&self, _rays: &LaneRays, out: &mut Answers) {
+        out.fill(f64::NAN)
+    }
 }
 
 /// A capsule (or with a = b, a sphere).
@@ -37,6 +43,10 @@ impl Shape for Round {
     fn bounds(&self) -> (DVec3, DVec3) {
         let r = DVec3::splat(self.radius);
         (self.a.min(self.b) - r, self.a.max(self.b) + r)
+    }
+    #[inline]
+    fn hits(&self, rays: &LaneRays, out: &mut Answers) {
+        round_hits(self, rays, out)
     }
 }
 
@@ -180,11 +190,89 @@ pub(super) unsafe extern "C" fn bounds<S: Shape>(args: *const RTCBoundsFunctionA
     }
 }
 
-/// The hit of lane i on the primitive: exact t in the caller's units (recorded in the context) and
-/// Embree's t, if it is closer than both the lane's exact best and Embree's tfar.
+/// The hits of the primitive on the lanes of an N-wide SoA ray that may meet it (`valid`, then
+/// the lane cull), by lane: Embree's t, if closer than both the lane's exact best (recorded in
+/// the context, in the caller's units) and Embree's tfar.
 ///
 /// # Safety
-/// `ctx` is an `ExactContext` (every query of this backend passes one); `base` as for `read`.
+/// `ctx` is an `ExactContext` (every query of this backend passes one); `base` points to an
+/// N-wide SoA ray and `valid` to its N entries.
+#[inline(always)]
+unsafe fn lane_hits<S: Shape>(
+    ctx: &ExactContext,
+    prim: &S,
+    valid: *const i32,
+    base: *const f32,
+    n: usize,
+    mut found: impl FnMut(usize, f32),
+) {
+    let (lo, hi) = prim.bounds();
+    let near = unsafe { lanes_near(valid, base, n, lo, hi) };
+    if n == 1 {
+        // Embree's single-ray traversal: nothing to share.
+        for i in near {
+            if let Some(t) = unsafe { lane_hit(ctx, prim, base, n, i) } {
+                found(i, t);
+            }
+        }
+        return;
+    }
+    // The lanes through the primitive's several-ray test, then what it left undecided through
+    // the scalar one.
+    let mut rays = LaneRays::new();
+    rays.gather(near.map(|i| {
+        let (o, d, tmin, tmax) = match ctx.rays.get(i) {
+            Some(r) => (r.origin - ctx.center, r.dir, r.tmin, ctx.best[i].get()),
+            None => unsafe { read(base, n, i) },
+        };
+        (i, o, d, tmin, tmax)
+    }));
+    let mut answers = [0.0; MAX];
+    prim.hits(&rays, &mut answers);
+    for (j, &answer) in answers.iter().enumerate().take(rays.len()) {
+        let (i, o, d, tmin, tmax) = rays.get(j);
+        let t = if answer.is_nan() {
+            prim.hit(o, d, tmin, tmax)
+        } else {
+            (answer < f64::INFINITY).then_some(answer)
+        };
+        if let Some(te) = t.and_then(|t| unsafe { embree_t(ctx, base, n, i, t, tmin, tmax) }) {
+            found(i, te);
+        }
+    }
+}
+
+/// Embree's t for an exact hit t of lane i, if it is closer than Embree's tfar (for the caller's
+/// rays, also recorded as the lane's exact best); bare rays' hits clamped to (tnear, tfar).
+///
+/// # Safety
+/// As for `lane_hits`, lane `i < n`.
+#[inline(always)]
+unsafe fn embree_t(
+    ctx: &ExactContext,
+    base: *const f32,
+    n: usize,
+    i: usize,
+    t: f64,
+    tmin: f64,
+    tmax: f64,
+) -> Option<f32> {
+    if ctx.rays.is_empty() {
+        return Some((t as f32).clamp(tmin as f32, tmax as f32));
+    }
+    let te = (t * ctx.len[i] + ctx.pullback) as f32;
+    // Embree's tfar may have been lowered by one of its own primitives.
+    let tfar = unsafe { *base.add(TFAR * n + i) };
+    (te <= tfar).then(|| {
+        ctx.best[i].set(t);
+        te
+    })
+}
+
+/// The hit of lane i on the primitive, tested alone (see `lane_hits`).
+///
+/// # Safety
+/// As for `lane_hits`, lane `i < n`.
 #[inline(always)]
 unsafe fn lane_hit<S: Shape>(
     ctx: &ExactContext,
@@ -193,23 +281,12 @@ unsafe fn lane_hit<S: Shape>(
     n: usize,
     i: usize,
 ) -> Option<f32> {
-    match ctx.rays.get(i) {
-        Some(r) => {
-            let t = prim.hit(r.origin - ctx.center, r.dir, r.tmin, ctx.best[i].get())?;
-            let te = (t * ctx.len[i] + ctx.pullback) as f32;
-            // Embree's tfar may have been lowered by one of its own primitives.
-            let tfar = unsafe { *base.add(TFAR * n + i) };
-            (te <= tfar).then(|| {
-                ctx.best[i].set(t);
-                te
-            })
-        }
-        None => {
-            let (o, d, tnear, tfar) = unsafe { read(base, n, i) };
-            prim.hit(o, d, tnear, tfar)
-                .map(|t| (t as f32).clamp(tnear as f32, tfar as f32))
-        }
-    }
+    let (o, d, tmin, tmax) = match ctx.rays.get(i) {
+        Some(r) => (r.origin - ctx.center, r.dir, r.tmin, ctx.best[i].get()),
+        None => unsafe { read(base, n, i) },
+    };
+    let t = prim.hit(o, d, tmin, tmax)?;
+    unsafe { embree_t(ctx, base, n, i, t, tmin, tmax) }
 }
 
 pub(super) unsafe extern "C" fn intersect<S: Shape>(args: *const RTCIntersectFunctionNArguments) {
@@ -221,21 +298,19 @@ pub(super) unsafe extern "C" fn intersect<S: Shape>(args: *const RTCIntersectFun
         let ctx = &*(args.context as *const ExactContext);
         let n = args.N as usize;
         let base = args.rayhit as *mut f32;
-        let (lo, hi) = prim.bounds();
-        for i in lanes_near(args.valid, base, n, lo, hi) {
-            if let Some(t) = lane_hit(ctx, prim, base, n, i) {
-                let slot = |k: usize| base.add(k * n + i);
-                *slot(TFAR) = t;
-                *slot(NG) = 0.0;
-                *slot(NG + 1) = 0.0;
-                *slot(NG + 2) = 1.0;
-                *slot(U) = 0.0;
-                *slot(U + 1) = 0.0;
-                *(slot(PRIM_ID) as *mut u32) = args.primID;
-                *(slot(GEOM_ID) as *mut u32) = args.geomID;
-                *(slot(INST_ID) as *mut u32) = (*args.context).instID[0];
-            }
-        }
+        let inst = (*args.context).instID[0];
+        lane_hits(ctx, prim, args.valid, base, n, |i, t| {
+            let slot = |k: usize| base.add(k * n + i);
+            *slot(TFAR) = t;
+            *slot(NG) = 0.0;
+            *slot(NG + 1) = 0.0;
+            *slot(NG + 2) = 1.0;
+            *slot(U) = 0.0;
+            *slot(U + 1) = 0.0;
+            *(slot(PRIM_ID) as *mut u32) = args.primID;
+            *(slot(GEOM_ID) as *mut u32) = args.geomID;
+            *(slot(INST_ID) as *mut u32) = inst;
+        });
     }
 }
 
@@ -247,11 +322,8 @@ pub(super) unsafe extern "C" fn occluded<S: Shape>(args: *const RTCOccludedFunct
         let ctx = &*(args.context as *const ExactContext);
         let n = args.N as usize;
         let base = args.ray as *mut f32;
-        let (lo, hi) = prim.bounds();
-        for i in lanes_near(args.valid, base, n, lo, hi) {
-            if lane_hit(ctx, prim, base, n, i).is_some() {
-                *base.add(TFAR * n + i) = f32::NEG_INFINITY;
-            }
-        }
+        lane_hits(ctx, prim, args.valid, base, n, |i, _| {
+            *base.add(TFAR * n + i) = f32::NEG_INFINITY;
+        });
     }
 }

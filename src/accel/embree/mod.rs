@@ -14,7 +14,10 @@ mod bare;
 mod culler;
 mod device;
 mod exact;
+#[cfg(target_arch = "x86_64")]
+mod f64x4;
 mod lane_cull;
+mod lane_hits;
 mod packet;
 mod scene;
 
