@@ -141,7 +141,7 @@ fn distance(b: &Aabb, o: DVec3) -> f64 {
 }
 
 impl LightBuffer {
-    /// Over `boxes` (item i is boxes[i]), for rays from `origin`.
+    /// Over `boxes` (item i is `boxes[i]`), for rays from `origin`.
     pub fn build(origin: DVec3, boxes: &[Aabb]) -> LightBuffer {
         // Nearest first: distances are ≥ 0, so their bits sort as they do.
         let mut keyed: Vec<(u64, u32)> = boxes
