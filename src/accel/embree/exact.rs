@@ -21,6 +21,8 @@ pub trait Shape: Copy {
     fn hit(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64>;
     /// Its bounds (min, max).
     fn bounds(&self) -> (DVec3, DVec3);
+    /// Whether `hits` decides any ray (else the callbacks skip gathering the lanes for it).
+    const SEVERAL: bool = false;
     /// Its hits on several rays at once (`lane_hits`); by default none decided.
     #[inline]
     fn hits(&self, _rays: &LaneRays, out: &mut Answers) {
@@ -45,6 +47,7 @@ impl Shape for Round {
         let r = DVec3::splat(self.radius);
         (self.a.min(self.b) - r, self.a.max(self.b) + r)
     }
+    const SEVERAL: bool = true;
     #[inline]
     fn hits(&self, rays: &LaneRays, out: &mut Answers) {
         round_hits(self, rays, out)
@@ -209,8 +212,8 @@ unsafe fn lane_hits<S: Shape>(
 ) {
     let (lo, hi) = prim.bounds();
     let near = unsafe { lanes_near(valid, base, n, lo, hi) };
-    if n == 1 {
-        // Embree's single-ray traversal: nothing to share.
+    if n == 1 || !S::SEVERAL {
+        // Embree's single-ray traversal, or a shape tested one ray at a time: nothing to share.
         for i in near {
             if let Some(t) = unsafe { lane_hit(ctx, prim, base, n, i) } {
                 found(i, t);
