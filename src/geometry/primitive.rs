@@ -256,10 +256,30 @@ fn aligned_capsule_hit(
     if h < 0.0 {
         return None;
     }
-    // Where along the axis the cylinder's crossing lies; beyond an end, the end ball's.
+    let ends = (ro - lo, ro - hi);
+    beside_or_ends(c0, c1, |t| oa.x + t * dr.x, len, ends, dr, r, tmin, tmax)
+}
+
+/// A capsule's first crossing in (tmin, tmax) from its infinite cylinder's crossings c0 ≤ c1:
+/// where a crossing's position along the axis, `axial(t)`, lies beyond the segment (0, end), the
+/// end ball on that side decides instead (`ends`: the ray's origin from the lower end's centre
+/// and from the upper's).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn beside_or_ends(
+    c0: f64,
+    c1: f64,
+    axial: impl Fn(f64) -> f64,
+    end: f64,
+    ends: (DVec3, DVec3),
+    d: DVec3,
+    r: f64,
+    tmin: f64,
+    tmax: f64,
+) -> Option<f64> {
     let ball = |t: f64| {
-        let y = oa.x + t * dr.x;
-        (y <= 0.0 || y >= len).then(|| round_roots(ro - if y <= 0.0 { lo } else { hi }, dr, r))
+        let y = axial(t);
+        (y <= 0.0 || y >= end).then(|| round_roots(if y <= 0.0 { ends.0 } else { ends.1 }, d, r))
     };
     let t_in = match ball(c0) {
         None => c0,
@@ -301,7 +321,7 @@ pub(crate) fn cylinder_crossings<T: Real>(ou: T, ov: T, du: T, dv: T, rr: T) -> 
 
 /// [`capsule_hit`] for a rod in any direction.
 #[inline(always)]
-pub(crate) fn any_capsule_hit(
+fn any_capsule_hit(
     a: DVec3,
     b: DVec3,
     r: f64,
@@ -323,54 +343,48 @@ pub(crate) fn any_capsule_hit(
     let op = baba * oa - baoa * ba;
     let rr = r * r * baba * baba;
     let qa = dp.length_squared();
-    let (t_in, t_out) = if qa == 0.0 {
+    if qa == 0.0 {
         // Along the axis: in through one end ball, out through the other.
         if op.length_squared() > rr {
             return None;
         }
         let (first, last) = if bard > 0.0 { (a, b) } else { (b, a) };
-        (
+        let (t_in, t_out) = (
             round_roots(o - first, d, r)?.0,
             round_roots(o - last, d, r)?.1,
-        )
-    } else {
-        // The infinite cylinder: qa·t² + 2qb·t + |op|² − rr = 0. Its discriminant, qa·(rr − l²)
-        // with l the closest approach, is tested before any division or root.
-        let qb = op.dot(dp);
-        let l = qa * op - qb * dp;
-        let h = rr * qa * qa - l.length_squared();
-        if h < 0.0 {
-            return None;
-        }
-        let inv = 1.0 / qa;
-        let q = -(qb + qb.signum() * (h * inv).sqrt());
-        let (u, v) = (
-            q * inv,
-            if q != 0.0 {
-                (op.length_squared() - rr) / q
-            } else {
-                q * inv
-            },
         );
-        let (c0, c1) = (u.min(v), u.max(v));
-        let ball = |t: f64| {
-            let y = baoa + t * bard;
-            (y <= 0.0 || y >= baba).then(|| round_roots(o - if y <= 0.0 { a } else { b }, d, r))
-        };
-        let t_in = match ball(c0) {
-            None => c0,
-            Some(roots) => roots?.0,
-        };
-        if t_in > tmin {
-            return (t_in < tmax).then_some(t_in);
-        }
-        let t_out = match ball(c1) {
-            None => c1,
-            Some(roots) => roots?.1,
-        };
-        (t_in, t_out)
-    };
-    [t_in, t_out].into_iter().find(|&t| t > tmin && t < tmax)
+        return [t_in, t_out].into_iter().find(|&t| t > tmin && t < tmax);
+    }
+    // The infinite cylinder: qa·t² + 2qb·t + |op|² − rr = 0. Its discriminant, qa·(rr − l²)
+    // with l the closest approach, is tested before any division or root.
+    let qb = op.dot(dp);
+    let l = qa * op - qb * dp;
+    let h = rr * qa * qa - l.length_squared();
+    if h < 0.0 {
+        return None;
+    }
+    let inv = 1.0 / qa;
+    let q = -(qb + qb.signum() * (h * inv).sqrt());
+    let (u, v) = (
+        q * inv,
+        if q != 0.0 {
+            (op.length_squared() - rr) / q
+        } else {
+            q * inv
+        },
+    );
+    let (c0, c1) = (u.min(v), u.max(v));
+    beside_or_ends(
+        c0,
+        c1,
+        |t| baoa + t * bard,
+        baba,
+        (o - a, o - b),
+        d,
+        r,
+        tmin,
+        tmax,
+    )
 }
 
 /// The first crossing of an axis-aligned box's surface (entry, or exit from inside).
