@@ -126,3 +126,64 @@ fn capsules_and_spheres_match_their_distance_functions() {
     assert!(checked > 2900, "only {checked} cases decided");
     assert!(hits > 1000, "only {hits} hits: the rays should hit often");
 }
+
+/// Rods along each axis (either end first) and spheres, hit from 1e3 to 1e9 away (where the
+/// boosted origins are near β → 1) with directions 1e-3 to 1e3 long (the boost's Doppler
+/// factor): the entry is where the geometry puts it, t = (D − √(r² − p²)) / |d| for a ray
+/// across the axis at distance D and offset p, to rounding of the origin's coordinates.
+#[test]
+fn far_rays_enter_where_the_geometry_says() {
+    let (c, r) = (DVec3::new(0.3, -0.2, 0.1), 0.25_f64);
+    let mut checked = 0;
+    for k in 0..3 {
+        let (mut e, mut n, mut m) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+        e[k] = 1.0;
+        n[(k + 1) % 3] = 1.0;
+        m[(k + 2) % 3] = 1.0;
+        for far in [1e3, 1e6, 1e9] {
+            for scale in [1e-3, 1.0, 1e3] {
+                for p in [0.0, 0.6 * r] {
+                    let want = (far - (r * r - p * p).sqrt()) / scale;
+                    let tol = 1e-15 * far / scale + 1e-13 / scale;
+                    let prims = [
+                        (
+                            Primitive::Capsule {
+                                a: c - 1.5 * e,
+                                b: c + 1.5 * e,
+                                radius: r,
+                            },
+                            0.4,
+                        ),
+                        (
+                            Primitive::Capsule {
+                                a: c + 1.5 * e,
+                                b: c - 1.5 * e,
+                                radius: r,
+                            },
+                            -0.7,
+                        ),
+                        (
+                            Primitive::Sphere {
+                                center: c,
+                                radius: r,
+                            },
+                            0.0,
+                        ),
+                    ];
+                    for (prim, along) in prims {
+                        let o = c + far * n + p * m + along * e;
+                        let got = prim.intersect(o, -scale * n, 0.0, f64::INFINITY);
+                        let got = got.unwrap_or_else(|| panic!("{prim:?} from {o}: no hit"));
+                        assert!(
+                            (got - want).abs() <= tol,
+                            "{prim:?} from {o} along {}: t = {got}, want {want}",
+                            -scale * n
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 3 * 3 * 3 * 2 * 3);
+}

@@ -168,45 +168,37 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
     let backend = backend_by_name(backend_name)?;
     let scene = with_spp(&case.scene, spp);
     memory::reset_peak();
-    let t = Instant::now();
-    let mut world = World::build_with(&scene, backend.as_ref(), options)?;
-    let mut build_s = t.elapsed().as_secs_f64();
-    // Builds of milliseconds vary as much as short passes: rebuild and keep the fastest.
-    for _ in 1..repeat.max(1) {
-        if build_s > 0.1 {
+    // The cold cost of a frame: the build, then the first render, which also builds whatever is
+    // built on first use (the time slices of many groups). Before that render one untimed
+    // primary pass (thread pools, page faults; renders right after a build were measured 1.5x
+    // slow while Embree's build threads wind down). Frames of milliseconds vary by tens of
+    // percent (one of 12 ms was once measured at 24): on fresh worlds, one at a time, keep the
+    // fastest build and the fastest first render.
+    let (mut build_s, mut first_render_s) = (f64::INFINITY, f64::INFINITY);
+    let mut kept = None;
+    for i in 0..repeat.max(1) {
+        if i > 0 && build_s + first_render_s > 0.1 {
             break;
         }
-        drop(world);
+        drop(kept.take());
         let t = Instant::now();
-        world = World::build_with(&scene, backend.as_ref(), options)?;
+        let world = World::build_with(&scene, backend.as_ref(), options)?;
         build_s = build_s.min(t.elapsed().as_secs_f64());
+        trace_primary(&scene, &world);
+        let t = Instant::now();
+        let (frame, _) = render_world(&scene, &world);
+        first_render_s = first_render_s.min(t.elapsed().as_secs_f64());
+        kept = Some((world, frame));
     }
-    // One untimed pass first: thread pools, page faults and caches are warm for every row.
-    let mut primary_rays = trace_primary(&scene, &world).0;
+    let (world, frame) = kept.expect("at least one build");
+    // Then the fastest primary pass and render: passes of a few milliseconds vary by tens of
+    // percent.
+    let mut primary_rays = 0;
     let primary_s = fastest(repeat, || primary_rays = trace_primary(&scene, &world).0);
-    // The first render also builds whatever is built on first use (the time slices of many
-    // groups): the cold cost of a frame is build + first render. Then the fastest render, as
-    // for primary passes: renders of a few milliseconds vary by tens of percent, and right
-    // after a backend is built they were measured 1.5x slow while its threads wind down.
-    let t = Instant::now();
-    let (frame, _) = render_world(&scene, &world);
-    let mut first_render_s = t.elapsed().as_secs_f64();
     let render_s = first_render_s.min(fastest(repeat.saturating_sub(1), || {
         render_world(&scene, &world);
     }));
     let peak_mib = memory::peak_mib();
-    // A cold frame of milliseconds varies as much (one of 12 ms was once measured at 24): on
-    // fresh worlds (one at a time, after the peak is read), keep the fastest first render.
-    drop(world);
-    for _ in 1..repeat.max(1) {
-        if build_s + first_render_s > 0.1 {
-            break;
-        }
-        let fresh = World::build_with(&scene, backend.as_ref(), options)?;
-        let t = Instant::now();
-        render_world(&scene, &fresh);
-        first_render_s = first_render_s.min(t.elapsed().as_secs_f64());
-    }
     let (w, h) = scene.image.frame_size();
     Ok((
         Row {

@@ -13,7 +13,7 @@ pub use aabb::Aabb;
 pub use box_tree::{walk, BoxTree, TreeNode, PACKET};
 pub use light_buffer::LightBuffer;
 #[cfg(feature = "embree")]
-pub(crate) use primitive::{ball_crossings, capsule_hit, cuboid_hit, cylinder_crossings};
+pub(crate) use primitive::{ball_crossings, capsule_hit, cuboid_hit, cylinder_crossings, AxisRod};
 pub use primitive::{Geometry, Part, Primitive};
 #[cfg(feature = "embree")]
 pub(crate) use real::Real;

@@ -213,25 +213,53 @@ pub(crate) fn capsule_hit(
     tmin: f64,
     tmax: f64,
 ) -> Option<f64> {
-    let ba = b - a;
-    let axis = match (ba.x != 0.0, ba.y != 0.0, ba.z != 0.0) {
-        (true, false, false) => 0,
-        (false, true, false) => 1,
-        (false, false, true) => 2,
-        _ => return any_capsule_hit(a, b, r, o, d, tmin, tmax),
-    };
-    aligned_capsule_hit(a, b, axis, r, o, d, tmin, tmax)
+    match AxisRod::of(a, b) {
+        Some(rod) => aligned_capsule_hit(&rod, a, b, r, o, d, tmin, tmax),
+        None => any_capsule_hit(a, b, r, o, d, tmin, tmax),
+    }
 }
 
-/// [`capsule_hit`] for a rod along coordinate axis `k` (a and b differ only in component k).
-/// It is the general test with ba = L e_k: there dp = L² d⊥, op = L² o⊥ and every quantity
-/// carries a power of L that cancels in the roots, so the values are the same up to rounding.
+/// A rod's segment along a coordinate axis: a and b differ in component `k` alone. Its ends
+/// in order along the axis (a capsule is symmetric in its two), `len = hi[k] − lo[k] > 0`.
+/// The scalar test and the Embree backend's four-ray test both start from here, so they
+/// start from the same numbers.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct AxisRod {
+    pub k: usize,
+    pub lo: DVec3,
+    pub hi: DVec3,
+    pub len: f64,
+}
+
+impl AxisRod {
+    #[inline(always)]
+    pub fn of(a: DVec3, b: DVec3) -> Option<AxisRod> {
+        let ba = b - a;
+        let k = match (ba.x != 0.0, ba.y != 0.0, ba.z != 0.0) {
+            (true, false, false) => 0,
+            (false, true, false) => 1,
+            (false, false, true) => 2,
+            _ => return None,
+        };
+        let (lo, hi) = if a[k] < b[k] { (a, b) } else { (b, a) };
+        Some(AxisRod {
+            k,
+            lo,
+            hi,
+            len: hi[k] - lo[k],
+        })
+    }
+}
+
+/// [`capsule_hit`] for a rod along a coordinate axis (`rod`, of the segment from a to b). It
+/// is the general test with ba = L e_k: there dp = L² d⊥, op = L² o⊥ and every quantity carries
+/// a power of L that cancels in the roots, so the values are the same up to rounding.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn aligned_capsule_hit(
+    rod: &AxisRod,
     a: DVec3,
     b: DVec3,
-    k: usize,
     r: f64,
     o: DVec3,
     d: DVec3,
@@ -239,14 +267,11 @@ fn aligned_capsule_hit(
     tmax: f64,
 ) -> Option<f64> {
     // Components rotated so the axis is x (swizzles stay in registers; indexing by k would not).
-    let (lo, hi, ro, dr) = match k {
-        0 => (a, b, o, d),
-        1 => (a.yzx(), b.yzx(), o.yzx(), d.yzx()),
-        _ => (a.zxy(), b.zxy(), o.zxy(), d.zxy()),
+    let (lo, hi, ro, dr) = match rod.k {
+        0 => (rod.lo, rod.hi, o, d),
+        1 => (rod.lo.yzx(), rod.hi.yzx(), o.yzx(), d.yzx()),
+        _ => (rod.lo.zxy(), rod.hi.zxy(), o.zxy(), d.zxy()),
     };
-    // The segment runs from lo to lo + len x̂, len > 0 (a capsule is symmetric in a and b).
-    let (lo, hi) = if lo.x < hi.x { (lo, hi) } else { (hi, lo) };
-    let len = hi.x - lo.x;
     let oa = ro - lo;
     let rr = r * r;
     if dr.y * dr.y + dr.z * dr.z == 0.0 {
@@ -257,7 +282,17 @@ fn aligned_capsule_hit(
         return None;
     }
     let ends = (ro - lo, ro - hi);
-    beside_or_ends(c0, c1, |t| oa.x + t * dr.x, len, ends, dr, r, tmin, tmax)
+    beside_or_ends(
+        c0,
+        c1,
+        |t| oa.x + t * dr.x,
+        rod.len,
+        ends,
+        dr,
+        r,
+        tmin,
+        tmax,
+    )
 }
 
 /// A capsule's first crossing in (tmin, tmax) from its infinite cylinder's crossings c0 ≤ c1:

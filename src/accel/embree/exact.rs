@@ -225,10 +225,7 @@ unsafe fn lane_hits<S: Shape>(
     // the scalar one.
     let mut rays = LaneRays::new();
     rays.gather(near.map(|i| {
-        let (o, d, tmin, tmax) = match ctx.rays.get(i) {
-            Some(r) => (r.origin - ctx.center, r.dir, r.tmin, ctx.best[i].get()),
-            None => unsafe { read(base, n, i) },
-        };
+        let (o, d, tmin, tmax) = unsafe { lane_ray(ctx, base, n, i) };
         (i, o, d, tmin, tmax)
     }));
     let mut answers = [0.0; MAX];
@@ -285,12 +282,27 @@ unsafe fn lane_hit<S: Shape>(
     n: usize,
     i: usize,
 ) -> Option<f32> {
-    let (o, d, tmin, tmax) = match ctx.rays.get(i) {
-        Some(r) => (r.origin - ctx.center, r.dir, r.tmin, ctx.best[i].get()),
-        None => unsafe { read(base, n, i) },
-    };
+    let (o, d, tmin, tmax) = unsafe { lane_ray(ctx, base, n, i) };
     let t = prim.hit(o, d, tmin, tmax)?;
     unsafe { embree_t(ctx, base, n, i, t, tmin, tmax) }
+}
+
+/// Lane i's ray to test, relative to the Embree scene's centre: the caller's f64 ray, with the
+/// lane's exact best as its end; for bare rays Embree's f32 one (origin, direction, tmin, tmax).
+///
+/// # Safety
+/// As for `lane_hits`, lane `i < n`.
+#[inline(always)]
+unsafe fn lane_ray(
+    ctx: &ExactContext,
+    base: *const f32,
+    n: usize,
+    i: usize,
+) -> (DVec3, DVec3, f64, f64) {
+    match ctx.rays.get(i) {
+        Some(r) => (r.origin - ctx.center, r.dir, r.tmin, ctx.best[i].get()),
+        None => unsafe { read(base, n, i) },
+    }
 }
 
 pub(super) unsafe extern "C" fn intersect<S: Shape>(args: *const RTCIntersectFunctionNArguments) {

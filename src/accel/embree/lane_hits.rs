@@ -13,6 +13,7 @@
 use super::exact::Round;
 #[cfg(target_arch = "x86_64")]
 use super::f64x4::F4;
+use crate::geometry::AxisRod;
 #[cfg(target_arch = "x86_64")]
 use crate::geometry::{ball_crossings, cylinder_crossings, Real};
 use glam::DVec3;
@@ -103,30 +104,18 @@ pub(super) type Answers = [f64; MAX];
 /// z, or on a CPU without AVX2.
 #[inline]
 pub(super) fn round_hits(prim: &Round, rays: &LaneRays, out: &mut Answers) {
-    let ba = prim.b - prim.a;
-    let kernel = if ba == DVec3::ZERO {
+    let kernel = if prim.a == prim.b {
         Kernel::Sphere {
             c: prim.a,
             r: prim.radius,
         }
     } else {
-        let k = match (ba.x != 0.0, ba.y != 0.0, ba.z != 0.0) {
-            (true, false, false) => 0,
-            (false, true, false) => 1,
-            (false, false, true) => 2,
-            _ => return out.fill(f64::NAN),
-        };
-        // From its lower end: a capsule is symmetric in its two ends.
-        let lo = if prim.a[k] < prim.b[k] {
-            prim.a
-        } else {
-            prim.b
-        };
-        Kernel::Rod {
-            k,
-            lo,
-            len: ba[k].abs(),
-            rr: prim.radius * prim.radius,
+        match AxisRod::of(prim.a, prim.b) {
+            Some(rod) => Kernel::Rod {
+                rod,
+                rr: prim.radius * prim.radius,
+            },
+            None => return out.fill(f64::NAN),
         }
     };
     #[cfg(target_arch = "x86_64")]
@@ -139,11 +128,9 @@ pub(super) fn round_hits(prim: &Round, rays: &LaneRays, out: &mut Answers) {
 }
 
 enum Kernel {
-    /// A rod along axis k from `lo` to lo + len e_k, len > 0, of radius² rr.
+    /// A rod along a coordinate axis, of radius² rr.
     Rod {
-        k: usize,
-        lo: DVec3,
-        len: f64,
+        rod: AxisRod,
         rr: f64,
     },
     Sphere {
@@ -161,7 +148,10 @@ unsafe fn run_avx2(kernel: &Kernel, rays: &LaneRays, out: &mut Answers) {
         let load = |k: usize| unsafe { F4::load(rays.col(k)[c..c + 4].try_into().unwrap()) };
         let (tmin, tmax) = (load(TMIN), load(TMAX));
         let ans = match *kernel {
-            Kernel::Rod { k, lo, len, rr } => {
+            Kernel::Rod {
+                rod: AxisRod { k, lo, len, .. },
+                rr,
+            } => {
                 let (u, v) = ((k + 1) % 3, (k + 2) % 3);
                 let oa = [
                     load(k) - F4::splat(lo[k]),
