@@ -7,8 +7,9 @@
 //! root and divisions; here the lanes are gathered into columns and the same branch-free
 //! arithmetic (`cylinder_crossings`, `ball_crossings`, shared with the scalar tests, so the
 //! results are the same to the bit) runs four lanes per AVX2 vector. A lane whose answer needs
-//! a branch (the entry beyond a rod's end, so its end ball decides; a ray along the axis) is
-//! left undecided, and the callback asks the scalar test.
+//! a branch (the entry, or for a ray that starts inside or past the rod the exit, beyond a rod's
+//! end, so its end ball decides; a ray along the axis) is left undecided, and the callback asks
+//! the scalar test.
 
 use super::exact::Round;
 #[cfg(target_arch = "x86_64")]
@@ -176,20 +177,28 @@ unsafe fn run_avx2(kernel: &Kernel, rays: &LaneRays, out: &mut Answers) {
 }
 
 /// Four entries against a rod along the first axis of `oa` (origins from the rod's lower end,
-/// axis component first), as `capsule_hit` decides them where the entry lies beside the segment.
+/// axis component first), as `capsule_hit` decides them where the entry lies beside the segment:
+/// the entry if it comes after tmin, else (a ray from inside, or a rod behind it: shadow rays
+/// leaving a surface) the exit, if that lies beside the segment too.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn rod(oa: [F4; 3], d: [F4; 3], len: f64, rr: f64, tmin: F4, tmax: F4) -> F4 {
-    let (h, c0, _) = cylinder_crossings(oa[1], oa[2], d[1], d[2], F4::splat(rr));
-    let y = oa[0] + c0 * d[0];
-    let (zero, inf, nan) = (
+    let (h, c0, c1) = cylinder_crossings(oa[1], oa[2], d[1], d[2], F4::splat(rr));
+    let (zero, inf, nan, len) = (
         F4::splat(0.0),
         F4::splat(f64::INFINITY),
         F4::splat(f64::NAN),
+        F4::splat(len),
     );
-    let hit = F4::select(c0.lt(tmax), c0, inf);
-    let beside = zero.lt(y).and(y.lt(F4::splat(len))).and(tmin.lt(c0));
-    let decided = F4::select(beside, hit, nan);
+    let beside = |t: F4| {
+        let y = oa[0] + t * d[0];
+        zero.lt(y).and(y.lt(len))
+    };
+    let (beside0, beside1) = (beside(c0), beside(c1));
+    let entry = F4::select(c0.lt(tmax), c0, inf);
+    let exit = F4::select(tmin.lt(c1).and(c1.lt(tmax)), c1, inf);
+    let decided = F4::select(beside0.and(beside1).and(tmin.ge(c0)), exit, nan);
+    let decided = F4::select(beside0.and(tmin.lt(c0)), entry, decided);
     // A miss of the infinite cylinder, which holds the capsule, is a miss.
     let decided = F4::select(h.lt(zero), inf, decided);
     // Along the axis the cylinder's roots are undefined.
@@ -241,6 +250,9 @@ mod tests {
     fn decided_answers_are_the_scalar_tests() {
         let mut rng = Rng(11);
         let (mut decided, mut hits, mut total) = (0, 0, 0);
+        // Rays from inside a rod (the entry before tmin: the exit decides), and how many of
+        // them were decided here.
+        let (mut inside, mut inside_decided) = (0, 0);
         for case in 0..4000 {
             let a = rng.vec(2.0);
             let b = match case % 4 {
@@ -291,10 +303,14 @@ mod tests {
                 let want = prim.hit(o, d, tmin, tmax);
                 total += 1;
                 hits += want.is_some() as usize;
+                inside += usize::from(case % 4 != 0 && lane % 7 == 0);
                 if out[j].is_nan() {
                     continue;
                 }
                 decided += 1;
+                if case % 4 != 0 && lane % 7 == 0 {
+                    inside_decided += 1;
+                }
                 let got = (out[j] < f64::INFINITY).then_some(out[j]);
                 assert_eq!(
                     got, want,
@@ -306,6 +322,10 @@ mod tests {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             assert!(decided > total / 2, "only {decided} of {total} decided");
+            assert!(
+                inside_decided > inside / 4,
+                "only {inside_decided} of {inside} rays from inside a rod decided"
+            );
         }
     }
 }
