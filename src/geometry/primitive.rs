@@ -172,10 +172,22 @@ impl Primitive {
         match *self {
             Primitive::Sphere { center, .. } => (p - center).normalize_or(DVec3::Z),
             Primitive::Capsule { a, b, .. } => {
-                let ab = b - a;
-                let s =
-                    ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-                (p - (a + s * ab)).normalize_or(DVec3::Z)
+                // From the segment's nearest point: along a rod on an axis, p's own coordinate
+                // clamped to the segment (no division).
+                let nearest = match AxisRod::of(a, b) {
+                    Some(rod) => {
+                        let mut q = rod.lo;
+                        q[rod.k] = p[rod.k].clamp(rod.lo[rod.k], rod.hi[rod.k]);
+                        q
+                    }
+                    None => {
+                        let ab = b - a;
+                        let s = ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE))
+                            .clamp(0.0, 1.0);
+                        a + s * ab
+                    }
+                };
+                (p - nearest).normalize_or(DVec3::Z)
             }
             Primitive::Cuboid { min, max } => {
                 let c = 0.5 * (min + max);
@@ -465,4 +477,41 @@ fn triangle_hit(v: [DVec3; 3], o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Opti
     }
     let t = e2.dot(q) * inv;
     (t > tmin && t < tmax).then_some(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Primitive;
+    use glam::DVec3;
+
+    /// A capsule's normal at points of its surface: across the axis beside the segment, and
+    /// from the end ball's centre beyond either end; for rods along each axis (either end first)
+    /// and one along no axis.
+    #[test]
+    fn capsule_normals() {
+        let a = DVec3::new(0.3, -1.2, 2.5);
+        let r = 0.25;
+        let along = [
+            DVec3::new(2.0, 0.0, 0.0),
+            DVec3::new(0.0, -3.0, 0.0),
+            DVec3::new(0.0, 0.0, 1.5),
+            DVec3::new(1.0, 2.0, -2.0),
+        ];
+        for ab in along {
+            for (a, b) in [(a, a + ab), (a + ab, a)] {
+                let rod = Primitive::Capsule { a, b, radius: r };
+                let axis = (b - a).normalize();
+                let across = axis.any_orthonormal_vector();
+                for (s, side) in [(0.3, across), (0.9, -across), (0.5, axis.cross(across))] {
+                    let p = a + s * (b - a) + r * side;
+                    assert!((rod.normal(p) - side).length() < 1e-12, "{a} {b} at {p}");
+                }
+                // Beyond the ends: from the end ball's centre.
+                let out = (across - axis).normalize();
+                assert!((rod.normal(a + r * out) - out).length() < 1e-12);
+                let out = (across + axis).normalize();
+                assert!((rod.normal(b + r * out) - out).length() < 1e-12);
+            }
+        }
+    }
 }
