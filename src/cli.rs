@@ -215,7 +215,7 @@ fn run_bench(args: &BenchArgs) -> Result<(), String> {
 
 fn run_render(args: &RenderArgs) -> Result<(), String> {
     // Check everything that can be checked before the (possibly long) render.
-    output::Format::for_path(&args.output).map_err(|e| format!("-o: {e}"))?;
+    let format = output::Format::for_path(&args.output).map_err(|e| format!("-o: {e}"))?;
     let backend_name = args
         .backend
         .clone()
@@ -223,7 +223,13 @@ fn run_render(args: &RenderArgs) -> Result<(), String> {
     let backend = accel::backend_by_name(&backend_name).map_err(|e| format!("--backend: {e}"))?;
     set_threads(args.threads)?;
     let scene = scene::load_file(&args.scene, &args.overrides()).map_err(|e| e.to_string())?;
-    let (frame, stats) = render::render(&scene, backend.as_ref())?;
+    // A PNG holds colour alone: the passes (and with several samples, their extra ray per
+    // pixel) are skipped.
+    let passes = match format {
+        output::Format::Exr => render::Passes::All,
+        output::Format::Png => render::Passes::Colour,
+    };
+    let (frame, stats) = render::render_passes(&scene, backend.as_ref(), passes)?;
     if stats.nonfinite_pixels > 0 {
         eprintln!(
             "warning: {} pixels came out NaN or infinite and were set to black; please report this scene",

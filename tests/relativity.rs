@@ -193,3 +193,46 @@ fn rendering_is_reproducible_with_samples() {
         );
     }
 }
+
+/// A render of colour alone (what a PNG holds) has the full render's colour and alpha, bit for
+/// bit, leaves the passes empty, and with several samples traces no ray for them.
+#[test]
+fn colour_only_renders_skip_the_passes() {
+    use rest_embree::render::{render_world_passes, Passes, World};
+    let text = scene_text(
+        "position = [0, -3, 0]\ndirection = [0, 1, 0]",
+        DVec3::new(0.8, 0.0, 0.0),
+        "position = [3, 2, 8]",
+    );
+    for samples in [1u32, 3] {
+        let s = scene(&text.replace(
+            "height = 120",
+            &format!("height = 120\nsamples = {samples}"),
+        ));
+        for backend in backends() {
+            let b = rest_embree::accel::backend_by_name(backend).unwrap();
+            let world = World::build(&s, b.as_ref()).unwrap();
+            let (all, all_stats) = render_world_passes(&s, &world, Passes::All);
+            let (colour, colour_stats) = render_world_passes(&s, &world, Passes::Colour);
+            assert!(all
+                .pixels
+                .iter()
+                .any(|p| p.object_id > 0 && p.lookback > 0.0));
+            for (p, q) in all.pixels.iter().zip(&colour.pixels) {
+                assert_eq!((p.color, p.alpha), (q.color, q.alpha), "{backend}");
+                assert_eq!(
+                    (q.object_id, q.lookback, q.doppler, q.normal, q.position),
+                    (0, 0.0, 0.0, [0.0; 3], [0.0; 3]),
+                    "{backend}: no passes"
+                );
+            }
+            // With several samples the passes have a centre ray of their own per pixel.
+            let extra = u64::from(samples > 1);
+            assert_eq!(
+                all_stats.primary_rays * u64::from(samples),
+                colour_stats.primary_rays * (u64::from(samples) + extra),
+                "{backend}"
+            );
+        }
+    }
+}

@@ -17,7 +17,9 @@ pub use suite::{bars_as_groups, cases, many_groups, paper, PAPER_SCENES};
 
 use crate::accel::backend_by_name;
 use crate::compare::{compare, Comparison};
-use crate::render::{render_world, trace_primary, Frame, World, WorldOptions};
+use crate::render::{
+    render_world, render_world_passes, trace_primary, Frame, Passes, World, WorldOptions,
+};
 use crate::scene::Scene;
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -121,8 +123,9 @@ impl Row {
 }
 
 /// A setting is a backend name, optionally with one skip switched off.
-fn parse_setting(setting: &str) -> (&str, WorldOptions) {
+fn parse_setting(setting: &str) -> (&str, WorldOptions, Passes) {
     let mut o = WorldOptions::default();
+    let mut passes = Passes::All;
     let mut parts = setting.split_whitespace();
     let backend = parts.next().unwrap_or("embree");
     for p in parts {
@@ -130,10 +133,11 @@ fn parse_setting(setting: &str) -> (&str, WorldOptions) {
             "no-cull" => o.bounds_cull = false,
             "no-tree" => o.group_tree = false,
             "no-merge" => o.merge_equal_velocities = false,
+            "colour-only" => passes = Passes::Colour,
             _ => {}
         }
     }
-    (backend, o)
+    (backend, o, passes)
 }
 
 fn with_spp(scene: &Scene, spp: u32) -> Scene {
@@ -164,7 +168,7 @@ fn fastest(repeat: usize, mut f: impl FnMut()) -> f64 {
 }
 
 fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, Frame), String> {
-    let (backend_name, options) = parse_setting(setting);
+    let (backend_name, options, passes) = parse_setting(setting);
     let backend = backend_by_name(backend_name)?;
     let scene = with_spp(&case.scene, spp);
     memory::reset_peak();
@@ -186,7 +190,7 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
         build_s = build_s.min(t.elapsed().as_secs_f64());
         trace_primary(&scene, &world);
         let t = Instant::now();
-        let (frame, _) = render_world(&scene, &world);
+        let (frame, _) = render_world_passes(&scene, &world, passes);
         first_render_s = first_render_s.min(t.elapsed().as_secs_f64());
         kept = Some((world, frame));
     }
@@ -196,7 +200,7 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
     let mut primary_rays = 0;
     let primary_s = fastest(repeat, || primary_rays = trace_primary(&scene, &world).0);
     let render_s = first_render_s.min(fastest(repeat.saturating_sub(1), || {
-        render_world(&scene, &world);
+        render_world_passes(&scene, &world, passes);
     }));
     let peak_mib = memory::peak_mib();
     let (w, h) = scene.image.frame_size();
@@ -284,7 +288,7 @@ pub fn run(
             if backend_by_name(parse_setting(setting).0).is_err() {
                 continue;
             }
-            let plain = setting == "embree" || setting == "bvh";
+            let plain = matches!(setting.as_str(), "embree" | "bvh" | "embree colour-only");
             let spps: Vec<u32> = std::iter::once(1)
                 .chain(case.extra_spp.iter().copied().filter(|_| plain))
                 .collect();
@@ -394,6 +398,24 @@ pub fn summary(rows: &[Row]) -> String {
                 "- {c}: embree / bvh primary throughput = {:.2}x (render time {:.2}x)",
                 e.mrays_per_s() / b.mrays_per_s(),
                 b.render_s / e.render_s
+            );
+        }
+    }
+    // Colour alone (a PNG) against every pass (an EXR).
+    for all in rows.iter().filter(|r| r.setting == "embree") {
+        let colour = rows
+            .iter()
+            .find(|r| r.case == all.case && r.spp == all.spp && r.setting == "embree colour-only");
+        if let Some(c) = colour {
+            let _ = writeln!(
+                s,
+                "- {} at {} spp (embree): render time with every pass {:.3} s, colour only {:.3} s \
+                 ({:.2}x as fast)",
+                all.case,
+                all.spp,
+                all.render_s,
+                c.render_s,
+                all.render_s / c.render_s
             );
         }
     }

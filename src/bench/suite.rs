@@ -172,6 +172,18 @@ pub fn cases(quick: bool) -> Vec<LazyCase> {
             &["embree", "bvh"],
         ))
     }));
+    // What the EXR passes cost: a PNG takes colour alone (with several samples the passes have
+    // a ray of their own through each pixel's centre).
+    out.push(LazyCase::new("lattice beta=0.9, passes", move || {
+        let mut s = size(px);
+        s.push("group.lattice.velocity=[-0.9,0,0]".into());
+        Ok(Case::new(
+            "lattice beta=0.9, passes",
+            paper("lattice", &s)?,
+            &["embree", "embree colour-only"],
+        )
+        .with_spp(&[4]))
+    }));
     // A large lattice: 100^3 nodes (1M spheres, ~3M rods) at 1024^2.
     let n = if quick { 30 } else { 100 };
     let big_name = format!("lattice {n}^3 beta=0.9");

@@ -38,13 +38,34 @@ pub struct RenderStats {
     pub nonfinite_pixels: u64,
 }
 
-/// Build the acceleration structures with `backend` and render the scene.
+/// What a render fills in besides the colour and alpha of each pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Passes {
+    /// The extra passes too (lookback, Doppler factor, object id, normal, positions): what an
+    /// EXR holds. With several samples per pixel they come from one more ray per pixel, through
+    /// its centre.
+    All,
+    /// Colour and alpha only (what a PNG holds); the pass channels stay 0, and no ray is traced
+    /// for them.
+    Colour,
+}
+
+/// Build the acceleration structures with `backend` and render the scene, with every pass.
 pub fn render(scene: &Scene, backend: &dyn Backend) -> Result<(Frame, RenderStats), String> {
+    render_passes(scene, backend, Passes::All)
+}
+
+/// As [`render`], filling in only `passes`.
+pub fn render_passes(
+    scene: &Scene,
+    backend: &dyn Backend,
+    passes: Passes,
+) -> Result<(Frame, RenderStats), String> {
     let t0 = Instant::now();
     let world = World::build(scene, backend)?;
     let build_time = t0.elapsed();
     let t1 = Instant::now();
-    let (frame, mut stats) = render_world(scene, &world);
+    let (frame, mut stats) = render_world_passes(scene, &world, passes);
     stats.build_time = build_time;
     stats.trace_time = t1.elapsed();
     Ok((frame, stats))
@@ -93,6 +114,11 @@ pub fn primary_rays_by_tile(scene: &Scene) -> Vec<Vec<crate::spacetime::NullRay>
 /// Render with acceleration structures already built. Each band of TILE rows is rendered tile
 /// by tile straight into its rows of the frame (no second copy of the image in flight).
 pub fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
+    render_world_passes(scene, world, Passes::All)
+}
+
+/// As [`render_world`], filling in only `passes`.
+pub fn render_world_passes(scene: &Scene, world: &World, passes: Passes) -> (Frame, RenderStats) {
     let (w, h) = scene.image.frame_size();
     let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
     let cull = ScreenCull::new(world, &cam);
@@ -106,7 +132,7 @@ pub fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
             let y0 = b as u32 * TILE;
             let mut counts = (0, 0);
             for x0 in (0..w).step_by(TILE as usize) {
-                let tile = tile::render_tile(scene, world, &cam, cull.as_ref(), x0, y0);
+                let tile = tile::render_tile(scene, world, &cam, cull.as_ref(), (x0, y0), passes);
                 counts.0 += tile.primary_rays;
                 counts.1 += tile.nonfinite;
                 for p in tile.pixels {

@@ -7,7 +7,7 @@ use super::sampler::sample_offset;
 use super::screen_cull::ScreenCull;
 use super::shade::Shader;
 use super::world::{SurfaceHit, World};
-use super::TILE;
+use super::{Passes, TILE};
 use crate::scene::Scene;
 use crate::spacetime::NullRay;
 use glam::DVec3;
@@ -183,8 +183,8 @@ pub fn render_tile(
     world: &World,
     cam: &CameraRays,
     cull: Option<&ScreenCull>,
-    x0: u32,
-    y0: u32,
+    (x0, y0): (u32, u32),
+    passes: Passes,
 ) -> TileResult {
     let TilePixels {
         offset,
@@ -207,9 +207,15 @@ pub fn render_tile(
     let mut hits = vec![None; live.len()];
     let mut primary = 0u64;
     // With one sample the pixel centre serves both colour and passes; with more, an extra
-    // centre ray gives crisp passes (ids, lookback) that compositors expect.
-    let aov_pass = n > 1;
-    let aov_sample = if aov_pass { n } else { 0 };
+    // centre ray gives crisp passes (ids, lookback) that compositors expect. Colour alone needs
+    // neither.
+    let with_passes = passes == Passes::All;
+    let aov_pass = with_passes && n > 1;
+    let aov_sample = match (with_passes, aov_pass) {
+        (false, _) => u32::MAX,
+        (true, true) => n,
+        (true, false) => 0,
+    };
     for s in 0..n + u32::from(aov_pass) {
         let centre = s == n;
         let sample = if centre { None } else { Some((s, n)) };
