@@ -226,7 +226,7 @@ pub(crate) fn capsule_hit(
     tmax: f64,
 ) -> Option<f64> {
     match AxisRod::of(a, b) {
-        Some(rod) => aligned_capsule_hit(&rod, a, b, r, o, d, tmin, tmax),
+        Some(rod) => aligned_capsule_hit(&rod, r, o, d, tmin, tmax),
         None => any_capsule_hit(a, b, r, o, d, tmin, tmax),
     }
 }
@@ -263,15 +263,11 @@ impl AxisRod {
     }
 }
 
-/// [`capsule_hit`] for a rod along a coordinate axis (`rod`, of the segment from a to b). It
-/// is the general test with ba = L e_k: there dp = L² d⊥, op = L² o⊥ and every quantity carries
+/// [`capsule_hit`] for a rod along a coordinate axis. It is the general test with ba = L e_k: there dp = L² d⊥, op = L² o⊥ and every quantity carries
 /// a power of L that cancels in the roots, so the values are the same up to rounding.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn aligned_capsule_hit(
     rod: &AxisRod,
-    a: DVec3,
-    b: DVec3,
     r: f64,
     o: DVec3,
     d: DVec3,
@@ -287,7 +283,8 @@ fn aligned_capsule_hit(
     let oa = ro - lo;
     let rr = r * r;
     if dr.y * dr.y + dr.z * dr.z == 0.0 {
-        return any_capsule_hit(a, b, r, o, d, tmin, tmax);
+        // Along the axis (the capsule is the same with its ends either way round).
+        return any_capsule_hit(rod.lo, rod.hi, r, o, d, tmin, tmax);
     }
     let (h, c0, c1) = cylinder_crossings(oa.y, oa.z, dr.y, dr.z, rr);
     if h < 0.0 {

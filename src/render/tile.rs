@@ -209,13 +209,12 @@ pub fn render_tile(
     // With one sample the pixel centre serves both colour and passes; with more, an extra
     // centre ray gives crisp passes (ids, lookback) that compositors expect. Colour alone needs
     // neither.
-    let with_passes = passes == Passes::All;
-    let aov_pass = with_passes && n > 1;
-    let aov_sample = match (with_passes, aov_pass) {
-        (false, _) => u32::MAX,
-        (true, true) => n,
-        (true, false) => 0,
+    let aov_sample = match passes {
+        Passes::Colour => None,
+        Passes::All if n > 1 => Some(n),
+        Passes::All => Some(0),
     };
+    let aov_pass = aov_sample == Some(n);
     for s in 0..n + u32::from(aov_pass) {
         let centre = s == n;
         let sample = if centre { None } else { Some((s, n)) };
@@ -233,7 +232,7 @@ pub fn render_tile(
                 covered[k] += u32::from(hit.is_some());
                 sum[k] += colors[j];
             }
-            if s == aov_sample {
+            if Some(s) == aov_sample {
                 aov[k] = hit.map(|hh| (*r, hh));
             }
         }
