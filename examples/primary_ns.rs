@@ -1,0 +1,96 @@
+//! Nanoseconds per primary ray on one thread, the paper's lattice (diagnostics, and the
+//! figures the README quotes per ray):
+//! `cargo run --release --example primary_ns -- [mode] [beta] [size] [seconds]`
+//! with mode `layer` (the renderer's primary pass, `trace_primary`), `bare` (bare Embree on the
+//! same rest-frame rays, as the bench's baseline), `bvh` (the primary pass on the f64 BVH) or
+//! `render` (a whole render, per pixel); defaults `layer 0 512 2`. Prints the fastest pass of
+//! as many as fit in the given seconds, in ns per pixel.
+use rest_embree::accel::backend_by_name;
+use rest_embree::render::{render_world, trace_primary, World};
+use std::time::Instant;
+
+fn main() {
+    let arg = |i: usize| std::env::args().nth(i);
+    let mode = arg(1).unwrap_or_else(|| "layer".into());
+    let beta = arg(2).unwrap_or_else(|| "0".into());
+    let size: u32 = arg(3).and_then(|s| s.parse().ok()).unwrap_or(512);
+    let seconds: f64 = arg(4).and_then(|s| s.parse().ok()).unwrap_or(2.0);
+    let sets = vec![
+        format!("image.width={size}"),
+        format!("image.height={size}"),
+        "image.samples=1".to_string(),
+        format!("group.lattice.velocity=[-{beta},0,0]"),
+    ];
+    let scene = rest_embree::bench::paper("lattice", &sets).unwrap_or_else(|e| fail(&e));
+    if !["layer", "bare", "bvh", "render"].contains(&mode.as_str()) {
+        fail(&format!(
+            "unknown mode `{mode}`: layer, bare, bvh or render"
+        ));
+    }
+    let backend =
+        backend_by_name(if mode == "bvh" { "bvh" } else { "embree" }).unwrap_or_else(|e| fail(&e));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let world = World::build(&scene, backend.as_ref()).unwrap();
+        let mut pass: Box<dyn FnMut()> = match mode.as_str() {
+            "layer" | "bvh" => Box::new(|| {
+                trace_primary(&scene, &world);
+            }),
+            "render" => Box::new(|| {
+                render_world(&scene, &world);
+            }),
+            _ => bare(&scene, &world),
+        };
+        pass();
+        let (start, mut best) = (Instant::now(), f64::INFINITY);
+        while start.elapsed().as_secs_f64() < seconds {
+            let t = Instant::now();
+            pass();
+            best = best.min(t.elapsed().as_secs_f64());
+        }
+        let pixels = f64::from(size) * f64::from(size);
+        println!(
+            "{mode} beta={beta} {size}x{size}: {:.2} ns per pixel",
+            best * 1e9 / pixels
+        );
+    });
+}
+
+fn fail(message: &dyn std::fmt::Display) -> ! {
+    eprintln!("primary_ns: {message}");
+    std::process::exit(2)
+}
+
+#[cfg(feature = "embree")]
+fn bare<'a>(scene: &'a rest_embree::scene::Scene, world: &'a World) -> Box<dyn FnMut() + 'a> {
+    use rest_embree::accel::EmbreeAccel;
+    let g = &world.groups[0];
+    let Some(accel) = g
+        .accel
+        .as_ref()
+        .and_then(|a| a.as_any().downcast_ref::<EmbreeAccel>())
+    else {
+        fail(&"bare Embree needs the lattice's one group on Embree")
+    };
+    let tiles: Vec<Vec<_>> = rest_embree::render::primary_rays_by_tile(scene)
+        .iter()
+        .map(|rays| {
+            rays.iter()
+                .map(|r| accel.bare_ray(g.boost.event(r.origin).x, g.boost.view_dir(r.dir).0))
+                .collect()
+        })
+        .collect();
+    Box::new(move || {
+        for t in &tiles {
+            accel.trace_bare(t);
+        }
+    })
+}
+
+#[cfg(not(feature = "embree"))]
+fn bare<'a>(_: &'a rest_embree::scene::Scene, _: &'a World) -> Box<dyn FnMut() + 'a> {
+    fail(&"bare Embree needs a build with the `embree` feature")
+}
