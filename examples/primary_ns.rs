@@ -1,12 +1,13 @@
 //! Nanoseconds per primary ray on one thread, the paper's lattice (diagnostics, and the
 //! figures the README quotes per ray):
 //! `cargo run --release --example primary_ns -- [mode] [beta] [size] [seconds]`
-//! with mode `layer` (the renderer's primary pass, `trace_primary`), `bare` (bare Embree on the
-//! same rest-frame rays, as the bench's baseline), `bvh` (the primary pass on the f64 BVH) or
-//! `render` (a whole render, per pixel); defaults `layer 0 512 2`. Prints the fastest pass of
+//! with mode `layer` (the renderer's primary pass, `trace_primary`), `layer-unfused` (the same
+//! with every primary ray made one by one, no fans), `bare` (bare Embree on the same rest-frame
+//! rays, as the bench's baseline), `bvh` (the primary pass on the f64 BVH) or `render` (a whole
+//! render, per pixel); defaults `layer 0 512 2`. Prints the fastest pass of
 //! as many as fit in the given seconds, in ns per pixel.
 use rest_embree::accel::backend_by_name;
-use rest_embree::render::{render_world, trace_primary, World};
+use rest_embree::render::{render_world, trace_primary, World, WorldOptions};
 use std::time::Instant;
 
 fn main() {
@@ -22,10 +23,9 @@ fn main() {
         format!("group.lattice.velocity=[-{beta},0,0]"),
     ];
     let scene = rest_embree::bench::paper("lattice", &sets).unwrap_or_else(|e| fail(&e));
-    if !["layer", "bare", "bvh", "render"].contains(&mode.as_str()) {
-        fail(&format!(
-            "unknown mode `{mode}`: layer, bare, bvh or render"
-        ));
+    let modes = ["layer", "layer-unfused", "bare", "bvh", "render"];
+    if !modes.contains(&mode.as_str()) {
+        fail(&format!("unknown mode `{mode}`: {}", modes.join(", ")));
     }
     let backend =
         backend_by_name(if mode == "bvh" { "bvh" } else { "embree" }).unwrap_or_else(|e| fail(&e));
@@ -34,9 +34,13 @@ fn main() {
         .build()
         .unwrap();
     pool.install(|| {
-        let world = World::build(&scene, backend.as_ref()).unwrap();
+        let options = WorldOptions {
+            fused_primary: mode != "layer-unfused",
+            ..WorldOptions::default()
+        };
+        let world = World::build_with(&scene, backend.as_ref(), options).unwrap();
         let mut pass: Box<dyn FnMut()> = match mode.as_str() {
-            "layer" | "bvh" => Box::new(|| {
+            "layer" | "layer-unfused" | "bvh" => Box::new(|| {
                 trace_primary(&scene, &world);
             }),
             "render" => Box::new(|| {

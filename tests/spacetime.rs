@@ -42,6 +42,54 @@ fn boost_then_inverse_is_identity_and_interval_is_preserved() {
     }
 }
 
+/// `Boost::null_dir` as it was written before it became one branch-free form for one lane or
+/// four (`1 ± a∥` by two branches): the reference for `null_dir_is_the_branching_form_to_the_bit`.
+fn null_dir_branching(v: &Velocity, a: DVec3) -> (DVec3, f64) {
+    let (axis, phi) = (v.direction(), v.rapidity());
+    let (e_pos, e_neg) = (phi.exp(), (-phi).exp());
+    let ap = a.dot(axis);
+    let perp = a - ap * axis;
+    let p2 = perp.length_squared();
+    let one_plus = if ap >= 0.0 { 1.0 + ap } else { p2 / (1.0 - ap) };
+    let one_minus = if ap <= 0.0 { 1.0 - ap } else { p2 / (1.0 + ap) };
+    let up = e_pos * one_plus;
+    let wp = e_neg * one_minus;
+    (perp + 0.5 * (up - wp) * axis, 0.5 * (up + wp))
+}
+
+#[test]
+fn null_dir_is_the_branching_form_to_the_bit() {
+    let mut r = Rng(11);
+    let bits = |(d, s): (DVec3, f64)| [d.x.to_bits(), d.y.to_bits(), d.z.to_bits(), s.to_bits()];
+    for k in 0..20_000 {
+        let v = match k % 4 {
+            0 => Velocity::from_one_minus_beta(r.unit(), 10f64.powf(r.range(-13.0, -1.0))).unwrap(),
+            _ => Velocity::from_rapidity(r.unit(), r.range(1e-9, 8.0)).unwrap(),
+        };
+        let axis = v.direction();
+        let side = axis.any_orthonormal_vector();
+        // Random directions, along the axis either way, across it (a∥ = ±0), and within a
+        // hair of the axis, where 1 ± a∥ cancels.
+        let tilt = 10f64.powf(r.range(-9.0, -1.0));
+        for a in [
+            r.unit(),
+            axis,
+            -axis,
+            side,
+            -side,
+            (axis + tilt * side).normalize(),
+            (-axis + tilt * side).normalize(),
+        ] {
+            let got = Boost::to_rest(&v).null_dir(a);
+            assert_eq!(
+                bits(got),
+                bits(null_dir_branching(&v, a)),
+                "v {v:?}, a {a:?}"
+            );
+        }
+    }
+}
+
 #[test]
 fn null_stays_null_and_view_dir_is_unit() {
     let mut r = Rng(2);

@@ -13,11 +13,13 @@ mod bvh;
 mod bvh32;
 #[cfg(feature = "embree")]
 mod embree;
+mod fan;
 
 pub use bvh::{Bvh, BvhBackend};
 pub use bvh32::Bvh32Backend;
 #[cfg(feature = "embree")]
 pub use embree::{BareRay, EmbreeAccel, EmbreeBackend};
+pub use fan::{Fan, FanHits, NO_HIT};
 
 use crate::geometry::{Aabb, BoxTree, Geometry, LightBuffer};
 use glam::DVec3;
@@ -52,6 +54,16 @@ pub trait Accelerator: Send + Sync {
     fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]);
     /// For each active ray, whether anything lies at `tmin < t < tmax` (inactive: false).
     fn occluded(&self, rays: &[Ray], out: &mut [bool]);
+    /// Whether `intersect_fan` serves fans of primary rays (here, on this CPU).
+    fn serves_fans(&self) -> bool {
+        false
+    }
+    /// The rays of a fan of primary rays and their closest hits for lookback in (0, ∞), made
+    /// and traced by a path of the backend's own, the same rays as the renderer's to the bit;
+    /// false, with nothing written, where the backend has none (`serves_fans`).
+    fn intersect_fan(&self, _fan: &Fan, _out: &mut FanHits) -> bool {
+        false
+    }
     /// The geometry this accelerator was built over.
     fn geometry(&self) -> &Arc<Geometry>;
     /// For benchmarks that need the concrete backend.

@@ -133,6 +133,7 @@ fn parse_setting(setting: &str) -> (&str, WorldOptions, Passes) {
             "no-cull" => o.bounds_cull = false,
             "no-tree" => o.group_tree = false,
             "no-merge" => o.merge_equal_velocities = false,
+            "no-fused" => o.fused_primary = false,
             "colour-only" => passes = Passes::Colour,
             _ => {}
         }

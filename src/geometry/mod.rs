@@ -15,5 +15,4 @@ pub use light_buffer::LightBuffer;
 #[cfg(feature = "embree")]
 pub(crate) use primitive::{ball_crossings, capsule_hit, cuboid_hit, cylinder_crossings, AxisRod};
 pub use primitive::{Geometry, Part, Primitive};
-#[cfg(feature = "embree")]
 pub(crate) use real::Real;

@@ -20,7 +20,12 @@ pub trait Real:
     fn min(self, other: Self) -> Self;
     fn max(self, other: Self) -> Self;
     fn splat(x: f64) -> Self;
+    fn abs(self) -> Self;
     fn ne_zero(self) -> Self::Mask;
+    /// `self >= other`, lane by lane (false where either is NaN).
+    fn ge(self, other: Self) -> Self::Mask;
+    /// `self <= other`, lane by lane (false where either is NaN).
+    fn le(self, other: Self) -> Self::Mask;
     /// `if m { a } else { b }`, lane by lane.
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
 }
@@ -48,8 +53,20 @@ impl Real for f64 {
         x
     }
     #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline(always)]
     fn ne_zero(self) -> bool {
         self != 0.0
+    }
+    #[inline(always)]
+    fn ge(self, other: Self) -> bool {
+        self >= other
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> bool {
+        self <= other
     }
     #[inline(always)]
     fn select(m: bool, a: Self, b: Self) -> Self {

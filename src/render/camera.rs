@@ -1,5 +1,5 @@
 use crate::scene::{Camera, Projection};
-use crate::spacetime::{Boost, Event, NullRay};
+use crate::spacetime::{Boost, Event, NullRay, Pinhole};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -13,6 +13,8 @@ pub struct CameraRays {
     width: f64,
     height: f64,
     focal: f64,
+    /// Used for pinhole projections only (its focal length is 0 for the others).
+    pinhole: Pinhole,
 }
 
 impl CameraRays {
@@ -21,24 +23,48 @@ impl CameraRays {
             Projection::Pinhole { fov_y } => 0.5 * height as f64 / (0.5 * fov_y).tan(),
             _ => 0.0,
         };
+        let to_world = Boost::from_rest(&camera.velocity);
+        let pinhole = Pinhole::new([focal * camera.forward, camera.right, camera.up], to_world);
         Self {
             camera: camera.clone(),
             event: camera.imaging_event(),
-            to_world: Boost::from_rest(&camera.velocity),
+            to_world,
             to_camera: Boost::to_rest(&camera.velocity),
             width: width as f64,
             height: height as f64,
             focal,
+            pinhole,
         }
+    }
+
+    /// The pinhole camera's looking directions (None for other projections).
+    pub fn pinhole(&self) -> Option<&Pinhole> {
+        matches!(self.camera.projection, Projection::Pinhole { .. }).then_some(&self.pinhole)
+    }
+
+    /// Image point (px, py), in pixels from the top-left corner, as (u, v): pixels right of and
+    /// above the image centre.
+    #[inline(always)]
+    pub fn centred(&self, px: f64, py: f64) -> (f64, f64) {
+        (px - 0.5 * self.width, 0.5 * self.height - py)
+    }
+
+    /// The imaging event, where every ray of a pinhole camera starts.
+    pub fn event(&self) -> Event {
+        self.event
     }
 
     /// The world-frame past null ray through image point (px, py), in pixels from the top-left
     /// corner (pixel (i, j) has its centre at (i + 0.5, j + 0.5)).
     pub fn ray(&self, px: f64, py: f64) -> NullRay {
         let c = &self.camera;
-        let (u, v) = (px - 0.5 * self.width, 0.5 * self.height - py);
+        let (u, v) = self.centred(px, py);
         let (origin, dir_cam) = match c.projection {
-            Projection::Pinhole { .. } => (self.event, self.pinhole(u, v)),
+            Projection::Pinhole { .. } => {
+                // Boosted into the world frame already.
+                let [x, y, z] = self.pinhole.look(u, v);
+                return NullRay::new(self.event, DVec3::new(x, y, z));
+            }
             Projection::Orthographic { view_height } => {
                 let s = view_height / self.height;
                 let offset = (u * c.right + v * c.up) * s;
@@ -65,12 +91,6 @@ impl CameraRays {
     pub fn pinhole_toward(&self, px: f64, py: f64) -> Option<DVec3> {
         matches!(self.camera.projection, Projection::Pinhole { .. })
             .then(|| self.toward(px - 0.5 * self.width, 0.5 * self.height - py))
-    }
-
-    /// The pinhole direction (camera frame) through the image point (u, v) pixels right of and
-    /// above the centre.
-    fn pinhole(&self, u: f64, v: f64) -> DVec3 {
-        self.toward(u, v).normalize()
     }
 
     /// A vector along the pinhole direction through (u, v), not normalised.

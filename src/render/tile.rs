@@ -34,8 +34,27 @@ pub fn tile_pixels(x0: u32, y0: u32, w: u32, h: u32) -> Vec<(u32, u32)> {
     v
 }
 
-/// The primary rays of `coords` (frame pixels; `offset` places the frame in the full image):
-/// sample `(s, n)` of each pixel, or the pixel centre for None.
+/// The image points of `coords` (frame pixels; `offset` places the frame in the full image),
+/// in pixels from the image's top-left corner: sample `(s, n)` of each pixel, or the pixel
+/// centre for None.
+fn image_points(
+    coords: &[(u32, u32)],
+    offset: (u32, u32),
+    sample: Option<(u32, u32)>,
+    px: &mut Vec<(f64, f64)>,
+) {
+    px.clear();
+    px.extend(coords.iter().map(|&(fx, fy)| {
+        let (x, y) = (fx + offset.0, fy + offset.1);
+        let (ox, oy) = match sample {
+            Some((s, n)) => sample_offset(x, y, s, n),
+            None => (0.5, 0.5),
+        };
+        (x as f64 + ox, y as f64 + oy)
+    }));
+}
+
+/// The primary rays of `coords` (see `image_points`).
 pub fn primary_rays(
     cam: &CameraRays,
     coords: &[(u32, u32)],
@@ -43,15 +62,10 @@ pub fn primary_rays(
     sample: Option<(u32, u32)>,
     rays: &mut Vec<NullRay>,
 ) {
+    let mut px = Vec::with_capacity(coords.len());
+    image_points(coords, offset, sample, &mut px);
     rays.clear();
-    for &(fx, fy) in coords {
-        let (x, y) = (fx + offset.0, fy + offset.1);
-        let (ox, oy) = match sample {
-            Some((s, n)) => sample_offset(x, y, s, n),
-            None => (0.5, 0.5),
-        };
-        rays.push(cam.ray(x as f64 + ox, y as f64 + oy));
-    }
+    rays.extend(px.iter().map(|&(x, y)| cam.ray(x, y)));
 }
 
 /// A tile's pixels that the screen cull keeps (frame coordinates, and their indices among
@@ -102,12 +116,13 @@ pub fn trace_tile(
     let t = TilePixels::new(scene, cam, cull, x0, y0);
     let (offset, coords) = (t.offset, t.live_coords);
     let n = scene.image.samples;
+    let mut px = Vec::with_capacity(coords.len());
     let mut rays = Vec::with_capacity(coords.len());
     let mut hits = vec![None; coords.len()];
     let mut found = 0;
     for s in 0..n {
-        primary_rays(cam, &coords, offset, Some((s, n)), &mut rays);
-        world.closest_hits(&rays, 0.0, &mut hits);
+        image_points(&coords, offset, Some((s, n)), &mut px);
+        world.primary_hits(cam, &px, &mut rays, &mut hits);
         found += hits.iter().filter(|h| h.is_some()).count() as u64;
     }
     (n as u64 * t.total as u64, found)
@@ -203,6 +218,7 @@ pub fn render_tile(
     }
     let mut covered = vec![0u32; coords.len()];
     let mut aov: Vec<Option<(NullRay, SurfaceHit)>> = vec![None; coords.len()];
+    let mut px = Vec::with_capacity(live.len());
     let mut rays = Vec::with_capacity(live.len());
     let mut hits = vec![None; live.len()];
     let mut primary = 0u64;
@@ -218,9 +234,9 @@ pub fn render_tile(
     for s in 0..n + u32::from(aov_pass) {
         let centre = s == n;
         let sample = if centre { None } else { Some((s, n)) };
-        primary_rays(cam, &live_coords, offset, sample, &mut rays);
+        image_points(&live_coords, offset, sample, &mut px);
         primary += coords.len() as u64;
-        world.closest_hits(&rays, 0.0, &mut hits);
+        world.primary_hits(cam, &px, &mut rays, &mut hits);
         let colors = if centre {
             Vec::new()
         } else {

@@ -1,4 +1,5 @@
 use super::{Event, Velocity};
+use crate::geometry::Real;
 use glam::DVec3;
 
 /// A passive Lorentz boost along any direction, evaluated in light-cone coordinates along the
@@ -72,17 +73,53 @@ impl Boost {
         if self.identity {
             return (a, 1.0);
         }
-        let ap = a.dot(self.axis);
-        let perp = a - ap * self.axis;
-        let p2 = perp.length_squared();
-        // 1 ± a∥ without cancellation (|a| = 1).
-        let one_plus = if ap >= 0.0 { 1.0 + ap } else { p2 / (1.0 - ap) };
-        let one_minus = if ap <= 0.0 { 1.0 - ap } else { p2 / (1.0 + ap) };
-        let up = self.e_pos * one_plus;
-        let wp = self.e_neg * one_minus;
-        let s = 0.5 * (up + wp);
-        let par = 0.5 * (up - wp);
-        (perp + par * self.axis, s)
+        let ([x, y, z], s) = self.null_dir_lanes([a.x, a.y, a.z]);
+        (DVec3::new(x, y, z), s)
+    }
+
+    /// [`Boost::null_dir`] of a non-identity boost, written once for one direction or several
+    /// at a time (`Real`): the same operations in the same order, so every lane's answer is the
+    /// scalar one to the bit.
+    #[inline(always)]
+    pub(crate) fn null_dir_lanes<R: Real>(&self, a: [R; 3]) -> ([R; 3], R) {
+        let axis = [
+            R::splat(self.axis.x),
+            R::splat(self.axis.y),
+            R::splat(self.axis.z),
+        ];
+        let ap = a[0] * axis[0] + a[1] * axis[1] + a[2] * axis[2];
+        let perp = [
+            a[0] - ap * axis[0],
+            a[1] - ap * axis[1],
+            a[2] - ap * axis[2],
+        ];
+        let p2 = perp[0] * perp[0] + perp[1] * perp[1] + perp[2] * perp[2];
+        // 1 ± a∥ without cancellation (|a| = 1): the sum of magnitudes where it is large, else
+        // |a⊥|² over it (1 + |a∥| is 1 + a∥ for a∥ ≥ 0 and 1 − a∥ for a∥ ≤ 0, exactly).
+        let one = R::splat(1.0);
+        let big = one + ap.abs();
+        let small = p2 / big;
+        let zero = R::splat(0.0);
+        let one_plus = R::select(ap.ge(zero), big, small);
+        let one_minus = R::select(ap.le(zero), big, small);
+        let up = R::splat(self.e_pos) * one_plus;
+        let wp = R::splat(self.e_neg) * one_minus;
+        let half = R::splat(0.5);
+        let s = half * (up + wp);
+        let par = half * (up - wp);
+        (
+            [
+                perp[0] + par * axis[0],
+                perp[1] + par * axis[1],
+                perp[2] + par * axis[2],
+            ],
+            s,
+        )
+    }
+
+    /// Whether this boost is the identity (a frame at rest relative to the one it starts from).
+    pub fn is_identity(&self) -> bool {
+        self.identity
     }
 
     /// The unit direction of a null ray after the boost, and the factor `s` of [`Boost::null_dir`].

@@ -7,11 +7,13 @@
 mod boost;
 mod event;
 mod null_ray;
+mod pinhole;
 mod retarded;
 mod velocity;
 
 pub use boost::Boost;
 pub use event::Event;
 pub use null_ray::NullRay;
+pub use pinhole::Pinhole;
 pub use retarded::{retarded_delay, retarded_position};
 pub use velocity::{Velocity, VelocityError};

@@ -1,9 +1,10 @@
-//! Four f64 in one AVX vector, as a `Real`, for the several-ray primitive tests (`lane_hits`).
+//! Four f64 in one AVX vector, as a `Real`, for the several-ray primitive tests (`lane_hits`)
+//! and the fans of primary rays (`fan.rs`).
 //!
 //! Written with the intrinsics rather than left to the compiler's vectoriser, which kept the
 //! rod test scalar (it paired one ray's two square roots instead of four rays' one). An `F4` is
 //! made only by `F4::load` and `Real::splat`, whose callers run with AVX2 enabled (`lane_hits`
-//! checks the CPU first); the operations are inlined into them.
+//! and `fan` check the CPU first); the operations are inlined into them.
 
 use crate::geometry::Real;
 use std::arch::x86_64::*;
@@ -28,6 +29,13 @@ impl F4 {
         // SAFETY: an F4 exists only where the CPU has AVX (see the module's comment).
         unsafe { _mm256_storeu_pd(out.as_mut_ptr(), self.0) };
         out
+    }
+
+    /// The four values rounded to f32 (to nearest, as `as f32`), into `out`.
+    #[inline(always)]
+    pub fn store_f32(self, out: &mut [f32; 4]) {
+        // SAFETY: as for `store`; `out` holds four f32.
+        unsafe { _mm_storeu_ps(out.as_mut_ptr(), _mm256_cvtpd_ps(self.0)) };
     }
 
     /// Lane by lane: all ones where self < o (ordered), else zero.
@@ -108,6 +116,20 @@ impl Real for F4 {
     fn splat(x: f64) -> Self {
         // SAFETY: as for `F4::store`.
         F4(unsafe { _mm256_set1_pd(x) })
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        // SAFETY: as for `F4::store`. The sign bit cleared, as `f64::abs`.
+        F4(unsafe { _mm256_andnot_pd(_mm256_set1_pd(-0.0), self.0) })
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> F4 {
+        F4::ge(self, o)
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> F4 {
+        // SAFETY: as for `F4::store`. Ordered, as f64's `<=`.
+        F4(unsafe { _mm256_cmp_pd::<_CMP_LE_OQ>(self.0, o.0) })
     }
     #[inline(always)]
     fn ne_zero(self) -> F4 {

@@ -16,6 +16,8 @@ mod device;
 mod exact;
 #[cfg(target_arch = "x86_64")]
 mod f64x4;
+#[cfg(target_arch = "x86_64")]
+mod fan;
 mod lane_cull;
 mod lane_hits;
 mod packet;
@@ -23,8 +25,8 @@ mod scene;
 
 pub use bare::BareRay;
 
-use super::{Accelerator, Backend, BoxCuller, CullerFactory, Hit, Ray};
-use crate::geometry::{Aabb, Geometry};
+use super::{Accelerator, Backend, BoxCuller, CullerFactory, Fan, FanHits, Hit, Ray};
+use crate::geometry::{Aabb, Geometry, Real};
 use device::Device;
 use std::sync::{Arc, OnceLock};
 
@@ -112,21 +114,39 @@ struct EmbreeRay {
     active: bool,
 }
 
+/// A ray as it goes into Embree's f32 packet, before the cast, written once for one ray or
+/// several (`Real`) so that a fan's rays are `embree_ray`'s to the bit: from the origin `o`
+/// (relative to the scene's centre) and direction `d`, the origin pulled back by `pullback`
+/// along the unit direction, the unit direction, |d|, and tnear for the caller's `tmin`.
+#[inline(always)]
+fn lane_geometry<R: Real>(o: [R; 3], d: [R; 3], tmin: R, pullback: R) -> ([R; 3], [R; 3], R, R) {
+    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    // One division, not three: the f32 cast rounds far more than this.
+    let inv = R::splat(1.0) / len;
+    let du = [d[0] * inv, d[1] * inv, d[2] * inv];
+    let org = [
+        o[0] - pullback * du[0],
+        o[1] - pullback * du[1],
+        o[2] - pullback * du[2],
+    ];
+    let tnear = (tmin * len + pullback).max(R::splat(0.0));
+    (org, du, len, tnear)
+}
+
 impl EmbreeAccel {
     #[inline(always)]
     fn embree_ray(&self, r: &Ray) -> EmbreeRay {
         if !r.is_active() {
             return EmbreeRay::default();
         }
-        let len = r.dir.length();
-        // One division, not three: the f32 cast below rounds far more than this.
-        let du = r.dir * len.recip();
-        let o = r.origin - self.scene.center - self.pullback * du;
-        let tnear = (r.tmin * len + self.pullback).max(0.0);
+        let o = r.origin - self.scene.center;
+        let d = r.dir;
+        let (o, du, len, tnear) =
+            lane_geometry([o.x, o.y, o.z], [d.x, d.y, d.z], r.tmin, self.pullback);
         let tfar = r.tmax * len + self.pullback;
         EmbreeRay {
-            org: [o.x as f32, o.y as f32, o.z as f32],
-            dir: [du.x as f32, du.y as f32, du.z as f32],
+            org: o.map(|x| x as f32),
+            dir: du.map(|x| x as f32),
             tnear: tnear as f32,
             tfar: if tfar.is_finite() {
                 (tfar as f32).max(tnear as f32)
@@ -200,6 +220,23 @@ impl Accelerator for EmbreeAccel {
             } else {
                 self.occluded8(rs, os);
             }
+        }
+    }
+
+    fn serves_fans(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        return EmbreeAccel::serves_fans(self);
+        #[cfg(not(target_arch = "x86_64"))]
+        false
+    }
+
+    fn intersect_fan(&self, fan: &Fan, out: &mut FanHits) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        return self.fan(fan, out);
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = (fan, out);
+            false
         }
     }
 

@@ -1,0 +1,134 @@
+//! Fans of primary rays (`World::primary_hits`): where the backend makes a packet's primary
+//! rays itself (Embree, four lanes per AVX2 vector) the renders are those of the rays made one
+//! by one, to the bit, in every pass.
+
+#![cfg(feature = "embree")]
+
+use rest_embree::accel::backend_by_name;
+use rest_embree::bench::paper;
+use rest_embree::render::{render_world, trace_primary, CameraRays, Frame, World, WorldOptions};
+use rest_embree::scene::Scene;
+
+fn lattice(sets: &[&str]) -> Scene {
+    let mut all = vec!["image.width=96", "image.height=80", "image.samples=1"];
+    all.extend_from_slice(sets);
+    let sets: Vec<String> = all.iter().map(|s| s.to_string()).collect();
+    paper("lattice", &sets).unwrap()
+}
+
+/// The first pixel where two frames differ, with both values.
+fn first_difference(a: &Frame, b: &Frame) -> Option<String> {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .enumerate()
+        .find(|(_, (p, q))| p != q)
+        .map(|(i, (p, q))| format!("pixel {i}: {p:?} vs {q:?}"))
+}
+
+/// Renders `scene` on Embree with fans and without; asserts they are the same frame and, where
+/// `fans` says so, that the fans were really used.
+fn same_with_and_without_fans(scene: &Scene, fans: bool) {
+    let backend = backend_by_name("embree").unwrap();
+    let with = World::build(scene, backend.as_ref()).unwrap();
+    let options = WorldOptions {
+        fused_primary: false,
+        ..WorldOptions::default()
+    };
+    let without = World::build_with(scene, backend.as_ref(), options).unwrap();
+    let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
+    assert!(!without.serves_fans(&cam));
+    if fans && std::arch::is_x86_feature_detected!("avx2") {
+        assert!(
+            with.serves_fans(&cam),
+            "the fused path should serve this scene"
+        );
+    }
+    let (a, b) = (
+        render_world(scene, &with).0,
+        render_world(scene, &without).0,
+    );
+    if let Some(d) = first_difference(&a, &b) {
+        panic!("with fans / without: {d}");
+    }
+    assert_eq!(trace_primary(scene, &with), trace_primary(scene, &without));
+}
+
+#[test]
+fn lattice_at_every_speed() {
+    for b in ["0", "0.5", "0.9", "0.99"] {
+        same_with_and_without_fans(
+            &lattice(&[&format!("group.lattice.velocity=[-{b},0,0]")]),
+            true,
+        );
+    }
+}
+
+#[test]
+fn moving_camera_samples_and_crop() {
+    for sets in [
+        &[
+            "group.lattice.velocity=[-0.3,0,0]",
+            "camera.velocity=[0.6,0.2,0]",
+        ][..],
+        &["group.lattice.velocity=[-0.9,0,0]", "image.samples=3"][..],
+        &[
+            "group.lattice.velocity=[-0.5,0,0]",
+            "camera.direction=[1,-1,1]",
+        ][..],
+        &[
+            "image.crop=[30,20,41,37]",
+            "group.lattice.one_minus_beta=1e-9",
+            "group.lattice.direction=[-1,0,0]",
+        ][..],
+    ] {
+        same_with_and_without_fans(&lattice(sets), true);
+    }
+    let bars = paper(
+        "bar_array",
+        &[
+            "image.width=64",
+            "image.height=64",
+            "group.bars.velocity=[0.9,0,0]",
+        ]
+        .map(String::from),
+    )
+    .unwrap();
+    same_with_and_without_fans(&bars, true);
+}
+
+#[test]
+fn scenes_fans_do_not_serve_are_unchanged() {
+    // One box: intersected directly, no accelerator.
+    let cube = paper(
+        "calibration_cube",
+        &[
+            "image.width=64",
+            "image.height=64",
+            "group.cube.velocity=[0.5,0,0]",
+        ]
+        .map(String::from),
+    )
+    .unwrap();
+    // Seen from afar, so rays are clipped to the group's bounds; other projections.
+    let far = lattice(&["camera.position=[-300,0,0]", "camera.time=300"]);
+    let ortho = lattice(&["camera.projection=orthographic", "camera.view_height=12"]);
+    let sky = lattice(&[
+        "camera.projection=equirectangular",
+        "group.lattice.velocity=[-0.5,0,0]",
+    ]);
+    let backend = backend_by_name("embree").unwrap();
+    for scene in [&cube, &far, &ortho, &sky] {
+        let world = World::build(scene, backend.as_ref()).unwrap();
+        let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
+        assert!(!world.serves_fans(&cam));
+        same_with_and_without_fans(scene, false);
+    }
+    // Backends without a path for fans: the BVH, Embree's 8-wide packets.
+    let scene = lattice(&["group.lattice.velocity=[-0.9,0,0]"]);
+    let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
+    for name in ["bvh", "embree-8", "embree-single"] {
+        let world = World::build(&scene, backend_by_name(name).unwrap().as_ref()).unwrap();
+        assert!(!world.serves_fans(&cam), "{name}");
+    }
+}
