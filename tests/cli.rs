@@ -464,3 +464,37 @@ fn bench_writes_its_table_csv_and_plot() {
     ]);
     assert!(!ok && err.contains("--case"), "{err}");
 }
+
+#[test]
+fn the_same_render_writes_the_same_file() {
+    // EXR blocks are compressed in parallel; the file must not depend on which finished first.
+    let d = Dir::new("same-file");
+    let scene = d.file("scene.toml", GOOD);
+    let mut files = Vec::new();
+    for (i, threads) in ["2", "2", "1"].iter().enumerate() {
+        for ext in ["exr", "png"] {
+            let out = d.0.join(format!("out{i}.{ext}"));
+            let (ok, err) = run(&[
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--width",
+                "300",
+                "--height",
+                "200",
+                "--samples",
+                "2",
+                "--threads",
+                threads,
+                "--quiet",
+            ]);
+            assert!(ok, "{err}");
+            files.push((ext, std::fs::read(&out).unwrap()));
+        }
+    }
+    for (ext, bytes) in &files[2..] {
+        let first = &files.iter().find(|(e, _)| e == ext).unwrap().1;
+        assert!(bytes == first, "{ext}: the same render, a different file");
+    }
+}

@@ -19,12 +19,13 @@ pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), String> {
         software_name: Some(Text::from("rest-embree")),
         ..Default::default()
     };
-    let layer = Layer::new(
-        size,
-        attrs,
-        Encoding::FAST_LOSSLESS,
-        AnyChannels::sort(list),
-    );
+    // Blocks in increasing order: compressed in parallel, they are otherwise written as they
+    // finish, and the same image would make a different file from run to run.
+    let encoding = Encoding {
+        line_order: LineOrder::Increasing,
+        ..Encoding::FAST_LOSSLESS
+    };
+    let layer = Layer::new(size, attrs, encoding, AnyChannels::sort(list));
     Image::from_layer(layer)
         .write()
         .to_file(path)
