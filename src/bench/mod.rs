@@ -391,6 +391,13 @@ pub fn summary(rows: &[Row]) -> String {
                     n.mrays_per_s() / b.mrays_per_s()
                 );
             }
+            if let Some(n) = find(c, "embree no-fused") {
+                let _ = write!(
+                    s,
+                    " (primary rays made one by one, no fans: {:.2})",
+                    n.mrays_per_s() / b.mrays_per_s()
+                );
+            }
             s.push('\n');
         }
         if let (Some(e), Some(b)) = (find(c, "embree"), find(c, "bvh")) {

@@ -99,7 +99,8 @@ fn glyph(c: char) -> [u8; 7] {
     }
 }
 
-const PALETTE: [[u8; 3]; 8] = [
+/// One colour per setting of the full suite (eleven), so no two share one.
+const PALETTE: [[u8; 3]; 12] = [
     [31, 119, 180],
     [255, 127, 14],
     [44, 160, 44],
@@ -108,6 +109,10 @@ const PALETTE: [[u8; 3]; 8] = [
     [140, 86, 75],
     [227, 119, 194],
     [23, 190, 207],
+    [188, 189, 34],
+    [0, 0, 0],
+    [127, 127, 127],
+    [100, 20, 120],
 ];
 
 /// Plot the rows that have a render time and an error against the 16-spp reference.

@@ -119,13 +119,14 @@ pub fn bars_as_groups(beta: f64) -> Result<crate::scene::Scene, SceneError> {
 }
 
 /// Settings measured on every lattice speed.
-const LATTICE_SETTINGS: [&str; 6] = [
+const LATTICE_SETTINGS: [&str; 7] = [
     "embree",
     "embree-8",
     "embree-single",
     "bvh",
     "bvh-f32",
     "embree no-cull",
+    "embree no-fused",
 ];
 
 /// The fixed suite, each case built only when it runs (so a row's peak memory is its own).
