@@ -1,10 +1,11 @@
 //! Nanoseconds per primary ray on one thread, the paper's lattice (diagnostics, and the
 //! figures the README quotes per ray):
-//! `cargo run --release --example primary_ns -- [mode] [beta] [size] [seconds]`
+//! `cargo run --release --example primary_ns -- [mode] [beta] [size] [seconds] [backend]`
 //! with mode `layer` (the renderer's primary pass, `trace_primary`), `layer-unfused` (the same
 //! with every primary ray made one by one, no fans), `bare` (bare Embree on the same rest-frame
 //! rays, as the bench's baseline), `bvh` (the primary pass on the f64 BVH) or `render` (a whole
-//! render, per pixel); defaults `layer 0 512 2`. Prints the fastest pass of
+//! render, per pixel), and the Embree backend's name for the modes that use it (`embree`, or
+//! `embree-16` / `embree-8` for a packet width); defaults `layer 0 512 2 embree`. Prints the fastest pass of
 //! as many as fit in the given seconds, in ns per pixel.
 use rest_embree::accel::backend_by_name;
 use rest_embree::render::{render_world, trace_primary, World, WorldOptions};
@@ -16,6 +17,7 @@ fn main() {
     let beta = arg(2).unwrap_or_else(|| "0".into());
     let size: u32 = arg(3).and_then(|s| s.parse().ok()).unwrap_or(512);
     let seconds: f64 = arg(4).and_then(|s| s.parse().ok()).unwrap_or(2.0);
+    let embree = arg(5).unwrap_or_else(|| "embree".into());
     let sets = vec![
         format!("image.width={size}"),
         format!("image.height={size}"),
@@ -28,7 +30,7 @@ fn main() {
         fail(&format!("unknown mode `{mode}`: {}", modes.join(", ")));
     }
     let backend =
-        backend_by_name(if mode == "bvh" { "bvh" } else { "embree" }).unwrap_or_else(|e| fail(&e));
+        backend_by_name(if mode == "bvh" { "bvh" } else { &embree }).unwrap_or_else(|e| fail(&e));
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()

@@ -27,9 +27,16 @@ fn first_difference(a: &Frame, b: &Frame) -> Option<String> {
 }
 
 /// Renders `scene` on Embree with fans and without; asserts they are the same frame and, where
-/// `fans` says so, that the fans were really used.
+/// `fans` says so, that the fans were really used. On 16- and 8-wide packets (a fan of 16 lanes
+/// is two packets there, as `intersect8` splits 16 rays).
 fn same_with_and_without_fans(scene: &Scene, fans: bool) {
-    let backend = backend_by_name("embree").unwrap();
+    for name in ["embree-16", "embree-8"] {
+        same_on(name, scene, fans);
+    }
+}
+
+fn same_on(name: &str, scene: &Scene, fans: bool) {
+    let backend = backend_by_name(name).unwrap();
     let with = World::build(scene, backend.as_ref()).unwrap();
     let options = WorldOptions {
         fused_primary: false,
@@ -62,6 +69,18 @@ fn lattice_at_every_speed() {
             true,
         );
     }
+}
+
+#[test]
+fn tiles_cut_by_the_image_edge() {
+    // 97 × 81: the last tiles are a pixel wide or tall, and the corner tile (at rest the lattice
+    // fills the view, so the screen cull keeps it) is one ray, which goes through Embree's
+    // single-ray traversal either way. (Single-ray and packet traversal differ only on rays
+    // grazing a box within f32 rounding, which this scene need not have: removing that rule
+    // from the fans does not fail this test; it holds by construction.)
+    let mut s = lattice(&["group.lattice.velocity=[0,0,0]"]);
+    (s.image.width, s.image.height) = (97, 81);
+    same_with_and_without_fans(&s, true);
 }
 
 #[test]
@@ -124,10 +143,10 @@ fn scenes_fans_do_not_serve_are_unchanged() {
         assert!(!world.serves_fans(&cam));
         same_with_and_without_fans(scene, false);
     }
-    // Backends without a path for fans: the BVH, Embree's 8-wide packets.
+    // Backends without a path for fans: the BVH, Embree's single rays.
     let scene = lattice(&["group.lattice.velocity=[-0.9,0,0]"]);
     let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
-    for name in ["bvh", "embree-8", "embree-single"] {
+    for name in ["bvh", "embree-single"] {
         let world = World::build(&scene, backend_by_name(name).unwrap().as_ref()).unwrap();
         assert!(!world.serves_fans(&cam), "{name}");
     }

@@ -1,6 +1,7 @@
-//! Embree's path for fans of primary rays (`Accelerator::intersect_fan`): a 16-wide packet's
-//! rays made, boosted and written into Embree's f32 packet four lanes per AVX2 vector, from the
-//! camera, the boost and the lanes' image points, then traced as `intersect16` traces them.
+//! Embree's path for fans of primary rays (`Accelerator::intersect_fan`): a packet's rays made,
+//! boosted and written into Embree's f32 packet four lanes per AVX2 vector, from the camera,
+//! the boost and the lanes' image points, then traced as `intersect16` (or, where the CPU has
+//! no native 16-wide packets, as `intersect8` on each half) traces them.
 //!
 //! Made one by one, a primary ray runs three chains of a square root and divisions (the
 //! camera's unit direction, the boost, the packet's unit direction) and goes through three
@@ -16,111 +17,138 @@ use super::packet::{flush_denormals, Valid};
 use super::{lane_geometry, EmbreeAccel};
 use crate::accel::{Fan, FanHits, Ray, NO_HIT};
 use crate::geometry::Real;
+use crate::geometry::PACKET;
 use embree_sys::*;
 use glam::DVec3;
 
-/// Lanes of a fan: Embree's 16-wide packet.
-const N: usize = 16;
-
 impl EmbreeAccel {
-    /// Whether this accelerator traces fans: 16-wide packets, on a CPU with AVX2.
+    /// Whether this accelerator traces fans: 16- or 8-wide packets, on a CPU with AVX2.
     pub(super) fn serves_fans(&self) -> bool {
-        self.width == N && std::arch::is_x86_feature_detected!("avx2")
+        matches!(self.width, 8 | 16) && std::arch::is_x86_feature_detected!("avx2")
     }
 
+    /// A fan's rays and hits; false for a fan of one ray, which (as `intersect` sends a single
+    /// ray) goes through Embree's single-ray traversal the caller's way.
     pub(super) fn fan(&self, fan: &Fan, out: &mut FanHits) -> bool {
-        if !self.serves_fans() {
+        if !self.serves_fans() || fan.n < 2 {
             return false;
         }
         flush_denormals();
         // SAFETY: the CPU has AVX2 (checked just now).
-        unsafe { self.fan_avx2(fan, out) };
+        unsafe {
+            if self.width == 16 {
+                self.fan16(fan, out, 0);
+            } else {
+                self.fan8(fan, out, 0);
+                if fan.n > 8 {
+                    self.fan8(fan, out, 8);
+                }
+            }
+        }
         true
     }
-
-    #[target_feature(enable = "avx2")]
-    unsafe fn fan_avx2(&self, fan: &Fan, out: &mut FanHits) {
-        let n = fan.n.min(N);
-        let mut rh = RTCRayHit16::default();
-        let mut len = [1.0; N];
-        let splat = F4::splat;
-        let o = fan.origin - self.scene.center;
-        let (o, pullback) = ([splat(o.x), splat(o.y), splat(o.z)], splat(self.pullback));
-        for c in (0..N).step_by(4) {
-            let four = |x: &[f64; N]| {
-                // SAFETY: this function runs with AVX2.
-                unsafe { F4::load(x[c..c + 4].try_into().expect("four lanes")) }
-            };
-            let look = fan.camera.look(four(&fan.u), four(&fan.v));
-            // As `World::rest_ray` boosts a primary ray, and `embree_ray` puts it in a lane.
-            let (dir, s) = if fan.to_rest.is_identity() {
-                (look, splat(1.0))
-            } else {
-                fan.to_rest.null_dir_lanes(look)
-            };
-            let (org, du, l, tnear) = lane_geometry(o, dir, splat(0.0), pullback);
-            let f32s = |x: F4, col: &mut [f32; N]| {
-                x.store_f32((&mut col[c..c + 4]).try_into().expect("four lanes"))
-            };
-            f32s(org[0], &mut rh.ray.org_x);
-            f32s(org[1], &mut rh.ray.org_y);
-            f32s(org[2], &mut rh.ray.org_z);
-            f32s(du[0], &mut rh.ray.dir_x);
-            f32s(du[1], &mut rh.ray.dir_y);
-            f32s(du[2], &mut rh.ray.dir_z);
-            f32s(tnear, &mut rh.ray.tnear);
-            let f64s = |x: F4, col: &mut [f64; N]| col[c..c + 4].copy_from_slice(&x.store());
-            for k in 0..3 {
-                f64s(look[k], &mut out.look[k]);
-                f64s(dir[k], &mut out.dir[k]);
-            }
-            f64s(s, &mut out.s);
-            f64s(l, &mut len);
-        }
-        // The rest-frame rays as `World::rest_ray` makes them (shifted by 0 along themselves),
-        // for the exact tests in the callbacks and the hits' read-back.
-        let rays: [Ray; N] = std::array::from_fn(|i| {
-            let dir = DVec3::new(out.dir[0][i], out.dir[1][i], out.dir[2][i]);
-            Ray {
-                origin: fan.origin + 0.0 * dir,
-                dir,
-                tmin: 0.0,
-                tmax: f64::INFINITY,
-            }
-        });
-        let mut lanes = Lanes::<N>::new(&rays[..n]);
-        lanes.len = len;
-        let mut valid = Valid([0i32; N]);
-        for i in 0..n {
-            rh.ray.tfar[i] = f32::INFINITY;
-            rh.ray.mask[i] = u32::MAX;
-            rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-            valid.0[i] = -1;
-        }
-        let mut ctx = self.context(true, &rays[..n], &lanes);
-        // SAFETY: a 16-wide packet with its valid mask (64-byte aligned), the scene and the
-        // context its user geometry expects.
-        unsafe { rtcIntersect16(valid.0.as_ptr(), self.scene.raw, ctx.raw(), &mut rh) };
-        for (i, ray) in rays.iter().enumerate().take(n) {
-            let hit = (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
-                .then(|| {
-                    self.to_hit(
-                        ray,
-                        lanes.len[i],
-                        rh.ray.tfar[i],
-                        rh.hit.geomID[i],
-                        rh.hit.primID[i],
-                        ctx.exact_t(i),
-                    )
-                })
-                .flatten();
-            // Written field by field: an Option copied whole went through the stack with loads
-            // that straddled its stores (a store-forwarding stall per lane).
-            out.prim[i] = NO_HIT;
-            if let Some(h) = hit {
-                out.t[i] = h.t;
-                out.prim[i] = h.prim;
-            }
-        }
-    }
 }
+
+/// The kernel for one N-wide packet of a fan's lanes `first..first + N`.
+macro_rules! fan_packet {
+    ($name:ident, $n:literal, $RayHitN:ident, $rtc_isect:ident) => {
+        impl EmbreeAccel {
+            #[target_feature(enable = "avx2")]
+            unsafe fn $name(&self, fan: &Fan, out: &mut FanHits, first: usize) {
+                const N: usize = $n;
+                const { assert!(N % 4 == 0 && N <= PACKET) };
+                let n = fan.n.saturating_sub(first).min(N);
+                let mut rh = $RayHitN::default();
+                let mut len = [1.0; N];
+                let splat = F4::splat;
+                let o = fan.origin - self.scene.center;
+                let (o, pullback) = ([splat(o.x), splat(o.y), splat(o.z)], splat(self.pullback));
+                for c in (0..N).step_by(4) {
+                    // Lanes c.. of the packet are lanes at.. of the fan.
+                    let at = first + c;
+                    let four = |x: &[f64; PACKET]| {
+                        // SAFETY: this function runs with AVX2.
+                        unsafe { F4::load(x[at..at + 4].try_into().expect("four lanes")) }
+                    };
+                    let look = fan.camera.look(four(&fan.u), four(&fan.v));
+                    // As `World::rest_ray` boosts a primary ray, and `embree_ray` puts it in a
+                    // lane.
+                    let (dir, s) = if fan.to_rest.is_identity() {
+                        (look, splat(1.0))
+                    } else {
+                        fan.to_rest.null_dir_lanes(look)
+                    };
+                    let (org, du, l, tnear) = lane_geometry(o, dir, splat(0.0), pullback);
+                    let f32s = |x: F4, col: &mut [f32; N]| {
+                        x.store_f32((&mut col[c..c + 4]).try_into().expect("four lanes"))
+                    };
+                    f32s(org[0], &mut rh.ray.org_x);
+                    f32s(org[1], &mut rh.ray.org_y);
+                    f32s(org[2], &mut rh.ray.org_z);
+                    f32s(du[0], &mut rh.ray.dir_x);
+                    f32s(du[1], &mut rh.ray.dir_y);
+                    f32s(du[2], &mut rh.ray.dir_z);
+                    f32s(tnear, &mut rh.ray.tnear);
+                    let f64s = |x: F4, col: &mut [f64; PACKET]| {
+                        col[at..at + 4].copy_from_slice(&x.store())
+                    };
+                    for k in 0..3 {
+                        f64s(look[k], &mut out.look[k]);
+                        f64s(dir[k], &mut out.dir[k]);
+                    }
+                    f64s(s, &mut out.s);
+                    len[c..c + 4].copy_from_slice(&l.store());
+                }
+                // The rest-frame rays as `World::rest_ray` makes them (shifted by 0 along
+                // themselves), for the exact tests in the callbacks and the hits' read-back.
+                let rays: [Ray; N] = std::array::from_fn(|i| {
+                    let d = &out.dir;
+                    let dir = DVec3::new(d[0][first + i], d[1][first + i], d[2][first + i]);
+                    Ray {
+                        origin: fan.origin + 0.0 * dir,
+                        dir,
+                        tmin: 0.0,
+                        tmax: f64::INFINITY,
+                    }
+                });
+                let mut lanes = Lanes::<N>::new(&rays[..n]);
+                lanes.len = len;
+                let mut valid = Valid([0i32; N]);
+                for i in 0..n {
+                    rh.ray.tfar[i] = f32::INFINITY;
+                    rh.ray.mask[i] = u32::MAX;
+                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+                    valid.0[i] = -1;
+                }
+                let mut ctx = self.context(true, &rays[..n], &lanes);
+                // SAFETY: an N-wide packet with its valid mask (64-byte aligned), the scene and
+                // the context its user geometry expects.
+                unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), &mut rh) };
+                for (i, ray) in rays.iter().enumerate().take(n) {
+                    let hit = (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
+                        .then(|| {
+                            self.to_hit(
+                                ray,
+                                lanes.len[i],
+                                rh.ray.tfar[i],
+                                rh.hit.geomID[i],
+                                rh.hit.primID[i],
+                                ctx.exact_t(i),
+                            )
+                        })
+                        .flatten();
+                    // Written field by field: an Option copied whole went through the stack
+                    // with loads that straddled its stores (a store-forwarding stall per lane).
+                    out.prim[first + i] = NO_HIT;
+                    if let Some(h) = hit {
+                        out.t[first + i] = h.t;
+                        out.prim[first + i] = h.prim;
+                    }
+                }
+            }
+        }
+    };
+}
+
+fan_packet!(fan16, 16, RTCRayHit16, rtcIntersect16);
+fan_packet!(fan8, 8, RTCRayHit8, rtcIntersect8);
