@@ -72,23 +72,9 @@ fn fail(message: &dyn std::fmt::Display) -> ! {
 
 #[cfg(feature = "embree")]
 fn bare<'a>(scene: &'a rest_embree::scene::Scene, world: &'a World) -> Box<dyn FnMut() + 'a> {
-    use rest_embree::accel::EmbreeAccel;
-    let g = &world.groups[0];
-    let Some(accel) = g
-        .accel
-        .as_ref()
-        .and_then(|a| a.as_any().downcast_ref::<EmbreeAccel>())
-    else {
+    let Some((accel, tiles)) = rest_embree::bench::bare_rays(scene, world) else {
         fail(&"bare Embree needs the lattice's one group on Embree")
     };
-    let tiles: Vec<Vec<_>> = rest_embree::render::primary_rays_by_tile(scene)
-        .iter()
-        .map(|rays| {
-            rays.iter()
-                .map(|r| accel.bare_ray(g.boost.event(r.origin).x, g.boost.view_dir(r.dir).0))
-                .collect()
-        })
-        .collect();
     Box::new(move || {
         for t in &tiles {
             accel.trace_bare(t);

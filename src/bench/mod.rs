@@ -227,35 +227,41 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
     ))
 }
 
-/// Bare Embree on the rest-frame primary rays of the scene's one group: (rays, best seconds).
+/// The bare-Embree baseline's input: the Embree accelerator of the world's one group and the
+/// scene's primary rays (pixel centres, tile by tile) in that group's rest frame, as bare f32
+/// rays; None unless the world is one group on Embree.
 #[cfg(feature = "embree")]
-fn bare_embree(case: &Case, repeat: usize) -> Result<Option<(u64, f64)>, String> {
-    use crate::accel::EmbreeAccel;
-    use crate::render::primary_rays_by_tile;
-    use crate::spacetime::Boost;
-    use rayon::prelude::*;
-    let backend = backend_by_name("embree")?;
-    let world = World::build(&case.scene, backend.as_ref())?;
-    if world.groups.len() != 1 {
-        return Ok(None);
-    }
-    let g = &world.groups[0];
-    let Some(accel) = g
-        .accel
-        .as_ref()
-        .and_then(|a| a.as_any().downcast_ref::<EmbreeAccel>())
-    else {
-        return Ok(None);
+pub fn bare_rays<'w>(
+    scene: &Scene,
+    world: &'w World,
+) -> Option<(
+    &'w crate::accel::EmbreeAccel,
+    Vec<Vec<crate::accel::BareRay>>,
+)> {
+    let [g] = world.groups.as_slice() else {
+        return None;
     };
-    let boost: Boost = g.boost;
-    let tiles: Vec<Vec<crate::accel::BareRay>> = primary_rays_by_tile(&case.scene)
+    let accel: &crate::accel::EmbreeAccel = g.accel.as_ref()?.as_any().downcast_ref()?;
+    let tiles = crate::render::primary_rays_by_tile(scene)
         .iter()
         .map(|rays| {
             rays.iter()
-                .map(|r| accel.bare_ray(boost.event(r.origin).x, boost.view_dir(r.dir).0))
+                .map(|r| accel.bare_ray(g.boost.event(r.origin).x, g.boost.view_dir(r.dir).0))
                 .collect()
         })
         .collect();
+    Some((accel, tiles))
+}
+
+/// Bare Embree on the rest-frame primary rays of the scene's one group: (rays, best seconds).
+#[cfg(feature = "embree")]
+fn bare_embree(case: &Case, repeat: usize) -> Result<Option<(u64, f64)>, String> {
+    use rayon::prelude::*;
+    let backend = backend_by_name("embree")?;
+    let world = World::build(&case.scene, backend.as_ref())?;
+    let Some((accel, tiles)) = bare_rays(&case.scene, &world) else {
+        return Ok(None);
+    };
     let n: u64 = tiles.iter().map(|t| t.len() as u64).sum();
     let _warm: usize = tiles.par_iter().map(|t| accel.trace_bare(t)).sum();
     let best = fastest(repeat, || {

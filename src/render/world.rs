@@ -403,7 +403,7 @@ impl World {
     /// The one group and its accelerator when primary rays through `cam` go to the backend as
     /// fans: a pinhole camera, a single group seen from close by (no clip, no group trees) and
     /// a backend with a path of its own for them.
-    fn fan_group(&self, cam: &'_ CameraRays) -> Option<(&GroupRt, &dyn Accelerator, Pinhole)> {
+    fn fan_group(&self, cam: &CameraRays) -> Option<(&GroupRt, &dyn Accelerator, Pinhole)> {
         let [g] = self.groups.as_slice() else {
             return None;
         };
