@@ -10,13 +10,14 @@
 //! every group costs a handful of box tests.
 
 use super::apparent_tree::ApparentTree;
-use super::camera::CameraRays;
 use super::group_tree::SlicedGroupTree;
 use super::light_tree::LightTree;
-use crate::accel::{Accelerator, Backend, Fan, FanHits, Hit, Ray, NO_HIT};
+
+mod fans;
+use crate::accel::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, Part, PACKET};
 use crate::scene::Scene;
-use crate::spacetime::{Boost, NullRay, Pinhole, Velocity};
+use crate::spacetime::{Boost, NullRay, Velocity};
 use glam::DVec3;
 use std::sync::{Arc, OnceLock};
 
@@ -397,84 +398,6 @@ impl World {
             point: rr.ray.origin + h.t * rr.ray.dir,
             dir: rr.ray.dir,
             s: rr.s,
-        }
-    }
-
-    /// The one group and its accelerator when primary rays through `cam` go to the backend as
-    /// fans: a pinhole camera, a single group seen from close by (no clip, no group trees) and
-    /// a backend with a path of its own for them.
-    fn fan_group(&self, cam: &CameraRays) -> Option<(&GroupRt, &dyn Accelerator, Pinhole)> {
-        let [g] = self.groups.as_slice() else {
-            return None;
-        };
-        if !self.options.fused_primary
-            || self.clip_rays
-            || self.primary_tree.is_some()
-            || cam.event() != self.event
-        {
-            return None;
-        }
-        let accel = g.accel.as_deref().filter(|a| a.serves_fans())?;
-        Some((g, accel, *cam.pinhole()?))
-    }
-
-    /// Whether `primary_hits` hands the primary rays through `cam` to the backend as fans.
-    pub fn serves_fans(&self, cam: &CameraRays) -> bool {
-        self.fan_group(cam).is_some()
-    }
-
-    /// The primary rays through the image points `px` (pixels from the top-left corner, a
-    /// tile's in packet order) into `rays`, and the visible hit of each: `cam.ray` of each and
-    /// `closest_hits`, or, where the backend has a path for them, fans of PACKET rays made,
-    /// boosted and traced by the backend, with the same rays and hits to the bit.
-    pub fn primary_hits(
-        &self,
-        cam: &CameraRays,
-        px: &[(f64, f64)],
-        rays: &mut Vec<NullRay>,
-        out: &mut [Option<SurfaceHit>],
-    ) {
-        rays.clear();
-        let Some((g, accel, camera)) = self.fan_group(cam) else {
-            rays.extend(px.iter().map(|&(x, y)| cam.ray(x, y)));
-            return self.closest_hits(rays, 0.0, out);
-        };
-        let mut hits = FanHits::default();
-        for (ps, os) in px.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
-            let mut fan = Fan {
-                camera: &camera,
-                to_rest: &g.boost,
-                origin: g.event_rest,
-                u: [0.0; PACKET],
-                v: [0.0; PACKET],
-                n: ps.len(),
-            };
-            for (i, &(x, y)) in ps.iter().enumerate() {
-                (fan.u[i], fan.v[i]) = cam.centred(x, y);
-            }
-            if !accel.intersect_fan(&fan, &mut hits) {
-                let start = rays.len();
-                rays.extend(ps.iter().map(|&(x, y)| cam.ray(x, y)));
-                self.closest_hits(&rays[start..], 0.0, os);
-                continue;
-            }
-            let col = |c: &[[f64; PACKET]; 3], i: usize| DVec3::new(c[0][i], c[1][i], c[2][i]);
-            for (i, o) in os.iter_mut().enumerate() {
-                rays.push(NullRay::new(cam.event(), col(&hits.look, i)));
-                // As `rest_ray` and `surface_hit` make them, with no shift along the ray.
-                *o = (hits.prim[i] != NO_HIT).then(|| {
-                    let dir = col(&hits.dir, i);
-                    let origin = g.event_rest + 0.0 * dir;
-                    SurfaceHit {
-                        group: 0,
-                        prim: hits.prim[i],
-                        lambda: 0.0 + hits.t[i],
-                        point: origin + hits.t[i] * dir,
-                        dir,
-                        s: hits.s[i],
-                    }
-                });
-            }
         }
     }
 
