@@ -86,7 +86,9 @@ pub fn trace_primary(scene: &Scene, world: &World) -> (u64, u64) {
     let cull = ScreenCull::new(world, &cam);
     tiles(scene)
         .par_iter()
-        .map(|&(x0, y0)| tile::trace_tile(scene, world, &cam, cull.as_ref(), x0, y0))
+        .map_init(tile::TileScratch::default, |scratch, &xy| {
+            tile::trace_tile(scene, world, &cam, cull.as_ref(), xy, scratch)
+        })
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
 
@@ -130,9 +132,11 @@ pub fn render_world_passes(scene: &Scene, world: &World, passes: Passes) -> (Fra
         .enumerate()
         .map(|(b, rows)| {
             let y0 = b as u32 * TILE;
-            let mut counts = (0, 0);
+            let (mut counts, mut scratch) = ((0, 0), tile::TileScratch::default());
             for x0 in (0..w).step_by(TILE as usize) {
-                let tile = tile::render_tile(scene, world, &cam, cull.as_ref(), (x0, y0), passes);
+                let xy = (x0, y0);
+                let tile =
+                    tile::render_tile(scene, world, &cam, cull.as_ref(), xy, passes, &mut scratch);
                 counts.0 += tile.primary_rays;
                 counts.1 += tile.nonfinite;
                 for p in tile.pixels {
