@@ -1,9 +1,10 @@
 //! The screen-space cull (a 4 × 4 block of pixels whose rays cannot reach any group's apparent
 //! box is background without tracing) changes no pixel: every pixel a ray hits without it lies
-//! in a block it keeps, and renders with and without bounds culling agree.
+//! in a block it keeps, every block it keeps lies in a tile it keeps, and renders with and
+//! without bounds culling agree.
 
 use rest_embree::bench::paper;
-use rest_embree::render::{render_world, CameraRays, ScreenCull, World, WorldOptions};
+use rest_embree::render::{render_world, CameraRays, ScreenCull, World, WorldOptions, TILE};
 use rest_embree::scene::Scene;
 
 fn scenes() -> Vec<(String, Scene)> {
@@ -106,7 +107,7 @@ fn scenes() -> Vec<(String, Scene)> {
 #[test]
 fn every_pixel_that_sees_a_group_is_kept() {
     let backend = rest_embree::accel::backend_by_name("bvh").unwrap();
-    let mut culled_somewhere = false;
+    let (mut culled_somewhere, mut whole_tiles) = (false, false);
     for (name, s) in scenes() {
         let cam = CameraRays::new(&s.camera, s.image.width, s.image.height);
         let uncull = World::build_with(
@@ -145,11 +146,20 @@ fn every_pixel_that_sees_a_group_is_kept() {
             continue;
         };
         let (ox, oy) = s.image.frame_offset();
-        let (mut hit, mut kept, mut dropped) = (0, 0, 0);
+        let (mut hit, mut kept, mut dropped, mut tiles_dropped) = (0, 0, 0, 0);
         for y in 0..plain.height {
             for x in 0..plain.width {
                 // The renderer's blocks are aligned in the frame (its tiles and packets).
                 let visible = cull.block_visible(&cam, (x & !3) + ox, (y & !3) + oy);
+                // A tile no group's cone reaches has none of its blocks tested: it must hold
+                // no block the blocks' own test keeps.
+                let t = !(TILE - 1);
+                let tile = cull.tile_visible(&cam, (x & t) + ox, (y & t) + oy);
+                assert!(
+                    tile || !visible,
+                    "{name}: block at ({x}, {y}) kept, its tile not"
+                );
+                tiles_dropped += u32::from(!tile);
                 if plain.get(x, y).alpha > 0.0 {
                     hit += 1;
                     assert!(
@@ -173,6 +183,7 @@ fn every_pixel_that_sees_a_group_is_kept() {
             assert!(dropped > 0, "{name}: background blocks are skipped");
         }
         culled_somewhere |= dropped > 0;
+        whole_tiles |= tiles_dropped > 0;
         // Without the cull nothing else changes but where rays are rebased (f64 rounding).
         for (a, b) in plain.pixels.iter().zip(&fast.pixels) {
             assert_eq!(
@@ -189,4 +200,5 @@ fn every_pixel_that_sees_a_group_is_kept() {
         culled_somewhere,
         "the cull skips background blocks somewhere"
     );
+    assert!(whole_tiles, "the cull skips whole tiles somewhere");
 }

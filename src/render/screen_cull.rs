@@ -8,12 +8,14 @@
 //! frame (the aberration of PHYSICS.md §1.1 each time), is again a cone, found exactly from
 //! three of its boundary directions. A 4 × 4 block of pixels (one ray packet) whose directions
 //! all lie outside every group's cone is background, with no camera ray, boost or bounds test
-//! spent on it: one dot product per block and group. Pinhole cameras only (image points L
+//! spent on it: one dot product per block and group, and first one per tile and group (a tile
+//! no group's cone reaches is background without its blocks tested). Pinhole cameras only (image points L
 //! pixels apart then look at most L / focal radians apart, which bounds a block's spread of
 //! directions); at most `MAX_GROUPS` groups (with more, the group tree culls).
 
 use super::camera::CameraRays;
 use super::world::World;
+use super::TILE;
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -30,6 +32,8 @@ pub struct ScreenCull {
     /// Per group: the cone's axis and the cosine of its half-angle widened by a block's
     /// angular radius (a block is visible when its centre direction is within that).
     cones: Vec<(DVec3, f64)>,
+    /// The same widened by a tile's angular radius instead, for a tile's test.
+    tile_cones: Vec<(DVec3, f64)>,
 }
 
 /// The angle between two unit vectors, accurate for small angles too (acos is not near 1).
@@ -64,7 +68,16 @@ impl ScreenCull {
         // Image points L pixels apart look at most L / focal apart: a 4 x 4 block's directions
         // are within 2 sqrt(2) / focal of its centre's.
         let block_radius = 8f64.sqrt() / cam.focal_px();
+        // A tile's: within TILE / sqrt(2) pixels of its centre (a block's centre within
+        // 6 sqrt(2), so a block within the reach of a cone lies in a tile within it).
+        let tile_radius = std::f64::consts::SQRT_2 * f64::from(TILE / 2) / cam.focal_px();
+        let widened = |axis: DVec3, half_angle: f64, radius: f64| {
+            // Slack for rounding in the maps (a pixel is ~1e-3 rad).
+            let reach = half_angle + radius + 1e-6;
+            (axis, if reach < PI { reach.cos() } else { -1.0 })
+        };
         let mut cones = Vec::with_capacity(world.groups.len());
+        let mut tile_cones = Vec::with_capacity(world.groups.len());
         for g in &world.groups {
             let out = g.boost.inverse();
             let b = &g.bounds;
@@ -102,30 +115,41 @@ impl ScreenCull {
             if centre.dot(c.axis) < c.half_angle.cos() || c.half_angle > 1.4 {
                 return None;
             }
-            // Slack for rounding in the maps (a pixel is ~1e-3 rad).
-            let reach = c.half_angle + block_radius + 1e-6;
-            cones.push((c.axis, if reach < PI { reach.cos() } else { -1.0 }));
+            cones.push(widened(c.axis, c.half_angle, block_radius));
+            tile_cones.push(widened(c.axis, c.half_angle, tile_radius));
         }
-        Some(ScreenCull { cones })
+        Some(ScreenCull { cones, tile_cones })
+    }
+
+    /// Whether any group may be seen from the TILE × TILE pixels whose top-left pixel is
+    /// (x, y) in full-image coordinates (where none can, no block of it need be tested).
+    pub fn tile_visible(&self, cam: &CameraRays, x: u32, y: u32) -> bool {
+        let half = f64::from(TILE / 2);
+        seen_from(&self.tile_cones, cam, x as f64 + half, y as f64 + half)
     }
 
     /// Whether any group may be seen from the 4 × 4 block of pixels whose top-left pixel is
     /// (x, y) in full-image coordinates.
     pub fn block_visible(&self, cam: &CameraRays, x: u32, y: u32) -> bool {
-        let (x0, y0) = (x as f64, y as f64);
-        let Some(d) = cam.pinhole_toward(x0 + 2.0, y0 + 2.0) else {
-            return true;
-        };
-        // axis · d ≥ cos_reach |d| without the square root: compare squares, minding signs.
-        let d2 = d.length_squared();
-        self.cones.iter().any(|&(axis, c)| {
-            let a = axis.dot(d);
-            let (a2, c2) = (a * a, c * c * d2);
-            if c >= 0.0 {
-                a >= 0.0 && a2 >= c2
-            } else {
-                a >= 0.0 || a2 <= c2
-            }
-        })
+        seen_from(&self.cones, cam, x as f64 + 2.0, y as f64 + 2.0)
     }
+}
+
+/// Whether the looking direction through image point (x, y) lies within any of `cones` (axis
+/// and cosine of the reach).
+fn seen_from(cones: &[(DVec3, f64)], cam: &CameraRays, x: f64, y: f64) -> bool {
+    let Some(d) = cam.pinhole_toward(x, y) else {
+        return true;
+    };
+    // axis · d ≥ cos_reach |d| without the square root: compare squares, minding signs.
+    let d2 = d.length_squared();
+    cones.iter().any(|&(axis, c)| {
+        let a = axis.dot(d);
+        let (a2, c2) = (a * a, c * c * d2);
+        if c >= 0.0 {
+            a >= 0.0 && a2 >= c2
+        } else {
+            a >= 0.0 || a2 <= c2
+        }
+    })
 }

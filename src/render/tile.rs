@@ -95,9 +95,12 @@ impl TilePixels {
         self.total = 0;
         self.live.clear();
         self.live_coords.clear();
+        let (ox, oy) = self.offset;
+        // Tiles start at multiples of TILE in the frame, so a tile's square is its pixels'.
+        let tile = cull.is_none_or(|c| c.tile_visible(cam, x0 + ox, y0 + oy));
         for (bx, by, bw, bh) in blocks(x0, y0, w, h) {
             let n = (bw * bh) as usize;
-            if cull.is_none_or(|c| c.block_visible(cam, bx + self.offset.0, by + self.offset.1)) {
+            if tile && cull.is_none_or(|c| c.block_visible(cam, bx + ox, by + oy)) {
                 self.live.extend(self.total..self.total + n);
                 for y in by..by + bh {
                     self.live_coords.extend((bx..bx + bw).map(|x| (x, y)));
