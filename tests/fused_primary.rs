@@ -84,6 +84,32 @@ fn tiles_cut_by_the_image_edge() {
 }
 
 #[test]
+fn lone_rays() {
+    // A tile of one pixel is a fan of one ray, which the Embree backend declines (it goes
+    // through single-ray traversal): the renderer makes it one by one and keeps it among the
+    // fans' columns, where the tile before (in the same buffers) left its own. Crops of
+    // 17 × 1 pixels (a tile of 16, then one of 1) along two rows, so that lone rays meet the
+    // lattice, and miss it after a first lane that met it, must come out as without fans.
+    let backend = backend_by_name("embree").unwrap();
+    let (mut meets, mut misses_after_a_hit) = (0, 0);
+    for y in [7, 21] {
+        for x in 0..80 {
+            let crop = format!("image.crop=[{x},{y},17,1]");
+            let s = lattice(&["group.lattice.velocity=[-0.5,0,0]", &crop]);
+            let frame = render_world(&s, &World::build(&s, backend.as_ref()).unwrap()).0;
+            let (first, lone) = (frame.get(0, 0).alpha > 0.0, frame.get(16, 0).alpha > 0.0);
+            meets += u32::from(lone);
+            misses_after_a_hit += u32::from(first && !lone);
+            same_with_and_without_fans(&s, true);
+        }
+    }
+    assert!(
+        meets > 10 && misses_after_a_hit > 10,
+        "{meets}, {misses_after_a_hit}"
+    );
+}
+
+#[test]
 fn moving_camera_samples_and_crop() {
     for sets in [
         &[

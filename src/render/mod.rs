@@ -19,7 +19,7 @@ pub use frame::{Frame, PixelValue, CHANNELS};
 pub use group_tree::{world_box, GroupTree, SlicedGroupTree};
 pub use light_tree::{reach_box, LightTree};
 pub use screen_cull::ScreenCull;
-pub use world::{SurfaceHit, World, WorldOptions, GROUP_TREE_MIN};
+pub use world::{PrimaryHits, SurfaceHit, World, WorldOptions, GROUP_TREE_MIN};
 
 use crate::accel::Backend;
 use crate::scene::Scene;

@@ -6,7 +6,7 @@ use super::frame::PixelValue;
 use super::sampler::sample_offset;
 use super::screen_cull::ScreenCull;
 use super::shade::Shader;
-use super::world::{SurfaceHit, World};
+use super::world::{PrimaryHits, SurfaceHit, World};
 use super::{Passes, TILE};
 use crate::scene::Scene;
 use crate::spacetime::NullRay;
@@ -118,8 +118,7 @@ impl TilePixels {
 pub struct TileScratch {
     pixels: TilePixels,
     px: Vec<(f64, f64)>,
-    rays: Vec<NullRay>,
-    hits: Vec<Option<SurfaceHit>>,
+    primary: PrimaryHits,
 }
 
 /// Trace (without shading) every sample's primary rays of one tile; returns the primary rays
@@ -135,17 +134,15 @@ pub fn trace_tile(
     let TileScratch {
         pixels: t,
         px,
-        rays,
-        hits,
+        primary,
     } = scratch;
     t.fill(scene, cam, cull, x0, y0);
     let n = scene.image.samples;
-    hits.resize(t.live_coords.len(), None);
     let mut found = 0;
     for s in 0..n {
         image_points(&t.live_coords, t.offset, Some((s, n)), px);
-        world.primary_hits(cam, px, rays, hits);
-        found += hits.iter().filter(|h| h.is_some()).count() as u64;
+        world.primary_hits(cam, px, primary);
+        found += (0..primary.len()).filter(|&i| primary.is_hit(i)).count() as u64;
     }
     (n as u64 * t.total as u64, found)
 }
@@ -155,18 +152,15 @@ pub fn trace_tile(
 fn shade_hits(
     shader: &Shader,
     world: &World,
-    rays: &[NullRay],
-    hits: &[Option<SurfaceHit>],
+    primary: &PrimaryHits,
     background: DVec3,
 ) -> Vec<DVec3> {
     // One entry per light and hit (None where there is no shadow ray), hit-major.
     let lights = shader.light_count();
-    let mut shadows = Vec::with_capacity(lights * hits.len());
-    let lits: Vec<_> = rays
-        .iter()
-        .zip(hits)
-        .map(|(r, h)| match h {
-            Some(h) => Some(shader.prepare(r, h, &mut shadows)),
+    let mut shadows = Vec::with_capacity(lights * primary.len());
+    let lits: Vec<_> = (0..primary.len())
+        .map(|i| match primary.hit(i) {
+            Some(h) => Some(shader.prepare(&primary.ray(i), &h, &mut shadows)),
             None => {
                 shadows.extend((0..lights).map(|_| None));
                 None
@@ -227,8 +221,7 @@ pub fn render_tile(
     let TileScratch {
         pixels: t,
         px,
-        rays,
-        hits,
+        primary,
     } = scratch;
     t.fill(scene, cam, cull, x0, y0);
     let (offset, live, live_coords) = (t.offset, &t.live, &t.live_coords);
@@ -243,8 +236,7 @@ pub fn render_tile(
     }
     let mut covered = vec![0u32; coords.len()];
     let mut aov: Vec<Option<(NullRay, SurfaceHit)>> = vec![None; coords.len()];
-    hits.resize(live.len(), None);
-    let mut primary = 0u64;
+    let mut traced = 0u64;
     // With one sample the pixel centre serves both colour and passes; with more, an extra
     // centre ray gives crisp passes (ids, lookback) that compositors expect. Colour alone needs
     // neither.
@@ -258,21 +250,20 @@ pub fn render_tile(
         let centre = s == n;
         let sample = if centre { None } else { Some((s, n)) };
         image_points(live_coords, offset, sample, px);
-        primary += coords.len() as u64;
-        world.primary_hits(cam, px, rays, hits);
+        traced += coords.len() as u64;
+        world.primary_hits(cam, px, primary);
         let colors = if centre {
             Vec::new()
         } else {
-            shade_hits(&shader, world, rays, hits, scene.image.background)
+            shade_hits(&shader, world, primary, scene.image.background)
         };
-        for (j, (&k, hit)) in live.iter().zip(hits.iter()).enumerate() {
-            let r = &rays[j];
+        for (j, &k) in live.iter().enumerate() {
             if !centre {
-                covered[k] += u32::from(hit.is_some());
+                covered[k] += u32::from(primary.is_hit(j));
                 sum[k] += colors[j];
             }
             if Some(s) == aov_sample {
-                aov[k] = hit.map(|hh| (*r, hh));
+                aov[k] = primary.hit(j).map(|hh| (primary.ray(j), hh));
             }
         }
     }
@@ -309,7 +300,7 @@ pub fn render_tile(
         .collect();
     TileResult {
         pixels,
-        primary_rays: primary,
+        primary_rays: traced,
         nonfinite,
     }
 }

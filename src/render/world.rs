@@ -18,6 +18,7 @@ use crate::accel::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, Part, PACKET};
 use crate::scene::Scene;
 use crate::spacetime::{Boost, NullRay, Velocity};
+pub use fans::PrimaryHits;
 use glam::DVec3;
 use std::sync::{Arc, OnceLock};
 
