@@ -184,6 +184,7 @@ const INACTIVE: Ray = Ray {
     dir: DVec3::X,
     tmin: 1.0,
     tmax: 0.0,
+    len: 1.0,
 };
 
 /// A ray boosted into a group's rest frame and rebased to the near side of the group's bounds.
@@ -385,6 +386,8 @@ impl World {
                 dir,
                 tmin: tmin - shift,
                 tmax: tmax - shift,
+                // |dir| is s (`Boost::null_dir`).
+                len: s,
             },
             shift,
             s,

@@ -22,12 +22,7 @@ fn build(backend: &dyn Backend, prims: Vec<Primitive>) -> Box<dyn Accelerator> {
 }
 
 fn ray(o: DVec3, d: DVec3) -> Ray {
-    Ray {
-        origin: o,
-        dir: d,
-        tmin: 0.0,
-        tmax: f64::INFINITY,
-    }
+    Ray::new(o, d, 0.0, f64::INFINITY)
 }
 
 fn one(a: &dyn Accelerator, r: Ray) -> Option<Hit> {

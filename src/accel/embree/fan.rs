@@ -78,7 +78,8 @@ macro_rules! fan_packet {
                     } else {
                         fan.to_rest.null_dir_lanes(look)
                     };
-                    let (org, du, l, tnear) = lane_geometry(o, dir, splat(0.0), pullback);
+                    // |dir| is s (`Ray::len`).
+                    let (org, du, tnear) = lane_geometry(o, dir, s, splat(0.0), pullback);
                     let f32s = |x: F4, col: &mut [f32; N]| {
                         x.store_f32((&mut col[c..c + 4]).try_into().expect("four lanes"))
                     };
@@ -97,7 +98,7 @@ macro_rules! fan_packet {
                         f64s(dir[k], &mut out.dir[k]);
                     }
                     f64s(s, &mut out.s);
-                    len[c..c + 4].copy_from_slice(&l.store());
+                    len[c..c + 4].copy_from_slice(&s.store());
                 }
                 // The rest-frame rays as `World::rest_ray` makes them (shifted by 0 along
                 // themselves), for the exact tests in the callbacks and the hits' read-back.
@@ -109,6 +110,7 @@ macro_rules! fan_packet {
                         dir,
                         tmin: 0.0,
                         tmax: f64::INFINITY,
+                        len: out.s[first + i],
                     }
                 });
                 let mut lanes = Lanes::<N>::new(&rays[..n]);

@@ -116,11 +116,18 @@ struct EmbreeRay {
 
 /// A ray as it goes into Embree's f32 packet, before the cast, written once for one ray or
 /// several (`Real`) so that a fan's rays are `embree_ray`'s to the bit: from the origin `o`
-/// (relative to the scene's centre) and direction `d`, the origin pulled back by `pullback`
-/// along the unit direction, the unit direction, |d|, and tnear for the caller's `tmin`.
+/// (relative to the scene's centre) and direction `d` of length `len` (`Ray::len`), the
+/// origin pulled back by `pullback` along the unit direction, the unit direction and tnear for
+/// the caller's `tmin`. Embree's t is then t · len + pullback whatever len is, so a len some
+/// ulps from |d| (as a boost's lookback factor is) changes nothing but rounding.
 #[inline(always)]
-fn lane_geometry<R: Real>(o: [R; 3], d: [R; 3], tmin: R, pullback: R) -> ([R; 3], [R; 3], R, R) {
-    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+fn lane_geometry<R: Real>(
+    o: [R; 3],
+    d: [R; 3],
+    len: R,
+    tmin: R,
+    pullback: R,
+) -> ([R; 3], [R; 3], R) {
     // One division, not three: the f32 cast rounds far more than this.
     let inv = R::splat(1.0) / len;
     let du = [d[0] * inv, d[1] * inv, d[2] * inv];
@@ -130,7 +137,7 @@ fn lane_geometry<R: Real>(o: [R; 3], d: [R; 3], tmin: R, pullback: R) -> ([R; 3]
         o[2] - pullback * du[2],
     ];
     let tnear = (tmin * len + pullback).max(R::splat(0.0));
-    (org, du, len, tnear)
+    (org, du, tnear)
 }
 
 impl EmbreeAccel {
@@ -140,9 +147,9 @@ impl EmbreeAccel {
             return EmbreeRay::default();
         }
         let o = r.origin - self.scene.center;
-        let d = r.dir;
-        let (o, du, len, tnear) =
-            lane_geometry([o.x, o.y, o.z], [d.x, d.y, d.z], r.tmin, self.pullback);
+        let (d, len) = (r.dir, r.len);
+        let (o, du, tnear) =
+            lane_geometry([o.x, o.y, o.z], [d.x, d.y, d.z], len, r.tmin, self.pullback);
         let tfar = r.tmax * len + self.pullback;
         EmbreeRay {
             org: o.map(|x| x as f32),
