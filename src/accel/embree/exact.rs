@@ -79,23 +79,21 @@ pub(super) struct ExactContext<'a> {
     rays: &'a [Ray],
     /// Embree coordinates are the caller's minus this.
     center: DVec3,
-    /// Embree's t = t · len + pullback (the caller's ray was pulled back and normalised).
+    /// Embree's t = t · len + pullback (the caller's ray was pulled back and normalised;
+    /// `Ray::len`).
     pullback: f64,
-    len: &'a [f64],
     /// The exact t of the closest user-geometry hit so far in each lane (starts at tmax).
     best: &'a [Cell<f64>],
 }
 
 /// Per-lane storage of an `ExactContext` for up to N rays.
 pub(super) struct Lanes<const N: usize> {
-    pub len: [f64; N],
     pub best: [Cell<f64>; N],
 }
 
 impl<const N: usize> Lanes<N> {
     pub fn new(rays: &[Ray]) -> Self {
         Lanes {
-            len: [1.0; N],
             best: std::array::from_fn(|i| Cell::new(rays.get(i).map_or(f64::INFINITY, |r| r.tmax))),
         }
     }
@@ -120,7 +118,6 @@ impl<'a> ExactContext<'a> {
             rays: &rays[..rays.len().min(N)],
             center,
             pullback,
-            len: &lanes.len,
             best: &lanes.best,
         }
     }
@@ -261,7 +258,7 @@ unsafe fn embree_t(
     if ctx.rays.is_empty() {
         return Some((t as f32).clamp(tmin as f32, tmax as f32));
     }
-    let te = (t * ctx.len[i] + ctx.pullback) as f32;
+    let te = (t * ctx.rays[i].len + ctx.pullback) as f32;
     // Embree's tfar may have been lowered by one of its own primitives.
     let tfar = unsafe { *base.add(TFAR * n + i) };
     (te <= tfar).then(|| {

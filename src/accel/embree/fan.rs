@@ -59,7 +59,6 @@ macro_rules! fan_packet {
                 const { assert!(N % 4 == 0 && N <= PACKET) };
                 let n = fan.n.saturating_sub(first).min(N);
                 let mut rh = $RayHitN::default();
-                let mut len = [1.0; N];
                 let splat = F4::splat;
                 let o = fan.origin - self.scene.center;
                 let (o, pullback) = ([splat(o.x), splat(o.y), splat(o.z)], splat(self.pullback));
@@ -98,7 +97,6 @@ macro_rules! fan_packet {
                         f64s(dir[k], &mut out.dir[k]);
                     }
                     f64s(s, &mut out.s);
-                    len[c..c + 4].copy_from_slice(&s.store());
                 }
                 // The rest-frame rays as `World::rest_ray` makes them (shifted by 0 along
                 // themselves), for the exact tests in the callbacks and the hits' read-back.
@@ -113,8 +111,7 @@ macro_rules! fan_packet {
                         len: out.s[first + i],
                     }
                 });
-                let mut lanes = Lanes::<N>::new(&rays[..n]);
-                lanes.len = len;
+                let lanes = Lanes::<N>::new(&rays[..n]);
                 let mut valid = Valid([0i32; N]);
                 for i in 0..n {
                     rh.ray.tfar[i] = f32::INFINITY;
@@ -131,7 +128,7 @@ macro_rules! fan_packet {
                         .then(|| {
                             self.to_hit(
                                 ray,
-                                lanes.len[i],
+                                ray.len,
                                 rh.ray.tfar[i],
                                 rh.hit.geomID[i],
                                 rh.hit.primID[i],

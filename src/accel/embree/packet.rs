@@ -49,10 +49,9 @@ macro_rules! packet_fns {
             pub(super) fn $isect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
                 let mut rh = $RayHitN::default();
                 let mut valid = Valid([0i32; $n]);
-                let mut lanes = Lanes::<$n>::new(rays);
+                let lanes = Lanes::<$n>::new(rays);
                 for (i, r) in rays.iter().enumerate() {
                     let e = self.embree_ray(r);
-                    lanes.len[i] = e.len;
                     fill_lane(&mut rh.ray, i, &e, &mut valid.0);
                     rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                 }
@@ -62,7 +61,7 @@ macro_rules! packet_fns {
                     hits[i] = if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID {
                         self.to_hit(
                             r,
-                            lanes.len[i],
+                            r.len,
                             rh.ray.tfar[i],
                             rh.hit.geomID[i],
                             rh.hit.primID[i],
@@ -77,10 +76,9 @@ macro_rules! packet_fns {
             pub(super) fn $occl(&self, rays: &[Ray], out: &mut [bool]) {
                 let mut ray = $RayN::default();
                 let mut valid = Valid([0i32; $n]);
-                let mut lanes = Lanes::<$n>::new(rays);
+                let lanes = Lanes::<$n>::new(rays);
                 for (i, r) in rays.iter().enumerate() {
                     let e = self.embree_ray(r);
-                    lanes.len[i] = e.len;
                     fill_lane(&mut ray, i, &e, &mut valid.0);
                 }
                 let mut ctx = self.context(true, rays, &lanes);
@@ -189,8 +187,7 @@ impl EmbreeAccel {
             },
         };
         let rays = std::slice::from_ref(r);
-        let mut lanes = Lanes::<1>::new(rays);
-        lanes.len[0] = e.len;
+        let lanes = Lanes::<1>::new(rays);
         let mut ctx = self.context(false, rays, &lanes);
         unsafe { rtcIntersect1(self.scene.raw, ctx.raw(), &mut rh) };
         if rh.hit.geomID == RTC_INVALID_GEOMETRY_ID {
@@ -213,8 +210,7 @@ impl EmbreeAccel {
         }
         let mut ray = single(&e);
         let rays = std::slice::from_ref(r);
-        let mut lanes = Lanes::<1>::new(rays);
-        lanes.len[0] = e.len;
+        let lanes = Lanes::<1>::new(rays);
         let mut ctx = self.context(false, rays, &lanes);
         unsafe { rtcOccluded1(self.scene.raw, ctx.raw(), &mut ray) };
         ray.tfar == f32::NEG_INFINITY
