@@ -99,6 +99,11 @@ impl CameraRays {
         self.focal * c.forward + u * c.right + v * c.up
     }
 
+    /// The full image's width and height in pixels.
+    pub fn image_size(&self) -> (f64, f64) {
+        (self.width, self.height)
+    }
+
     /// A pinhole camera's focal length in pixels (0 for other projections): image points L
     /// pixels apart look in directions at most L / focal radians apart.
     pub fn focal_px(&self) -> f64 {

@@ -118,6 +118,19 @@ impl ScreenCull {
             cones.push(widened(c.axis, c.half_angle, block_radius));
             tile_cones.push(widened(c.axis, c.half_angle, tile_radius));
         }
+        // A cull that keeps every block is all cost (4% of a primary ray where the lattice
+        // fills the view). A cone narrower than a hemisphere is convex on the sphere, and a
+        // pinhole's image is the convex hull of its corners' directions (lines on the image
+        // plane look along great circles), so a cone that holds the four corners holds the
+        // centre of every block.
+        let (w, h) = cam.image_size();
+        let corners = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)];
+        let fills_view = |&cone: &(DVec3, f64)| {
+            cone.1 > 0.0 && corners.iter().all(|&(x, y)| seen_from(&[cone], cam, x, y))
+        };
+        if cones.iter().any(fills_view) {
+            return None;
+        }
         Some(ScreenCull { cones, tile_cones })
     }
 

@@ -44,14 +44,21 @@ fn image_points(
     px: &mut Vec<(f64, f64)>,
 ) {
     px.clear();
-    px.extend(coords.iter().map(|&(fx, fy)| {
-        let (x, y) = (fx + offset.0, fy + offset.1);
-        let (ox, oy) = match sample {
-            Some((s, n)) => sample_offset(x, y, s, n),
-            None => (0.5, 0.5),
-        };
-        (x as f64 + ox, y as f64 + oy)
-    }));
+    let (dx, dy) = (offset.0 as f64, offset.1 as f64);
+    match sample {
+        Some((s, n)) if n > 1 => px.extend(coords.iter().map(|&(fx, fy)| {
+            let (x, y) = (fx + offset.0, fy + offset.1);
+            let (ox, oy) = sample_offset(x, y, s, n);
+            (x as f64 + ox, y as f64 + oy)
+        })),
+        // One sample per pixel is its centre (`sample_offset`), in a loop without the test
+        // per pixel, which the compiler vectorises.
+        _ => px.extend(
+            coords
+                .iter()
+                .map(|&(fx, fy)| (fx as f64 + dx + 0.5, fy as f64 + dy + 0.5)),
+        ),
+    }
 }
 
 /// The primary rays of `coords` (see `image_points`).
@@ -142,7 +149,7 @@ pub fn trace_tile(
     for s in 0..n {
         image_points(&t.live_coords, t.offset, Some((s, n)), px);
         world.primary_hits(cam, px, primary);
-        found += (0..primary.len()).filter(|&i| primary.is_hit(i)).count() as u64;
+        found += primary.hit_count() as u64;
     }
     (n as u64 * t.total as u64, found)
 }

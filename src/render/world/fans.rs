@@ -140,6 +140,15 @@ impl PrimaryHits {
         NullRay::new(event, DVec3::new(f.look[0][j], f.look[1][j], f.look[2][j]))
     }
 
+    /// How many of the primary rays meet anything.
+    pub fn hit_count(&self) -> usize {
+        if self.fan.is_none() {
+            return self.hits.iter().filter(|h| h.is_some()).count();
+        }
+        let lanes = self.fans.iter().flat_map(|f| &f.prim).take(self.len);
+        lanes.filter(|&&p| p != NO_HIT).count()
+    }
+
     /// Whether primary ray i meets anything.
     #[inline]
     pub fn is_hit(&self, i: usize) -> bool {
