@@ -11,6 +11,9 @@ pub struct Boost {
     e_pos: f64,
     e_neg: f64,
     identity: bool,
+    /// `Some((k, σ))` where the axis is σ times the k-th unit vector (motion along x, y or z,
+    /// as in most scenes): `null_dir` then skips the products with the axis' zeros.
+    aligned: Option<(usize, f64)>,
 }
 
 impl Boost {
@@ -19,6 +22,7 @@ impl Boost {
         e_pos: 1.0,
         e_neg: 1.0,
         identity: true,
+        aligned: None,
     };
 
     /// The boost from a frame into the frame that moves at `v` relative to it
@@ -28,11 +32,13 @@ impl Boost {
             return Self::IDENTITY;
         }
         let phi = v.rapidity();
+        let axis = v.direction();
         Boost {
-            axis: v.direction(),
+            axis,
             e_pos: phi.exp(),
             e_neg: (-phi).exp(),
             identity: false,
+            aligned: aligned(axis),
         }
     }
 
@@ -50,6 +56,7 @@ impl Boost {
             e_pos: self.e_neg,
             e_neg: self.e_pos,
             identity: false,
+            aligned: self.aligned,
         }
     }
 
@@ -82,6 +89,17 @@ impl Boost {
     /// scalar one to the bit.
     #[inline(always)]
     pub(crate) fn null_dir_lanes<R: Real>(&self, a: [R; 3]) -> ([R; 3], R) {
+        if let Some((k, sigma)) = self.aligned {
+            // The axis is σ e_k: a∥ = σ a_k, a⊥ = a but for its k-th component (zero), and
+            // d' = a⊥ + par σ e_k. The same numbers as below but for the signs of zeros.
+            let ap = R::splat(sigma) * a[k];
+            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+            let p2 = a[i] * a[i] + a[j] * a[j];
+            let (s, par) = self.along(ap, p2);
+            let mut d = a;
+            d[k] = par * R::splat(sigma);
+            return (d, s);
+        }
         let axis = [
             R::splat(self.axis.x),
             R::splat(self.axis.y),
@@ -94,8 +112,21 @@ impl Boost {
             a[2] - ap * axis[2],
         ];
         let p2 = perp[0] * perp[0] + perp[1] * perp[1] + perp[2] * perp[2];
-        // 1 ± a∥ without cancellation (|a| = 1): the sum of magnitudes where it is large, else
-        // |a⊥|² over it (1 + |a∥| is 1 + a∥ for a∥ ≥ 0 and 1 − a∥ for a∥ ≤ 0, exactly).
+        let (s, par) = self.along(ap, p2);
+        (
+            [
+                perp[0] + par * axis[0],
+                perp[1] + par * axis[1],
+                perp[2] + par * axis[2],
+            ],
+            s,
+        )
+    }
+
+    /// For a unit direction with a∥ = `ap` along the axis and |a⊥|² = `p2` across it: the
+    /// boosted null vector's s = −t' and its component along the axis.
+    #[inline(always)]
+    fn along<R: Real>(&self, ap: R, p2: R) -> (R, R) {
         let one = R::splat(1.0);
         let big = one + ap.abs();
         let small = p2 / big;
@@ -107,14 +138,7 @@ impl Boost {
         let half = R::splat(0.5);
         let s = half * (up + wp);
         let par = half * (up - wp);
-        (
-            [
-                perp[0] + par * axis[0],
-                perp[1] + par * axis[1],
-                perp[2] + par * axis[2],
-            ],
-            s,
-        )
+        (s, par)
     }
 
     /// Whether this boost is the identity (a frame at rest relative to the one it starts from).
@@ -130,4 +154,12 @@ impl Boost {
         let (d, s) = self.null_dir(a);
         (d / s, s)
     }
+}
+
+/// `Some((k, σ))` where `axis` is σ e_k exactly.
+fn aligned(axis: DVec3) -> Option<(usize, f64)> {
+    let a = axis.to_array();
+    let k = (0..3).find(|&k| a[k].abs() == 1.0)?;
+    let others_zero = (0..3).all(|j| j == k || a[j] == 0.0);
+    others_zero.then_some((k, a[k]))
 }
