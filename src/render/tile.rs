@@ -85,6 +85,10 @@ struct TilePixels {
     offset: (u32, u32),
     live: Vec<usize>,
     live_coords: Vec<(u32, u32)>,
+    /// A whole tile's pixels at (0, 0) (`tile_pixels`), made on first use.
+    template: Vec<(u32, u32)>,
+    /// Whether `live` is every index of a whole tile (kept from one whole tile to the next).
+    all_live: bool,
 }
 
 impl TilePixels {
@@ -99,10 +103,14 @@ impl TilePixels {
     ) {
         let (w, h) = scene.image.frame_size();
         self.offset = scene.image.frame_offset();
+        let (ox, oy) = self.offset;
+        if cull.is_none() && x0 + TILE <= w && y0 + TILE <= h {
+            return self.fill_whole(x0, y0);
+        }
         self.total = 0;
         self.live.clear();
         self.live_coords.clear();
-        let (ox, oy) = self.offset;
+        self.all_live = false;
         // Tiles start at multiples of TILE in the frame, so a tile's square is its pixels'.
         let tile = cull.is_none_or(|c| c.tile_visible(cam, x0 + ox, y0 + oy));
         for (bx, by, bw, bh) in blocks(x0, y0, w, h) {
@@ -115,6 +123,24 @@ impl TilePixels {
             }
             self.total += n;
         }
+    }
+
+    /// A whole tile with every pixel kept (no cull): the first whole tile's pixels moved to
+    /// (x0, y0), in one pass without the blocks' bookkeeping.
+    fn fill_whole(&mut self, x0: u32, y0: u32) {
+        const N: usize = (TILE * TILE) as usize;
+        if !self.all_live {
+            self.live.clear();
+            self.live.extend(0..N);
+            self.all_live = true;
+        }
+        if self.template.is_empty() {
+            self.template = tile_pixels(0, 0, TILE, TILE);
+        }
+        self.total = N;
+        self.live_coords.clear();
+        let shifted = self.template.iter().map(|&(x, y)| (x + x0, y + y0));
+        self.live_coords.extend(shifted);
     }
 }
 

@@ -145,8 +145,15 @@ impl PrimaryHits {
         if self.fan.is_none() {
             return self.hits.iter().filter(|h| h.is_some()).count();
         }
-        let lanes = self.fans.iter().flat_map(|f| &f.prim).take(self.len);
-        lanes.filter(|&&p| p != NO_HIT).count()
+        // Packet by packet (a flat iterator over the lanes cost ~1% of a primary ray).
+        let (whole, rest) = (self.len / PACKET, self.len % PACKET);
+        let count = |prim: &[u32]| {
+            prim.iter()
+                .map(|&p| usize::from(p != NO_HIT))
+                .sum::<usize>()
+        };
+        let full: usize = self.fans[..whole].iter().map(|f| count(&f.prim)).sum();
+        full + self.fans.get(whole).map_or(0, |f| count(&f.prim[..rest]))
     }
 
     /// Whether primary ray i meets anything.
