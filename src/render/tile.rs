@@ -154,6 +154,20 @@ pub struct TileScratch {
     primary: PrimaryHits,
 }
 
+impl TileScratch {
+    /// The tile at (x0, y0): its pixels, and the buffers for its image points and hits.
+    fn tile(
+        &mut self,
+        scene: &Scene,
+        cam: &CameraRays,
+        cull: Option<&ScreenCull>,
+        (x0, y0): (u32, u32),
+    ) -> (&TilePixels, &mut Vec<(f64, f64)>, &mut PrimaryHits) {
+        self.pixels.fill(scene, cam, cull, x0, y0);
+        (&self.pixels, &mut self.px, &mut self.primary)
+    }
+}
+
 /// Trace (without shading) every sample's primary rays of one tile; returns the primary rays
 /// resolved (culled ones as background included) and the hits.
 pub fn trace_tile(
@@ -164,12 +178,7 @@ pub fn trace_tile(
     (x0, y0): (u32, u32),
     scratch: &mut TileScratch,
 ) -> (u64, u64) {
-    let TileScratch {
-        pixels: t,
-        px,
-        primary,
-    } = scratch;
-    t.fill(scene, cam, cull, x0, y0);
+    let (t, px, primary) = scratch.tile(scene, cam, cull, (x0, y0));
     let n = scene.image.samples;
     let mut found = 0;
     for s in 0..n {
@@ -251,12 +260,7 @@ pub fn render_tile(
     passes: Passes,
     scratch: &mut TileScratch,
 ) -> TileResult {
-    let TileScratch {
-        pixels: t,
-        px,
-        primary,
-    } = scratch;
-    t.fill(scene, cam, cull, x0, y0);
+    let (t, px, primary) = scratch.tile(scene, cam, cull, (x0, y0));
     let (offset, live, live_coords) = (t.offset, &t.live, &t.live_coords);
     let (w, h) = scene.image.frame_size();
     let coords = tile_pixels(x0, y0, w, h);
