@@ -3,13 +3,14 @@
 //! the boost and the lanes' image points, then traced as `intersect16` (or, where the CPU has
 //! no native 16-wide packets, as `intersect8` on each half) traces them.
 //!
-//! Made one by one, a primary ray runs three chains of a square root and divisions (the
-//! camera's unit direction, the boost, the packet's unit direction) and goes through three
-//! layouts (the world-frame ray, the rest-frame ray, Embree's lane), at ~25 ns per ray on the
-//! paper's lattice against bare Embree's ~40. Here the same arithmetic (`Pinhole::look`,
-//! `Boost::null_dir_lanes`, `lane_geometry`, each written once for one lane or four) runs on
-//! columns, so every lane's values are the scalar path's to the bit and images do not depend
-//! on which path made them (tests/fused_primary.rs).
+//! Made one by one, a primary ray runs a chain of square roots and divisions (the camera's
+//! unit direction, the boost, the packet's unit direction) and goes through three layouts (the
+//! world-frame ray, the rest-frame ray, Embree's lane): ~25 ns of the layer's own per ray on the
+//! paper's lattice, before the fans, against bare Embree's ~40. Here the same arithmetic
+//! (`Pinhole::look`, `Boost::null_dir_lanes`, `lane_geometry`, each written once for one lane or
+//! four) runs on columns, so every lane's values are the scalar path's to the bit and images do
+//! not depend on which path made them (tests/fused_primary.rs); the columns (`FanHits`) are
+//! what the renderer reads the rays and hits from (`render::PrimaryHits`).
 
 use super::exact::Lanes;
 use super::f64x4::F4;
