@@ -66,7 +66,6 @@ impl BareRay {
             dir: self.dir,
             tnear: 0.0,
             tfar: f32::INFINITY,
-            len: 1.0,
             active: true,
         }
     }

@@ -129,7 +129,6 @@ macro_rules! fan_packet {
                         .then(|| {
                             self.to_hit(
                                 ray,
-                                ray.len,
                                 rh.ray.tfar[i],
                                 rh.hit.geomID[i],
                                 rh.hit.primID[i],

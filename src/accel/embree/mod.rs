@@ -109,8 +109,6 @@ struct EmbreeRay {
     dir: [f32; 3],
     tnear: f32,
     tfar: f32,
-    /// |d| of the original ray: Embree's t = |d| · t − ... see `to_t`.
-    len: f64,
     active: bool,
 }
 
@@ -160,23 +158,16 @@ impl EmbreeAccel {
             } else {
                 f32::INFINITY
             },
-            len,
             active: true,
         }
     }
 
     /// Embree's hit back in the caller's units: exact already for user geometry (`exact_t`,
-    /// from the context), else refined in f64 on the primitive that was hit.
+    /// from the context), else refined in f64 on the primitive that was hit (Embree's t is
+    /// t · `r.len` + pullback).
     #[inline(always)]
-    fn to_hit(
-        &self,
-        r: &Ray,
-        len: f64,
-        t_embree: f32,
-        geom: u32,
-        prim: u32,
-        exact_t: f64,
-    ) -> Option<Hit> {
+    fn to_hit(&self, r: &Ray, t_embree: f32, geom: u32, prim: u32, exact_t: f64) -> Option<Hit> {
+        let len = r.len;
         let (prim, exact) = self.scene.prim(geom, prim)?;
         if exact {
             return (exact_t > r.tmin && exact_t < r.tmax).then_some(Hit { t: exact_t, prim });

@@ -61,7 +61,6 @@ macro_rules! packet_fns {
                     hits[i] = if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID {
                         self.to_hit(
                             r,
-                            r.len,
                             rh.ray.tfar[i],
                             rh.hit.geomID[i],
                             rh.hit.primID[i],
@@ -193,14 +192,7 @@ impl EmbreeAccel {
         if rh.hit.geomID == RTC_INVALID_GEOMETRY_ID {
             return None;
         }
-        self.to_hit(
-            r,
-            e.len,
-            rh.ray.tfar,
-            rh.hit.geomID,
-            rh.hit.primID,
-            ctx.exact_t(0),
-        )
+        self.to_hit(r, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, ctx.exact_t(0))
     }
 
     pub(super) fn occluded1(&self, r: &Ray) -> bool {

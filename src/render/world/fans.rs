@@ -68,9 +68,11 @@ impl World {
             }
             // Declined: made one by one, into the columns. The one group's primary rays are
             // not shifted along themselves (no clip), so the hits are read back the same.
-            let (mut rays, mut found) = (Vec::with_capacity(PACKET), [None; PACKET]);
-            self.one_by_one(cam, ps, &mut rays, &mut found[..ps.len()]);
-            for (i, (r, h)) in rays.iter().zip(&found).enumerate() {
+            // (Its buffer for rays made one by one is free in this mode.)
+            let mut found = [None; PACKET];
+            out.rays.clear();
+            self.one_by_one(cam, ps, &mut out.rays, &mut found[..ps.len()]);
+            for (i, (r, h)) in out.rays.iter().zip(&found).enumerate() {
                 for k in 0..3 {
                     hits.look[k][i] = r.dir[k];
                 }
