@@ -14,6 +14,7 @@ use crate::geometry::{capsule_hit, cuboid_hit, Aabb};
 use embree_sys::*;
 use glam::DVec3;
 use std::cell::Cell;
+use std::sync::OnceLock;
 
 /// A primitive Embree traces as user geometry, relative to the Embree scene's centre.
 pub trait Shape: Copy {
@@ -99,6 +100,26 @@ impl<const N: usize> Lanes<N> {
     }
 }
 
+/// Embree's intersect context as `rtcInitIntersectContext` makes it, coherent or not: made
+/// once and copied. Made per packet, the C function's 4-byte stores were read back 8 bytes at a
+/// time as the struct was moved (a store-forwarding stall per packet).
+fn initial_context(coherent: bool) -> RTCIntersectContext {
+    static MADE: OnceLock<[RTCIntersectContext; 2]> = OnceLock::new();
+    let [incoherent, coherent_one] = *MADE.get_or_init(|| {
+        let mut rtc = RTCIntersectContext::default();
+        // SAFETY: initialises the plain struct in place.
+        unsafe { rtcInitIntersectContext(&mut rtc) };
+        let mut c = rtc;
+        c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        [rtc, c]
+    });
+    if coherent {
+        coherent_one
+    } else {
+        incoherent
+    }
+}
+
 impl<'a> ExactContext<'a> {
     pub fn new<const N: usize>(
         coherent: bool,
@@ -107,14 +128,8 @@ impl<'a> ExactContext<'a> {
         center: DVec3,
         pullback: f64,
     ) -> Self {
-        let mut rtc = RTCIntersectContext::default();
-        // SAFETY: initialises the plain struct in place.
-        unsafe { rtcInitIntersectContext(&mut rtc) };
-        if coherent {
-            rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        }
         ExactContext {
-            rtc,
+            rtc: initial_context(coherent),
             rays: &rays[..rays.len().min(N)],
             center,
             pullback,
