@@ -14,12 +14,14 @@ use super::group_tree::SlicedGroupTree;
 use super::light_tree::LightTree;
 
 mod fans;
+mod moving_bounds;
 use crate::accel::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, Part, PACKET};
 use crate::scene::Scene;
 use crate::spacetime::{Boost, NullRay, Velocity};
 pub use fans::PrimaryHits;
 use glam::DVec3;
+use moving_bounds::MovingBounds;
 use std::sync::{Arc, OnceLock};
 
 /// From this many groups on, rays find their groups through the group tree.
@@ -80,6 +82,8 @@ pub struct GroupRt {
     pub accel: Option<Box<dyn Accelerator>>,
     /// Offset for spawning secondary rays off surfaces, in rest-frame length.
     pub epsilon: f64,
+    /// The bounds as they move through the world frame: a test before the boost.
+    moving: MovingBounds,
 }
 
 impl GroupRt {
@@ -272,6 +276,7 @@ impl World {
                 geometry,
                 accel,
                 epsilon: 1e-7 * bounds.diagonal().max(1e-3) + 1e-12 * bounds.max_abs(),
+                moving: MovingBounds::new(&bounds, &velocity, event.t),
             });
         }
         let (tree, primary_tree, light_trees) =
@@ -506,6 +511,9 @@ impl World {
     #[inline(always)]
     fn hit_before(&self, gi: usize, ray: &NullRay, tmin: f64, tmax: f64) -> Option<SurfaceHit> {
         let g = &self.groups[gi];
+        if !g.moving.may_meet(ray, tmin, tmax) {
+            return None;
+        }
         let rr = self.rest_ray(g, ray, tmin, tmax)?;
         let sh = Self::surface_hit(gi, &rr, g.intersect1(&rr.ray)?);
         (sh.lambda < tmax).then_some(sh)
@@ -585,8 +593,10 @@ impl World {
     /// Whether group gi has anything on the ray between lookback `tmin` and `tmax`.
     fn group_blocks(&self, gi: usize, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
         let g = &self.groups[gi];
-        self.rest_ray(g, ray, tmin, tmax)
-            .is_some_and(|rr| g.occluded1(&rr.ray))
+        g.moving.may_meet(ray, tmin, tmax)
+            && self
+                .rest_ray(g, ray, tmin, tmax)
+                .is_some_and(|rr| g.occluded1(&rr.ray))
     }
 
     /// Whether the shadow ray toward scene light `light` is blocked before lookback `tmax`.
