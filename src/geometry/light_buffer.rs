@@ -49,8 +49,7 @@ impl Face {
 /// Boxes around one point, for rays from it.
 pub struct LightBuffer {
     origin: DVec3,
-    /// The boxes (in the order the cells list them), their items, and their distances from
-    /// the origin.
+    /// The boxes nearest first (to the origin), their items, and their distances from it.
     boxes: Vec<Aabb>,
     items: Vec<u32>,
     near: Vec<f64>,
@@ -252,38 +251,7 @@ impl LightBuffer {
         }
         lb.start = start;
         lb.entries = entries;
-        lb.store_by_cell();
         lb
-    }
-
-    /// Renumber the boxes in the order the cells list them (each box where it is first listed,
-    /// cell by cell), so a cell's boxes lie together in memory: a shadow ray tests a cell's
-    /// boxes one after another, and the rays of a tile go to many slices' buffers, so nearest-
-    /// first storage had made nearly every box a cache miss. Each cell's list stays nearest
-    /// first.
-    fn store_by_cell(&mut self) {
-        const UNSEEN: u32 = u32::MAX;
-        let mut new_index = vec![UNSEEN; self.boxes.len()];
-        let mut order = Vec::with_capacity(self.boxes.len());
-        for &k in self.everywhere.iter().chain(&self.entries) {
-            if new_index[k as usize] == UNSEEN {
-                new_index[k as usize] = order.len() as u32;
-                order.push(k);
-            }
-        }
-        // Boxes no cell lists (on no face) after the others.
-        for k in 0..self.boxes.len() as u32 {
-            if new_index[k as usize] == UNSEEN {
-                new_index[k as usize] = order.len() as u32;
-                order.push(k);
-            }
-        }
-        self.boxes = order.iter().map(|&k| self.boxes[k as usize]).collect();
-        self.items = order.iter().map(|&k| self.items[k as usize]).collect();
-        self.near = order.iter().map(|&k| self.near[k as usize]).collect();
-        for k in self.everywhere.iter_mut().chain(self.entries.iter_mut()) {
-            *k = new_index[*k as usize];
-        }
     }
 
     /// How many boxes it holds.
