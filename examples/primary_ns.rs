@@ -9,7 +9,6 @@
 //! the fastest pass of as many as fit in the given seconds, in ns per pixel (wall time, so on
 //! two threads about half the one-thread figure). Every mode runs its tiles in parallel, as
 //! the bench does.
-use rayon::prelude::*;
 use rest_embree::accel::backend_by_name;
 use rest_embree::render::{render_world, trace_primary, World, WorldOptions};
 use std::time::Instant;
@@ -80,6 +79,7 @@ fn bare<'a>(scene: &'a rest_embree::scene::Scene, world: &'a World) -> Box<dyn F
         fail(&"bare Embree needs the lattice's one group on Embree")
     };
     Box::new(move || {
+        use rayon::prelude::*;
         let _: usize = tiles.par_iter().map(|t| accel.trace_bare(t)).sum();
     })
 }
