@@ -46,7 +46,8 @@ fn corner_distance(b: &Aabb, p: DVec3) -> f64 {
 pub struct WorldOptions {
     /// Merge groups with the same velocity into one rest-frame scene.
     pub merge_equal_velocities: bool,
-    /// Test rays against each group's rest-frame bounds first (and rebase them there).
+    /// Test rays against each group's bounds first: in the world frame, where they move, then
+    /// in the rest frame (and rebase them there).
     pub bounds_cull: bool,
     /// Use the kinetic group tree when there are many groups.
     pub group_tree: bool,
@@ -511,7 +512,7 @@ impl World {
     #[inline(always)]
     fn hit_before(&self, gi: usize, ray: &NullRay, tmin: f64, tmax: f64) -> Option<SurfaceHit> {
         let g = &self.groups[gi];
-        if !g.moving.may_meet(ray, tmin, tmax) {
+        if self.clip_rays && !g.moving.may_meet(ray, tmin, tmax) {
             return None;
         }
         let rr = self.rest_ray(g, ray, tmin, tmax)?;
@@ -593,7 +594,7 @@ impl World {
     /// Whether group gi has anything on the ray between lookback `tmin` and `tmax`.
     fn group_blocks(&self, gi: usize, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
         let g = &self.groups[gi];
-        g.moving.may_meet(ray, tmin, tmax)
+        (!self.clip_rays || g.moving.may_meet(ray, tmin, tmax))
             && self
                 .rest_ray(g, ray, tmin, tmax)
                 .is_some_and(|rr| g.occluded1(&rr.ray))
