@@ -1,6 +1,7 @@
 //! The fixed cases of `rest-embree bench`.
 
 use super::{Case, LazyCase};
+use crate::rng::Rng;
 use crate::scene::{load_str, SceneError};
 use std::fmt::Write as _;
 
@@ -32,20 +33,6 @@ fn sets(list: &[&str]) -> Vec<String> {
 }
 
 /// A small deterministic generator for the many-groups scenes.
-struct Rng(u64);
-impl Rng {
-    fn f(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.f()
-    }
-}
-
 /// `n` boxes in a cloud in front of the camera, each in its own group with its own velocity
 /// (|β| ≤ 0.8), or (`one_group`) all in one group at rest: the same geometry either way.
 pub fn many_groups(

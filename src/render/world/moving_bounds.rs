@@ -64,34 +64,8 @@ impl MovingBounds {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::Rng;
     use crate::spacetime::{Boost, Event};
-
-    /// Random numbers for the tests (xorshift).
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn range(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * self.next()
-        }
-        fn unit(&mut self) -> DVec3 {
-            loop {
-                let p = DVec3::new(
-                    self.range(-1.0, 1.0),
-                    self.range(-1.0, 1.0),
-                    self.range(-1.0, 1.0),
-                );
-                let l = p.length();
-                if l > 0.1 && l <= 1.0 {
-                    return p / l;
-                }
-            }
-        }
-    }
 
     /// Whether the ray boosted into the group's frame meets the rest-frame bounds in
     /// [tmin, tmax] of world lookback (as `World::rest_ray` tests it).
