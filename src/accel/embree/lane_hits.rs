@@ -225,22 +225,10 @@ mod tests {
     use super::*;
     use crate::accel::embree::exact::Shape;
 
-    /// A small deterministic generator (the tests' own; no dependency).
-    struct Rng(u64);
-    impl Rng {
-        fn f(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn range(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * self.f()
-        }
-        fn vec(&mut self, s: f64) -> DVec3 {
-            DVec3::new(self.range(-s, s), self.range(-s, s), self.range(-s, s))
-        }
+    use crate::rng::Rng;
+
+    fn vec(r: &mut Rng, s: f64) -> DVec3 {
+        DVec3::new(r.range(-s, s), r.range(-s, s), r.range(-s, s))
     }
 
     /// Every answer the several-ray test decides is the scalar test's, to the bit: rods along
@@ -254,7 +242,7 @@ mod tests {
         // them were decided here.
         let (mut inside, mut inside_decided) = (0, 0);
         for case in 0..4000 {
-            let a = rng.vec(2.0);
+            let a = vec(&mut rng, 2.0);
             let b = match case % 4 {
                 0 => a,
                 k => {
@@ -271,11 +259,12 @@ mod tests {
             let rays: Vec<(usize, DVec3, DVec3, f64, f64)> = (0..1 + case % MAX)
                 .map(|lane| {
                     let far = [1.0, 10.0, 1e3, 1e6][lane % 4];
-                    let target = a + (b - a) * rng.range(-0.2, 1.2) + rng.vec(prim.radius * 1.5);
+                    let target =
+                        a + (b - a) * rng.range(-0.2, 1.2) + vec(&mut rng, prim.radius * 1.5);
                     let o = match lane % 7 {
                         // From inside.
-                        0 => a + (b - a) * rng.f() + rng.vec(prim.radius * 0.5),
-                        _ => target + rng.vec(1.0).normalize() * far,
+                        0 => a + (b - a) * rng.f() + vec(&mut rng, prim.radius * 0.5),
+                        _ => target + vec(&mut rng, 1.0).normalize() * far,
                     };
                     let mut d = (target - o) * rng.range(0.1, 3.0);
                     if lane % 11 == 5 {
