@@ -38,7 +38,8 @@ pub struct BenchArgs {
     /// Smaller images and scenes: the whole suite in well under a minute.
     #[arg(long)]
     pub quick: bool,
-    /// Only the suite's cases whose name contains this text (repeatable).
+    /// Only this case of the suite, or where no case has this name, every case whose name
+    /// contains it (repeatable).
     #[arg(long = "case")]
     pub cases: Vec<String>,
     /// Override any value of SCENE, as for render.
@@ -148,18 +149,42 @@ fn set_threads(threads: Option<usize>) -> Result<(), String> {
     Ok(())
 }
 
+/// The cases `--case` asks for: for each text, the case of that name, or where no case has it,
+/// every case whose name contains it (so `lattice beta=0.9` is that case alone, `beta=0.9` also
+/// its variants and 0.99).
+fn pick_cases(all: Vec<bench::LazyCase>, texts: &[String]) -> Result<Vec<bench::LazyCase>, String> {
+    let names: Vec<String> = all.iter().map(|c| c.name.clone()).collect();
+    let named = |t: &String| names.contains(t);
+    let wanted = |name: &str| {
+        texts.iter().any(|t| {
+            if named(t) {
+                name == t
+            } else {
+                name.contains(t.as_str())
+            }
+        })
+    };
+    let picked: Vec<bench::LazyCase> = all.into_iter().filter(|c| wanted(&c.name)).collect();
+    if picked.is_empty() {
+        return Err(format!(
+            "--case: no case of the suite matches {}; the cases are: {}",
+            texts.join(", "),
+            names.join("; ")
+        ));
+    }
+    Ok(picked)
+}
+
 fn run_bench(args: &BenchArgs) -> Result<(), String> {
     set_threads(args.threads)?;
     let cases = match &args.scene {
         None => {
-            let mut all = bench::cases(args.quick);
-            if !args.cases.is_empty() {
-                all.retain(|c| args.cases.iter().any(|f| c.name.contains(f.as_str())));
-                if all.is_empty() {
-                    return Err("--case: no case of the suite matches".into());
-                }
+            let all = bench::cases(args.quick);
+            if args.cases.is_empty() {
+                all
+            } else {
+                pick_cases(all, &args.cases)?
             }
-            all
         }
         Some(path) => {
             let overrides: Vec<(String, String)> = args
@@ -253,4 +278,33 @@ fn run_render(args: &RenderArgs) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn picked(texts: &[&str]) -> Result<Vec<String>, String> {
+        let texts: Vec<String> = texts.iter().map(|t| t.to_string()).collect();
+        Ok(pick_cases(bench::cases(true), &texts)?
+            .into_iter()
+            .map(|c| c.name)
+            .collect())
+    }
+
+    #[test]
+    fn a_case_name_picks_that_case_and_other_text_every_case_holding_it() {
+        assert_eq!(picked(&["lattice beta=0.9"]).unwrap(), ["lattice beta=0.9"]);
+        let some = picked(&["beta=0.9"]).unwrap();
+        assert!(some.len() >= 4, "{some:?}");
+        assert!(some.iter().all(|n| n.contains("beta=0.9")), "{some:?}");
+        assert!(some.contains(&"lattice beta=0.99".to_string()), "{some:?}");
+        let both = picked(&["lattice beta=0", "lattice beta=0.5"]).unwrap();
+        assert_eq!(both, ["lattice beta=0", "lattice beta=0.5"]);
+        let err = picked(&["no such case"]).unwrap_err();
+        assert!(
+            err.contains("--case") && err.contains("lattice beta=0.99"),
+            "{err}"
+        );
+    }
 }
