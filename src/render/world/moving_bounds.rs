@@ -19,13 +19,21 @@ use glam::DVec3;
 /// ray the exact bounds would keep, and a little more kept only costs a boost.
 const SLACK: f64 = 1e-9;
 
+/// Groups faster than 1 − β = this have no world-frame test (every ray goes on to the boost).
+/// Near c a ray riding along with a group has d + v of ~1 − β, which the f64 β and d carry
+/// only to ~2e-16 / (1 − β) relative, and over its long ride (a lookback of ~1/(1 − β)) that
+/// moves it sideways by as much relative to its distance: below the slack only for
+/// 1 − β ≳ 2e-6. (At 1 − β = 1e-12 such rays were turned away from groups they meet; the boost
+/// works with the rapidity instead, PHYSICS.md §8.)
+const MIN_ONE_MINUS_BETA: f64 = 1e-5;
+
 #[derive(Clone, Copy, Debug)]
 pub struct MovingBounds {
     /// The world-frame box at time `t_ref` of the group's bounds; its largest |coordinate|.
     at_ref: Aabb,
     scale: f64,
-    /// The group's velocity (units of c), None at rest (the world-frame test is then the
-    /// bounds test itself, which the caller makes anyway).
+    /// The group's velocity (units of c); None at rest (the world-frame test is then the
+    /// bounds test itself, which the caller makes anyway) and near c (`MIN_ONE_MINUS_BETA`).
     v: Option<DVec3>,
     t_ref: f64,
 }
@@ -38,7 +46,7 @@ impl MovingBounds {
         MovingBounds {
             at_ref,
             scale: at_ref.max_abs(),
-            v: (!v.is_zero()).then(|| v.beta_vec()),
+            v: (!v.is_zero() && v.one_minus_beta() >= MIN_ONE_MINUS_BETA).then(|| v.beta_vec()),
             t_ref,
         }
     }
@@ -150,5 +158,61 @@ mod tests {
             rejected > 4 * missed,
             "the test should reject most misses: {rejected} rejected, {missed} kept"
         );
+    }
+
+    /// The hardest rays near c: nearly along the group's motion (d + v small, so a ray crosses
+    /// the contracted box over a lookback of ~1/(1 − β)), aimed in the rest frame at points of
+    /// the bounds from up to 60 box sizes ahead in the world frame (60 γ in the rest frame),
+    /// through its faces. Fails at 1 − β = 1e-12 without `MIN_ONE_MINUS_BETA` (tried).
+    #[test]
+    fn keeps_rays_that_ride_along_with_the_group_near_c() {
+        let mut rng = Rng(0x5eed_1e55);
+        let rest = Aabb::new(DVec3::new(-1.0, -1.5, -0.5), DVec3::new(1.0, 1.5, 0.5));
+        for e in [1e-3, 1e-4, 2e-5, 1e-5, 1e-6, 1e-9, 1e-12] {
+            let v = Velocity::from_one_minus_beta(DVec3::X, e).expect("below c");
+            let boost = Boost::to_rest(&v);
+            let bounds = MovingBounds::new(&rest, &v, 120.0);
+            let mut met = 0;
+            for case in 0..4_000 {
+                // A rest-frame event ahead of the box along x (half of them as far ahead in the
+                // world frame, where the box is contracted by γ), beside it in y or within its
+                // section; a ray toward a point of the box (on its y face in half the cases),
+                // brought back to the world.
+                let far = if case % 4 < 2 { v.gamma() } else { 1.0 };
+                let beside = case % 8 >= 4;
+                let y = if beside {
+                    rng.range(1.6, 4.0)
+                } else {
+                    rng.range(-1.4, 1.4)
+                };
+                let ahead = DVec3::new(rng.range(2.0, 60.0) * far, y, rng.range(-0.4, 0.4));
+                let mut p = DVec3::new(
+                    rng.range(-1.0, 1.0),
+                    rng.range(-1.5, 1.5),
+                    rng.range(-0.5, 0.5),
+                );
+                if case % 2 == 0 {
+                    p.y = 1.5;
+                }
+                let rest_dir = (p - ahead).normalize();
+                // Its rest-frame time such that its world time is near t_ref, as a shading
+                // point's would be: t = γ(τ + β x) (PHYSICS.md §1.3).
+                let t_world = 120.0 - rng.range(0.0, 50.0);
+                let tau = t_world / v.gamma() - v.beta() * ahead.x;
+                let rest_event = Event::new(tau, ahead);
+                let world = boost.inverse();
+                let ray = NullRay::new(world.event(rest_event), world.view_dir(rest_dir).0);
+                let meets = meets_in_rest_frame(&rest, &v, &ray, 0.0, f64::INFINITY);
+                met += usize::from(meets);
+                assert!(
+                    !meets || bounds.may_meet(&ray, 0.0, f64::INFINITY),
+                    "1 − β = {e:e}, case {case}: a ray riding along was turned away"
+                );
+            }
+            assert!(
+                met > 1_000,
+                "1 − β = {e:e}: too few rays met the bounds ({met})"
+            );
+        }
     }
 }
