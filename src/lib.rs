@@ -12,6 +12,6 @@ pub mod compare;
 pub mod geometry;
 pub mod output;
 pub mod render;
-mod rng;
+pub mod rng;
 pub mod scene;
 pub mod spacetime;

@@ -6,7 +6,6 @@ mod common;
 use common::*;
 use glam::DVec3;
 use rest_embree::compare::compare;
-use rest_embree::render::Frame;
 use rest_embree::spacetime::Event;
 
 fn paper(name: &str, sets: &[&str]) -> rest_embree::scene::Scene {
@@ -17,29 +16,6 @@ fn paper(name: &str, sets: &[&str]) -> rest_embree::scene::Scene {
         .collect();
     all.extend(sets.iter().map(|s| ("--set".to_string(), s.to_string())));
     rest_embree::scene::load_file(path.as_ref(), &all).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn same_picture(a: &Frame, b: &Frame, what: &str, max_id_share: f64, max_color: f32) {
-    let ids = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .filter(|(p, q)| p.object_id != q.object_id)
-        .count();
-    let share = ids as f64 / a.pixels.len() as f64;
-    assert!(
-        share <= max_id_share,
-        "{what}: {ids} pixels see another object"
-    );
-    let mut worst = 0.0f32;
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        if p.object_id == q.object_id {
-            for k in 0..3 {
-                worst = worst.max((p.color[k] - q.color[k]).abs());
-            }
-        }
-    }
-    assert!(worst <= max_color, "{what}: colour differs by {worst}");
 }
 
 #[test]

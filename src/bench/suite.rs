@@ -32,7 +32,6 @@ fn sets(list: &[&str]) -> Vec<String> {
     list.iter().map(|s| s.to_string()).collect()
 }
 
-/// A small deterministic generator for the many-groups scenes.
 /// `n` boxes in a cloud in front of the camera, each in its own group with its own velocity
 /// (|β| ≤ 0.8), or (`one_group`) all in one group at rest: the same geometry either way.
 pub fn many_groups(

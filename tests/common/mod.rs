@@ -1,39 +1,32 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use glam::DVec3;
+/// The crate's deterministic generator (splitmix64), for property tests.
+pub use rest_embree::rng::Rng;
 
-/// A small deterministic generator for property tests (splitmix64).
-pub struct Rng(pub u64);
-
-impl Rng {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn f(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.f()
-    }
-    pub fn unit(&mut self) -> DVec3 {
-        loop {
-            let v = DVec3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            let l = v.length();
-            if l > 0.1 && l <= 1.0 {
-                return v / l;
+/// Two renders of one picture: at most `max_id_share` of the pixels see another object, and
+/// where they see the same one the colours differ by at most `max_color`.
+pub fn same_picture(a: &Frame, b: &Frame, what: &str, max_id_share: f64, max_color: f32) {
+    let ids = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .filter(|(p, q)| p.object_id != q.object_id)
+        .count();
+    let share = ids as f64 / a.pixels.len() as f64;
+    assert!(
+        share <= max_id_share,
+        "{what}: {ids} pixels see another object"
+    );
+    let mut worst = 0.0f32;
+    for (p, q) in a.pixels.iter().zip(&b.pixels) {
+        if p.object_id == q.object_id {
+            for k in 0..3 {
+                worst = worst.max((p.color[k] - q.color[k]).abs());
             }
         }
     }
+    assert!(worst <= max_color, "{what}: colour differs by {worst}");
 }
 
 pub fn assert_close(a: f64, b: f64, tol: f64, what: &str) {
