@@ -14,7 +14,7 @@
 
 use super::exact::Lanes;
 use super::f64x4::F4;
-use super::packet::{flush_denormals, Valid};
+use super::packet::{flush_denormals, NoHit, Reused, Valid};
 use super::{lane_geometry, EmbreeAccel};
 use crate::accel::{Fan, FanHits, Ray, NO_HIT};
 use crate::geometry::Real;
@@ -50,100 +50,102 @@ impl EmbreeAccel {
     }
 }
 
-/// The kernel for one N-wide packet of a fan's lanes `first..first + N`.
+/// The kernel for one N-wide packet of a fan's lanes `first..first + N`, in this thread's
+/// packet `rh` (`Reused`: it writes the fields a query writes).
 macro_rules! fan_packet {
     ($name:ident, $n:literal, $RayHitN:ident, $rtc_isect:ident) => {
         impl EmbreeAccel {
             #[target_feature(enable = "avx2")]
             unsafe fn $name(&self, fan: &Fan, out: &mut FanHits, first: usize) {
-                const N: usize = $n;
-                const { assert!(N % 4 == 0 && N <= PACKET) };
-                let n = fan.n.saturating_sub(first).min(N);
-                let mut rh = $RayHitN::default();
-                let splat = F4::splat;
-                let o = fan.origin - self.scene.center;
-                let (o, pullback) = ([splat(o.x), splat(o.y), splat(o.z)], splat(self.pullback));
-                for c in (0..N).step_by(4) {
-                    // Lanes c.. of the packet are lanes at.. of the fan.
-                    let at = first + c;
-                    let four = |x: &[f64; PACKET]| {
-                        // SAFETY: this function runs with AVX2.
-                        unsafe { F4::load(x[at..at + 4].try_into().expect("four lanes")) }
-                    };
-                    let look = fan.camera.look(four(&fan.u), four(&fan.v));
-                    // As `World::rest_ray` boosts a primary ray, and `embree_ray` puts it in a
-                    // lane.
-                    let (dir, s) = if fan.to_rest.is_identity() {
-                        (look, splat(1.0))
-                    } else {
-                        fan.to_rest.null_dir_lanes(look)
-                    };
-                    // |dir| is s (`Ray::len`).
-                    let (org, du, tnear) = lane_geometry(o, dir, s, splat(0.0), pullback);
-                    let f32s = |x: F4, col: &mut [f32; N]| {
-                        x.store_f32((&mut col[c..c + 4]).try_into().expect("four lanes"))
-                    };
-                    f32s(org[0], &mut rh.ray.org_x);
-                    f32s(org[1], &mut rh.ray.org_y);
-                    f32s(org[2], &mut rh.ray.org_z);
-                    f32s(du[0], &mut rh.ray.dir_x);
-                    f32s(du[1], &mut rh.ray.dir_y);
-                    f32s(du[2], &mut rh.ray.dir_z);
-                    f32s(tnear, &mut rh.ray.tnear);
-                    let f64s = |x: F4, col: &mut [f64; PACKET]| {
-                        col[at..at + 4].copy_from_slice(&x.store())
-                    };
-                    for k in 0..3 {
-                        f64s(look[k], &mut out.look[k]);
-                        f64s(dir[k], &mut out.dir[k]);
+                $RayHitN::with(|rh| {
+                    const N: usize = $n;
+                    const { assert!(N % 4 == 0 && N <= PACKET) };
+                    let n = fan.n.saturating_sub(first).min(N);
+                    let splat = F4::splat;
+                    let o = fan.origin - self.scene.center;
+                    let (o, pullback) =
+                        ([splat(o.x), splat(o.y), splat(o.z)], splat(self.pullback));
+                    for c in (0..N).step_by(4) {
+                        // Lanes c.. of the packet are lanes at.. of the fan.
+                        let at = first + c;
+                        let four = |x: &[f64; PACKET]| {
+                            // SAFETY: this function runs with AVX2.
+                            unsafe { F4::load(x[at..at + 4].try_into().expect("four lanes")) }
+                        };
+                        let look = fan.camera.look(four(&fan.u), four(&fan.v));
+                        // As `World::rest_ray` boosts a primary ray, and `embree_ray` puts it in a
+                        // lane.
+                        let (dir, s) = if fan.to_rest.is_identity() {
+                            (look, splat(1.0))
+                        } else {
+                            fan.to_rest.null_dir_lanes(look)
+                        };
+                        // |dir| is s (`Ray::len`).
+                        let (org, du, tnear) = lane_geometry(o, dir, s, splat(0.0), pullback);
+                        let f32s = |x: F4, col: &mut [f32; N]| {
+                            x.store_f32((&mut col[c..c + 4]).try_into().expect("four lanes"))
+                        };
+                        f32s(org[0], &mut rh.ray.org_x);
+                        f32s(org[1], &mut rh.ray.org_y);
+                        f32s(org[2], &mut rh.ray.org_z);
+                        f32s(du[0], &mut rh.ray.dir_x);
+                        f32s(du[1], &mut rh.ray.dir_y);
+                        f32s(du[2], &mut rh.ray.dir_z);
+                        f32s(tnear, &mut rh.ray.tnear);
+                        let f64s = |x: F4, col: &mut [f64; PACKET]| {
+                            col[at..at + 4].copy_from_slice(&x.store())
+                        };
+                        for k in 0..3 {
+                            f64s(look[k], &mut out.look[k]);
+                            f64s(dir[k], &mut out.dir[k]);
+                        }
+                        f64s(s, &mut out.s);
                     }
-                    f64s(s, &mut out.s);
-                }
-                // The rest-frame rays as `World::rest_ray` makes them (shifted by 0 along
-                // themselves), for the exact tests in the callbacks and the hits' read-back.
-                let rays: [Ray; N] = std::array::from_fn(|i| {
-                    let d = &out.dir;
-                    let dir = DVec3::new(d[0][first + i], d[1][first + i], d[2][first + i]);
-                    Ray {
-                        origin: fan.origin + 0.0 * dir,
-                        dir,
-                        tmin: 0.0,
-                        tmax: f64::INFINITY,
-                        len: out.s[first + i],
+                    // The rest-frame rays as `World::rest_ray` makes them (shifted by 0 along
+                    // themselves), for the exact tests in the callbacks and the hits' read-back.
+                    let rays: [Ray; N] = std::array::from_fn(|i| {
+                        let d = &out.dir;
+                        let dir = DVec3::new(d[0][first + i], d[1][first + i], d[2][first + i]);
+                        Ray {
+                            origin: fan.origin + 0.0 * dir,
+                            dir,
+                            tmin: 0.0,
+                            tmax: f64::INFINITY,
+                            len: out.s[first + i],
+                        }
+                    });
+                    let lanes = Lanes::<N>::new(&rays[..n]);
+                    let mut valid = Valid([0i32; N]);
+                    for i in 0..n {
+                        rh.ray.tfar[i] = f32::INFINITY;
+                        rh.hit.no_hit(i);
+                        valid.0[i] = -1;
                     }
-                });
-                let lanes = Lanes::<N>::new(&rays[..n]);
-                let mut valid = Valid([0i32; N]);
-                for i in 0..n {
-                    rh.ray.tfar[i] = f32::INFINITY;
-                    rh.ray.mask[i] = u32::MAX;
-                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-                    valid.0[i] = -1;
-                }
-                let mut ctx = self.context(true, &rays[..n], &lanes);
-                // SAFETY: an N-wide packet with its valid mask (64-byte aligned), the scene and
-                // the context its user geometry expects.
-                unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), &mut rh) };
-                for (i, ray) in rays.iter().enumerate().take(n) {
-                    let hit = (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
-                        .then(|| {
-                            self.to_hit(
-                                ray,
-                                rh.ray.tfar[i],
-                                rh.hit.geomID[i],
-                                rh.hit.primID[i],
-                                ctx.exact_t(i),
-                            )
-                        })
-                        .flatten();
-                    // Written field by field: an Option copied whole went through the stack
-                    // with loads that straddled its stores (a store-forwarding stall per lane).
-                    out.prim[first + i] = NO_HIT;
-                    if let Some(h) = hit {
-                        out.t[first + i] = h.t;
-                        out.prim[first + i] = h.prim;
+                    let mut ctx = self.context(true, &rays[..n], &lanes);
+                    // SAFETY: an N-wide packet with its valid mask (64-byte aligned), the scene and
+                    // the context its user geometry expects.
+                    unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), rh) };
+                    for (i, ray) in rays.iter().enumerate().take(n) {
+                        let hit = (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
+                            .then(|| {
+                                self.to_hit(
+                                    ray,
+                                    rh.ray.tfar[i],
+                                    rh.hit.geomID[i],
+                                    rh.hit.primID[i],
+                                    ctx.exact_t(i),
+                                )
+                            })
+                            .flatten();
+                        // Written field by field: an Option copied whole went through the stack
+                        // with loads that straddled its stores (a store-forwarding stall per lane).
+                        out.prim[first + i] = NO_HIT;
+                        if let Some(h) = hit {
+                            out.t[first + i] = h.t;
+                            out.prim[first + i] = h.prim;
+                        }
                     }
-                }
+                })
             }
         }
     };

@@ -4,7 +4,7 @@ use super::exact::{ExactContext, Lanes};
 use super::{BareRay, EmbreeAccel, EmbreeRay};
 use crate::accel::{Hit, Ray};
 use embree_sys::*;
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 thread_local! {
     static FTZ_SET: Cell<bool> = const { Cell::new(false) };
@@ -28,65 +28,132 @@ pub(super) fn flush_denormals() {
     });
 }
 
+/// A thread's Embree packet of each kind, kept and reused: made per packet, a 16-wide
+/// `RTCRayHit16` is 1.28 kB zeroed before its rays are written over half of it. The fields
+/// every query here gives the same value (a ray's time 0, mask all ones, flags and id 0; a
+/// hit's instID none, which is also what Embree writes back at the top level) are set when
+/// the packet is made, and nothing changes them; each query writes the rest that Embree reads
+/// in the lanes it marks valid: a ray's origin, tnear, direction and tfar (`Lane::set`, or the
+/// fans' kernel) and a hit's geomID (`NoHit`). The rest of a hit Embree writes where it
+/// reports one. Embree's callbacks start no query, so a packet is never in use twice on one
+/// thread.
+pub(super) trait Reused: Sized {
+    /// `f` on this thread's packet of this kind.
+    fn with<R>(f: impl FnOnce(&mut Self) -> R) -> R;
+}
+
+macro_rules! reused {
+    ($T:ident, $made:expr) => {
+        impl Reused for $T {
+            #[inline(always)]
+            fn with<R>(f: impl FnOnce(&mut Self) -> R) -> R {
+                thread_local! {
+                    static PACKET: RefCell<$T> = RefCell::new($made);
+                }
+                PACKET.with_borrow_mut(f)
+            }
+        }
+    };
+}
+
+/// The hit fields of a packet that a query writes (`Reused`).
+pub(super) trait NoHit {
+    /// Lane i as no hit yet.
+    fn no_hit(&mut self, i: usize);
+}
+
 macro_rules! packet_fns {
-    ($n:literal, $isect:ident, $occl:ident, $bare:ident, $RayHitN:ident, $RayN:ident, $rtc_isect:ident, $rtc_occl:ident) => {
+    ($n:literal, $isect:ident, $occl:ident, $bare:ident, $RayHitN:ident, $RayN:ident, $HitN:ident, $rtc_isect:ident, $rtc_occl:ident) => {
         impl EmbreeAccel {
             /// Bare Embree (the benchmark's baseline): prepared rays in one packet, nothing
             /// else; returns how many hit.
             pub(super) fn $bare(&self, rays: &[BareRay], ctx: *mut RTCIntersectContext) -> usize {
-                let mut rh = $RayHitN::default();
-                let mut valid = Valid([0i32; $n]);
-                for (i, r) in rays.iter().enumerate() {
-                    fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
-                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-                }
-                unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx, &mut rh) };
-                (0..rays.len())
-                    .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
-                    .count()
+                $RayHitN::with(|rh| {
+                    let mut valid = Valid([0i32; $n]);
+                    for (i, r) in rays.iter().enumerate() {
+                        fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
+                        rh.hit.no_hit(i);
+                    }
+                    unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx, rh) };
+                    (0..rays.len())
+                        .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
+                        .count()
+                })
             }
 
             pub(super) fn $isect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-                let mut rh = $RayHitN::default();
-                let mut valid = Valid([0i32; $n]);
-                let lanes = Lanes::<$n>::new(rays);
-                for (i, r) in rays.iter().enumerate() {
-                    let e = self.embree_ray(r);
-                    fill_lane(&mut rh.ray, i, &e, &mut valid.0);
-                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-                }
-                let mut ctx = self.context(true, rays, &lanes);
-                unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), &mut rh) };
-                for (i, r) in rays.iter().enumerate() {
-                    hits[i] = if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID {
-                        self.to_hit(
-                            r,
-                            rh.ray.tfar[i],
-                            rh.hit.geomID[i],
-                            rh.hit.primID[i],
-                            ctx.exact_t(i),
-                        )
-                    } else {
-                        None
-                    };
-                }
+                $RayHitN::with(|rh| {
+                    let mut valid = Valid([0i32; $n]);
+                    let lanes = Lanes::<$n>::new(rays);
+                    for (i, r) in rays.iter().enumerate() {
+                        let e = self.embree_ray(r);
+                        fill_lane(&mut rh.ray, i, &e, &mut valid.0);
+                        rh.hit.no_hit(i);
+                    }
+                    let mut ctx = self.context(true, rays, &lanes);
+                    unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), rh) };
+                    for (i, r) in rays.iter().enumerate() {
+                        hits[i] = if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID
+                        {
+                            self.to_hit(
+                                r,
+                                rh.ray.tfar[i],
+                                rh.hit.geomID[i],
+                                rh.hit.primID[i],
+                                ctx.exact_t(i),
+                            )
+                        } else {
+                            None
+                        };
+                    }
+                })
             }
 
             pub(super) fn $occl(&self, rays: &[Ray], out: &mut [bool]) {
-                let mut ray = $RayN::default();
-                let mut valid = Valid([0i32; $n]);
-                let lanes = Lanes::<$n>::new(rays);
-                for (i, r) in rays.iter().enumerate() {
-                    let e = self.embree_ray(r);
-                    fill_lane(&mut ray, i, &e, &mut valid.0);
-                }
-                let mut ctx = self.context(true, rays, &lanes);
-                unsafe { $rtc_occl(valid.0.as_ptr(), self.scene.raw, ctx.raw(), &mut ray) };
-                for i in 0..rays.len() {
-                    out[i] = valid.0[i] != 0 && ray.tfar[i] == f32::NEG_INFINITY;
-                }
+                $RayN::with(|ray| {
+                    let mut valid = Valid([0i32; $n]);
+                    let lanes = Lanes::<$n>::new(rays);
+                    for (i, r) in rays.iter().enumerate() {
+                        let e = self.embree_ray(r);
+                        fill_lane(ray, i, &e, &mut valid.0);
+                    }
+                    let mut ctx = self.context(true, rays, &lanes);
+                    unsafe { $rtc_occl(valid.0.as_ptr(), self.scene.raw, ctx.raw(), ray) };
+                    for i in 0..rays.len() {
+                        out[i] = valid.0[i] != 0 && ray.tfar[i] == f32::NEG_INFINITY;
+                    }
+                })
             }
         }
+
+        impl NoHit for $HitN {
+            #[inline(always)]
+            fn no_hit(&mut self, i: usize) {
+                self.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+            }
+        }
+
+        // The fields every query gives the same value (`Reused`).
+        reused!(
+            $RayN,
+            $RayN {
+                mask: [u32::MAX; $n],
+                ..Default::default()
+            }
+        );
+        reused!(
+            $RayHitN,
+            $RayHitN {
+                ray: $RayN {
+                    mask: [u32::MAX; $n],
+                    ..Default::default()
+                },
+                hit: $HitN {
+                    instID: [[RTC_INVALID_GEOMETRY_ID; $n]],
+                    ..Default::default()
+                },
+            }
+        );
 
         impl Lane for $RayN {
             fn set(&mut self, i: usize, e: &EmbreeRay) {
@@ -98,9 +165,6 @@ macro_rules! packet_fns {
                 self.dir_z[i] = e.dir[2];
                 self.tnear[i] = e.tnear;
                 self.tfar[i] = e.tfar;
-                self.mask[i] = u32::MAX;
-                self.time[i] = 0.0;
-                self.flags[i] = 0;
             }
         }
     };
@@ -131,6 +195,7 @@ packet_fns!(
     bare16,
     RTCRayHit16,
     RTCRay16,
+    RTCHit16,
     rtcIntersect16,
     rtcOccluded16
 );
@@ -141,6 +206,7 @@ packet_fns!(
     bare8,
     RTCRayHit8,
     RTCRay8,
+    RTCHit8,
     rtcIntersect8,
     rtcOccluded8
 );
