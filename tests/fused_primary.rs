@@ -142,6 +142,64 @@ fn moving_camera_samples_and_crop() {
     same_with_and_without_fans(&bars, true);
 }
 
+/// A group of `objects` (TOML `[[group.object]]` bodies) at 0.5c, seen from among them.
+fn one_group(objects: &[String]) -> Scene {
+    let mut text = String::from(
+        "[camera]\nposition = [0, -6, 0.3]\nlook_at = [0, 0, 0]\nup = [0, 0, 1]\nfov_y = 70\n\
+         time = 0\n[image]\nwidth = 64\nheight = 48\nsamples = 1\n\
+         [[light]]\nposition = [2, -4, 5]\n\
+         [[group]]\nname = \"g\"\nvelocity = [-0.5, 0, 0]\n",
+    );
+    for o in objects {
+        text += &format!("[[group.object]]\n{o}\n");
+    }
+    rest_embree::scene::load_str("one_group.toml", &text, &[]).unwrap()
+}
+
+#[test]
+fn every_way_the_backend_reads_hits_back() {
+    // Embree names a hit by geometry and primitive. Spheres and rods are one geometry, boxes
+    // another, a mesh a third, refined after Embree rather than exact. Where each geometry's
+    // primitives are a run of the scene's (kinds in blocks) the fans read hits back with no
+    // lookup; interleaved kinds, or a mesh, take the general way.
+    let (sphere, cube, rod) = (
+        |x: f64, z: f64| format!("type = \"sphere\"\ncenter = [{x}, 0, {z}]\nradius = 0.45"),
+        |x: f64, z: f64| {
+            format!(
+                "type = \"box\"\nmin = [{}, -0.4, {}]\nmax = [{}, 0.4, {}]",
+                x - 0.4,
+                z - 0.4,
+                x + 0.4,
+                z + 0.4
+            )
+        },
+        |x: f64| format!("type = \"rod\"\nfrom = [{x}, -1, -3]\nto = [{x}, 1, 3]\nradius = 0.1"),
+    );
+    let xs = [-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0];
+    let in_blocks: Vec<String> = (xs.iter().map(|&x| sphere(x, 1.0)))
+        .chain(xs.iter().map(|&x| rod(x + 0.5)))
+        .chain(xs.iter().map(|&x| cube(x, -1.0)))
+        .collect();
+    let interleaved: Vec<String> = xs
+        .iter()
+        .flat_map(|&x| [sphere(x, 1.0), cube(x, -1.0), rod(x + 0.5)])
+        .collect();
+    let mesh = "type = \"mesh\"\nvertices = [[-4, 2, -3], [4, 2, -3], [0, 2, 3]]\n\
+                indices = [[0, 1, 2]]"
+        .to_string();
+    let with_mesh: Vec<String> = in_blocks.iter().cloned().chain([mesh]).collect();
+    for objects in [&in_blocks, &interleaved, &with_mesh] {
+        let scene = one_group(objects);
+        same_with_and_without_fans(&scene, true);
+        let world = World::build(&scene, backend_by_name("embree").unwrap().as_ref()).unwrap();
+        let (rays, hits) = trace_primary(&scene, &world);
+        assert!(
+            hits > rays / 10 && hits < rays,
+            "{hits} of {rays} rays hit: the test needs hits and misses"
+        );
+    }
+}
+
 #[test]
 fn scenes_fans_do_not_serve_are_unchanged() {
     // One box: intersected directly, no accelerator.

@@ -125,6 +125,21 @@ macro_rules! fan_packet {
                     // SAFETY: an N-wide packet with its valid mask (64-byte aligned), the scene and
                     // the context its user geometry expects.
                     unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), rh) };
+                    if let Some(runs) = self.scene.exact_runs {
+                        // Every hit exact, so as `to_hit` reads it (the callbacks record only
+                        // a t in the rays' lookback (0, ∞)), but with no lookup and no branch on
+                        // whether a lane hit: lanes hit or miss about at random, and the
+                        // general read-back below cost ~1.5 ns per primary ray more.
+                        for i in 0..n {
+                            let (g, t) = (rh.hit.geomID[i], ctx.exact_t(i));
+                            let hit = g != RTC_INVALID_GEOMETRY_ID;
+                            debug_assert!(!hit || (t > 0.0 && t < f64::INFINITY));
+                            let prim = runs.prim(g, rh.hit.primID[i]);
+                            out.t[first + i] = t;
+                            out.prim[first + i] = if hit { prim } else { NO_HIT };
+                        }
+                        return;
+                    }
                     for (i, ray) in rays.iter().enumerate().take(n) {
                         let hit = (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
                             .then(|| {

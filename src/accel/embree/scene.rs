@@ -25,10 +25,49 @@ pub struct PrimMap {
     pub exact: bool,
 }
 
+/// The scene primitives of an Embree scene whose every geometry is user geometry with exact
+/// hits and holds a run of the scene's primitives (`PrimMap::prims[i] = first + i`): the
+/// firsts, by geomID. A hit's primitive is then `first + primID` and its t the context's, read
+/// back with no lookup and no branch on whether a lane hit (`fan.rs`; the paper's lattice, the
+/// bar array and every scene of spheres and rods are such).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExactRuns([u32; ExactRuns::MAX]);
+
+impl ExactRuns {
+    /// Geometries at most (a scene has one of each kind).
+    const MAX: usize = 4;
+
+    /// The runs of these maps, if they are such.
+    fn of(maps: &[PrimMap]) -> Option<ExactRuns> {
+        let run = |m: &PrimMap| {
+            let first = *m.prims.first()?;
+            let consecutive = (first..).zip(&m.prims).all(|(want, &p)| p == want);
+            (m.exact && consecutive).then_some(first)
+        };
+        let mut firsts = [0; ExactRuns::MAX];
+        if maps.is_empty() || maps.len() > ExactRuns::MAX {
+            return None;
+        }
+        for (f, m) in firsts.iter_mut().zip(maps) {
+            *f = run(m)?;
+        }
+        Some(ExactRuns(firsts))
+    }
+
+    /// The scene primitive an Embree hit names, for a geomID of the scene; some number for
+    /// any other (no hit), which the caller discards.
+    #[inline(always)]
+    pub fn prim(&self, geom: u32, prim: u32) -> u32 {
+        self.0[geom as usize % ExactRuns::MAX].wrapping_add(prim)
+    }
+}
+
 pub struct Scene {
     pub(super) raw: RTCScene,
     /// Indexed by geomID.
     pub maps: Vec<PrimMap>,
+    /// The maps as runs, where they are runs of exact geometries.
+    pub exact_runs: Option<ExactRuns>,
     /// Embree coordinates are rest-frame coordinates minus this.
     pub center: DVec3,
     /// What Embree's user geometry points into; dropped after the scene is released.
@@ -79,6 +118,7 @@ impl Scene {
         let mut scene = Scene {
             raw,
             maps: Vec::new(),
+            exact_runs: None,
             center,
             rounds: None,
             cuboids: None,
@@ -146,6 +186,7 @@ impl Scene {
         scene.cuboids = scene.user_geometry(&device, cuboids, cuboid_map)?;
         unsafe { rtcCommitScene(raw) };
         device.check("committing a scene")?;
+        scene.exact_runs = ExactRuns::of(&scene.maps);
         Ok(scene)
     }
 
@@ -222,5 +263,38 @@ impl Scene {
     pub fn prim(&self, geom: u32, prim: u32) -> Option<(u32, bool)> {
         let m = self.maps.get(geom as usize)?;
         Some((*m.prims.get(prim as usize)?, m.exact))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn map(prims: &[u32], exact: bool) -> PrimMap {
+        PrimMap {
+            prims: prims.to_vec(),
+            exact,
+        }
+    }
+
+    #[test]
+    fn runs_of_exact_geometries_only() {
+        let runs = ExactRuns::of(&[map(&[0, 1, 2], true), map(&[3, 4], true)]).unwrap();
+        assert_eq!(
+            (runs.prim(0, 2), runs.prim(1, 0), runs.prim(1, 1)),
+            (2, 3, 4)
+        );
+        assert_eq!(ExactRuns::of(&[map(&[5], true)]).unwrap().prim(0, 0), 5);
+        // Interleaved kinds (a sphere, a box, a sphere), a geometry refined after Embree
+        // (triangles), an empty map, no geometry, more than there are kinds.
+        for maps in [
+            vec![map(&[0, 2], true), map(&[1], true)],
+            vec![map(&[0, 1], true), map(&[2], false)],
+            vec![map(&[], true)],
+            vec![],
+            (0..5).map(|i| map(&[i], true)).collect(),
+        ] {
+            assert_eq!(ExactRuns::of(&maps), None);
+        }
     }
 }
