@@ -14,7 +14,7 @@
 
 use super::exact::Lanes;
 use super::f64x4::F4;
-use super::packet::{flush_denormals, NoHit, Reused, Valid};
+use super::packet::{flush_denormals, Reused, Valid};
 use super::{lane_geometry, EmbreeAccel};
 use crate::accel::{Fan, FanHits, Ray, NO_HIT};
 use crate::geometry::Real;
@@ -118,7 +118,7 @@ macro_rules! fan_packet {
                     let mut valid = Valid([0i32; N]);
                     for i in 0..n {
                         rh.ray.tfar[i] = f32::INFINITY;
-                        rh.hit.no_hit(i);
+                        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                         valid.0[i] = -1;
                     }
                     let mut ctx = self.context(true, &rays[..n], &lanes);

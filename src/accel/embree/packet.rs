@@ -34,7 +34,7 @@ pub(super) fn flush_denormals() {
 /// hit's instID none, which is also what Embree writes back at the top level) are set when
 /// the packet is made, and nothing changes them; each query writes the rest that Embree reads
 /// in the lanes it marks valid: a ray's origin, tnear, direction and tfar (`Lane::set`, or the
-/// fans' kernel) and a hit's geomID (`NoHit`). The rest of a hit Embree writes where it
+/// fans' kernel) and a hit's geomID. The rest of a hit Embree writes where it
 /// reports one. Embree's callbacks start no query, so a packet is never in use twice on one
 /// thread.
 pub(super) trait Reused: Sized {
@@ -56,12 +56,6 @@ macro_rules! reused {
     };
 }
 
-/// The hit fields of a packet that a query writes (`Reused`).
-pub(super) trait NoHit {
-    /// Lane i as no hit yet.
-    fn no_hit(&mut self, i: usize);
-}
-
 macro_rules! packet_fns {
     ($n:literal, $isect:ident, $occl:ident, $bare:ident, $RayHitN:ident, $RayN:ident, $HitN:ident, $rtc_isect:ident, $rtc_occl:ident) => {
         impl EmbreeAccel {
@@ -72,7 +66,7 @@ macro_rules! packet_fns {
                     let mut valid = Valid([0i32; $n]);
                     for (i, r) in rays.iter().enumerate() {
                         fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
-                        rh.hit.no_hit(i);
+                        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                     }
                     unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx, rh) };
                     (0..rays.len())
@@ -88,7 +82,7 @@ macro_rules! packet_fns {
                     for (i, r) in rays.iter().enumerate() {
                         let e = self.embree_ray(r);
                         fill_lane(&mut rh.ray, i, &e, &mut valid.0);
-                        rh.hit.no_hit(i);
+                        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                     }
                     let mut ctx = self.context(true, rays, &lanes);
                     unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), rh) };
@@ -123,13 +117,6 @@ macro_rules! packet_fns {
                         out[i] = valid.0[i] != 0 && ray.tfar[i] == f32::NEG_INFINITY;
                     }
                 })
-            }
-        }
-
-        impl NoHit for $HitN {
-            #[inline(always)]
-            fn no_hit(&mut self, i: usize) {
-                self.geomID[i] = RTC_INVALID_GEOMETRY_ID;
             }
         }
 
