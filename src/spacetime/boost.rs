@@ -141,6 +141,12 @@ impl Boost {
         (s, par)
     }
 
+    /// The most it stretches a null vector's time part: e^|φ| (`null_dir`'s s lies within
+    /// [e^−|φ|, e^|φ|]).
+    pub fn max_stretch(&self) -> f64 {
+        self.e_pos.max(self.e_neg)
+    }
+
     /// Whether this boost is the identity (a frame at rest relative to the one it starts from).
     pub fn is_identity(&self) -> bool {
         self.identity

@@ -9,6 +9,7 @@
 
 use super::lane_cull::lanes_near;
 use super::lane_hits::{round_hits, Answers, LaneRays, MAX};
+use super::scale;
 use crate::accel::Ray;
 use crate::geometry::{capsule_hit, cuboid_hit, Aabb};
 use embree_sys::*;
@@ -80,8 +81,8 @@ pub(super) struct ExactContext<'a> {
     rays: &'a [Ray],
     /// Embree coordinates are the caller's minus this.
     center: DVec3,
-    /// Embree's t = t · len + pullback (the caller's ray was pulled back and normalised;
-    /// `Ray::len`).
+    /// Embree's t = t · scale(len) + pullback (the caller's ray was pulled back, and
+    /// normalised where its length is far from 1: `scale`, `Ray::len`).
     pullback: f64,
     /// The exact t of the closest user-geometry hit so far in each lane (starts at tmax).
     best: &'a [Cell<f64>],
@@ -273,7 +274,7 @@ unsafe fn embree_t(
     if ctx.rays.is_empty() {
         return Some((t as f32).clamp(tmin as f32, tmax as f32));
     }
-    let te = (t * ctx.rays[i].len + ctx.pullback) as f32;
+    let te = (t * scale(ctx.rays[i].len) + ctx.pullback) as f32;
     // Embree's tfar may have been lowered by one of its own primitives.
     let tfar = unsafe { *base.add(TFAR * n + i) };
     (te <= tfar).then(|| {

@@ -15,7 +15,7 @@
 use super::exact::Lanes;
 use super::f64x4::F4;
 use super::packet::{flush_denormals, Reused, Valid};
-use super::{lane_geometry, EmbreeAccel};
+use super::{lane_geometry, EmbreeAccel, AS_THEY_ARE};
 use crate::accel::{Fan, FanHits, Ray, NO_HIT};
 use crate::geometry::Real;
 use crate::geometry::PACKET;
@@ -61,6 +61,9 @@ macro_rules! fan_packet {
                     const N: usize = $n;
                     const { assert!(N % 4 == 0 && N <= PACKET) };
                     let n = fan.n.saturating_sub(first).min(N);
+                    // Every lane's s lies within [1/stretch, stretch] but for rounding, which
+                    // the margin below 16 covers: then `scale` is 1 in every lane.
+                    let raw = fan.to_rest.max_stretch() <= AS_THEY_ARE - 1.0;
                     let splat = F4::splat;
                     let o = fan.origin - self.scene.center;
                     let (o, pullback) =
@@ -80,8 +83,16 @@ macro_rules! fan_packet {
                         } else {
                             fan.to_rest.null_dir_lanes(look)
                         };
-                        // |dir| is s (`Ray::len`).
-                        let (org, du, tnear) = lane_geometry(o, dir, s, splat(0.0), pullback);
+                        // |dir| is s (`Ray::len`); Embree traces dir as it is where `scale` says
+                        // so: in every lane when the boost stretches no more than `raw` allows.
+                        let (org, du, tnear) = if raw {
+                            lane_geometry(o, dir, splat(1.0), splat(0.0), pullback)
+                        } else {
+                            let near_one =
+                                s.ge(splat(1.0 / AS_THEY_ARE)).and(s.le(splat(AS_THEY_ARE)));
+                            let k = F4::select(near_one, splat(1.0), s);
+                            lane_geometry(o, dir, k, splat(0.0), pullback)
+                        };
                         let f32s = |x: F4, col: &mut [f32; N]| {
                             x.store_f32((&mut col[c..c + 4]).try_into().expect("four lanes"))
                         };
@@ -168,3 +179,43 @@ macro_rules! fan_packet {
 
 fan_packet!(fan16, 16, RTCRayHit16, rtcIntersect16);
 fan_packet!(fan8, 8, RTCRayHit8, rtcIntersect8);
+
+#[cfg(test)]
+mod tests {
+    use super::super::scale;
+    use super::AS_THEY_ARE;
+    use crate::rng::Rng;
+    use crate::spacetime::{Boost, Velocity};
+
+    /// The fans trace every lane's direction as it is where the boost stretches by at most
+    /// `AS_THEY_ARE − 1`, which is right only if `scale` then says 1 for every ray the boost
+    /// makes (so that a fan's Embree rays are `embree_ray`'s to the bit); beyond, `scale` must
+    /// say so for some directions, or the margin would be wasted.
+    #[test]
+    fn within_the_stretch_every_direction_goes_in_as_it_is() {
+        let mut rng = Rng(0x5eed_f00d_1234_5678);
+        let limit = AS_THEY_ARE - 1.0;
+        // e^φ = limit at β = (limit² − 1) / (limit² + 1).
+        let edge = (limit * limit - 1.0) / (limit * limit + 1.0);
+        for case in 0..2_000 {
+            let beta = if case % 2 == 0 {
+                rng.range(0.0, edge)
+            } else {
+                edge * (1.0 - 1e-15 * rng.range(0.0, 1.0))
+            };
+            let v = Velocity::from_beta(rng.unit(), beta).expect("below c");
+            let boost = Boost::to_rest(&v);
+            assert!(boost.max_stretch() <= limit * (1.0 + 1e-14), "{beta}");
+            for _ in 0..50 {
+                let (_, s) = boost.null_dir(rng.unit());
+                assert_eq!(scale(s), 1.0, "β = {beta}: s = {s}");
+            }
+        }
+        let fast = Boost::to_rest(&Velocity::from_beta(glam::DVec3::X, 0.999).expect("below c"));
+        assert!(fast.max_stretch() > limit);
+        let unit = (0..1000)
+            .filter(|_| scale(fast.null_dir(rng.unit()).1) == 1.0)
+            .count();
+        assert!(unit < 1000, "at 0.999c some directions are normalised");
+    }
+}

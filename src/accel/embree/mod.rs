@@ -112,29 +112,47 @@ struct EmbreeRay {
     active: bool,
 }
 
+/// Directions this long, within a factor of the unit, Embree traces as they are (`scale`).
+const AS_THEY_ARE: f64 = 16.0;
+
+/// What Embree traces a direction of length `len` (`Ray::len`) divided by: 1 where `len`
+/// lies within [1/16, 16], so the direction goes in as it is, with no division (a boost's
+/// null directions are so long up to 0.99c, as a camera's unit ones are); else `len`, the
+/// unit direction, since far from 1 an unnormalised one would pull the origin back by that
+/// much more or less, out where f32 is coarser or into the rounding. Embree's t is then
+/// t · scale + pullback.
+#[inline(always)]
+fn scale(len: f64) -> f64 {
+    if (1.0 / AS_THEY_ARE..=AS_THEY_ARE).contains(&len) {
+        1.0
+    } else {
+        len
+    }
+}
+
 /// A ray as it goes into Embree's f32 packet, before the cast, written once for one ray or
 /// several (`Real`) so that a fan's rays are `embree_ray`'s to the bit: from the origin `o`
-/// (relative to the scene's centre) and direction `d` of length `len` (`Ray::len`), the
-/// origin pulled back by `pullback` along the unit direction, the unit direction and tnear for
-/// the caller's `tmin`. Embree's t is then t · len + pullback whatever len is, so a len some
-/// ulps from |d| (as a boost's lookback factor is) changes nothing but rounding.
+/// (relative to the scene's centre) and direction `d` traced divided by `scale` (`scale`), the
+/// origin pulled back by `pullback` along that, the direction Embree traces and tnear for the
+/// caller's `tmin`. Embree's t is t · scale + pullback; for a scale of 1 the division is by 1,
+/// exact, and a caller that knows it passes the constant, which the compiler folds away.
 #[inline(always)]
 fn lane_geometry<R: Real>(
     o: [R; 3],
     d: [R; 3],
-    len: R,
+    scale: R,
     tmin: R,
     pullback: R,
 ) -> ([R; 3], [R; 3], R) {
     // One division, not three: the f32 cast rounds far more than this.
-    let inv = R::splat(1.0) / len;
+    let inv = R::splat(1.0) / scale;
     let du = [d[0] * inv, d[1] * inv, d[2] * inv];
     let org = [
         o[0] - pullback * du[0],
         o[1] - pullback * du[1],
         o[2] - pullback * du[2],
     ];
-    let tnear = (tmin * len + pullback).max(R::splat(0.0));
+    let tnear = (tmin * scale + pullback).max(R::splat(0.0));
     (org, du, tnear)
 }
 
@@ -145,10 +163,10 @@ impl EmbreeAccel {
             return EmbreeRay::default();
         }
         let o = r.origin - self.scene.center;
-        let (d, len) = (r.dir, r.len);
+        let (d, k) = (r.dir, scale(r.len));
         let (o, du, tnear) =
-            lane_geometry([o.x, o.y, o.z], [d.x, d.y, d.z], len, r.tmin, self.pullback);
-        let tfar = r.tmax * len + self.pullback;
+            lane_geometry([o.x, o.y, o.z], [d.x, d.y, d.z], k, r.tmin, self.pullback);
+        let tfar = r.tmax * k + self.pullback;
         EmbreeRay {
             org: o.map(|x| x as f32),
             dir: du.map(|x| x as f32),
@@ -164,10 +182,10 @@ impl EmbreeAccel {
 
     /// Embree's hit back in the caller's units: exact already for user geometry (`exact_t`,
     /// from the context), else refined in f64 on the primitive that was hit (Embree's t is
-    /// t · `r.len` + pullback).
+    /// t · `scale(r.len)` + pullback).
     #[inline(always)]
     fn to_hit(&self, r: &Ray, t_embree: f32, geom: u32, prim: u32, exact_t: f64) -> Option<Hit> {
-        let len = r.len;
+        let len = scale(r.len);
         let (prim, exact) = self.scene.prim(geom, prim)?;
         if exact {
             return (exact_t > r.tmin && exact_t < r.tmax).then_some(Hit { t: exact_t, prim });
