@@ -86,6 +86,18 @@ macro_rules! packet_fns {
                     }
                     let mut ctx = self.context(true, rays, &lanes);
                     unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), rh) };
+                    if let Some(runs) = self.scene.exact_runs {
+                        // As the fans read hits back (`ExactRuns`): every hit exact, within the
+                        // ray's (tmin, tmax), its primitive with no lookup.
+                        for (i, r) in rays.iter().enumerate() {
+                            let (g, t) = (rh.hit.geomID[i], ctx.exact_t(i));
+                            let hit = valid.0[i] != 0 && g != RTC_INVALID_GEOMETRY_ID;
+                            debug_assert!(!hit || (t > r.tmin && t < r.tmax));
+                            let prim = runs.prim(g, rh.hit.primID[i]);
+                            hits[i] = hit.then_some(Hit { t, prim });
+                        }
+                        return;
+                    }
                     for (i, r) in rays.iter().enumerate() {
                         hits[i] = if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID
                         {
