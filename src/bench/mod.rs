@@ -67,6 +67,8 @@ pub struct Case {
     pub bare: bool,
     /// Compare with a 16-spp f64 render (costly for the large cases).
     pub hi_reference: bool,
+    /// For many groups: the same boxes in one group, measured beside them (`one_group_beside`).
+    pub one_group: Option<Scene>,
 }
 
 impl Case {
@@ -78,7 +80,12 @@ impl Case {
             extra_spp: Vec::new(),
             bare: false,
             hi_reference: true,
+            one_group: None,
         }
+    }
+    pub fn against_one_group(mut self, scene: Scene) -> Case {
+        self.one_group = Some(scene);
+        self
     }
     pub fn with_bare(mut self) -> Case {
         self.bare = true;
@@ -114,6 +121,16 @@ pub struct Row {
     pub vs_same: Option<Comparison>,
     /// Against the f64 BVH at 16 samples per pixel.
     pub vs_hi: Option<Comparison>,
+    /// For many groups: the same boxes in one group on the same setting.
+    pub one_group: Option<OneGroup>,
+}
+
+/// What the same boxes in one group cost beside a row of many groups (`one_group_beside`).
+#[derive(Clone, Copy, Debug)]
+pub struct OneGroup {
+    pub build_s: f64,
+    pub first_render_s: f64,
+    pub render_s: f64,
 }
 
 impl Row {
@@ -222,9 +239,48 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
             peak_mib,
             vs_same: None,
             vs_hi: None,
+            one_group: None,
         },
         frame,
     ))
+}
+
+/// The same boxes in one group (`one`) beside a row of `case`'s many groups on `setting`: the
+/// one group's frame measured as `measure` measures one, then the warm renders of both in
+/// alternating blocks, each the fastest of its passes, which count among the row's (as
+/// `bare_embree` sets the layer beside bare Embree). Measured as two cases seconds apart, a
+/// render of 25 ms was once the fastest of ten at 29 on one side only, and the ratio read 3.4
+/// instead of 2.8.
+fn one_group_beside(
+    case: &Case,
+    one: &Scene,
+    setting: &str,
+    repeat: usize,
+    row: &mut Row,
+) -> Result<OneGroup, String> {
+    let alone = Case::new(&case.name, one.clone(), &[setting]).without_hi_reference();
+    let (one_row, _) = measure(&alone, setting, 1, repeat)?;
+    let (backend_name, options, passes) = parse_setting(setting);
+    let backend = backend_by_name(backend_name)?;
+    let (many, one) = (with_spp(&case.scene, 1), with_spp(one, 1));
+    let many_world = World::build_with(&many, backend.as_ref(), options)?;
+    let one_world = World::build_with(&one, backend.as_ref(), options)?;
+    let render = |scene: &Scene, world: &World| {
+        render_world_passes(scene, world, passes);
+    };
+    render(&many, &many_world);
+    render(&one, &one_world);
+    let (mut many_s, mut one_s) = (row.render_s, one_row.render_s);
+    for _ in 0..PAIRED_BLOCKS {
+        many_s = many_s.min(fastest(repeat, || render(&many, &many_world)));
+        one_s = one_s.min(fastest(repeat, || render(&one, &one_world)));
+    }
+    row.render_s = many_s;
+    Ok(OneGroup {
+        build_s: one_row.build_s,
+        first_render_s: one_row.first_render_s,
+        render_s: one_s,
+    })
 }
 
 /// The bare-Embree baseline's input: the Embree accelerator of the world's one group and the
@@ -253,8 +309,8 @@ pub fn bare_rays<'w>(
     Some((accel, tiles))
 }
 
-/// Blocks of each side in `bare_embree`.
-#[cfg(feature = "embree")]
+/// Blocks of each side where two measurements are set side by side (`bare_embree`,
+/// `one_group_beside`).
 const PAIRED_BLOCKS: usize = 3;
 
 /// Bare Embree on the rest-frame primary rays of the scene's one group, and the layer's
@@ -319,6 +375,9 @@ pub fn run(
                 .collect();
             for spp in spps {
                 let (mut row, frame) = measure(case, setting, spp, repeat)?;
+                if let (Some(one), 1, "embree" | "bvh") = (&case.one_group, spp, setting.as_str()) {
+                    row.one_group = Some(one_group_beside(case, one, setting, repeat, &mut row)?);
+                }
                 if !refs.iter().any(|(s, _)| *s == spp) {
                     refs.push((spp, reference(&case.scene, spp)?));
                 }
@@ -354,6 +413,7 @@ pub fn run(
                     peak_mib: None,
                     vs_same: None,
                     vs_hi: None,
+                    one_group: None,
                 });
             }
         }
@@ -458,28 +518,22 @@ pub fn summary(rows: &[Row]) -> String {
             );
         }
     }
-    // Many groups against one group holding the same boxes, on each backend.
-    for backend in ["embree", "bvh"] {
-        let one = rows
-            .iter()
-            .find(|r| r.case.ends_with("in 1 group") && r.setting == backend);
-        for r in rows.iter().filter(|r| {
-            r.case.contains(" groups") && r.setting == backend && !r.case.contains("bars")
-        }) {
-            if let Some(o) = one {
-                let _ = writeln!(
-                    s,
-                    "- {} ({backend}): render time {:.3} s = {:.2}x that of the same boxes in one \
-                     group ({:.3} s); build + first render {:.3} s = {:.2}x ({:.3} s)",
-                    r.case,
-                    r.render_s,
-                    r.render_s / o.render_s,
-                    o.render_s,
-                    r.build_s + r.first_render_s,
-                    (r.build_s + r.first_render_s) / (o.build_s + o.first_render_s),
-                    o.build_s + o.first_render_s
-                );
-            }
+    // Many groups against the same boxes in one group, measured beside them.
+    for r in rows.iter() {
+        if let Some(o) = r.one_group {
+            let _ = writeln!(
+                s,
+                "- {} ({}): render time {:.3} s = {:.2}x that of the same boxes in one group \
+                 ({:.3} s); build + first render {:.3} s = {:.2}x ({:.3} s)",
+                r.case,
+                r.setting,
+                r.render_s,
+                r.render_s / o.render_s,
+                o.render_s,
+                r.build_s + r.first_render_s,
+                (r.build_s + r.first_render_s) / (o.build_s + o.first_render_s),
+                o.build_s + o.first_render_s
+            );
         }
     }
     for r in rows.iter().filter(|r| r.case.contains("^3")) {

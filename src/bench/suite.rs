@@ -224,7 +224,8 @@ pub fn cases(quick: bool) -> Vec<LazyCase> {
                     many_groups(g, false, gpx)?,
                     settings,
                 )
-                .without_hi_reference())
+                .without_hi_reference()
+                .against_one_group(many_groups(g, true, gpx)?))
             },
         ));
     }
