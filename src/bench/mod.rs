@@ -333,8 +333,10 @@ fn bare_embree(case: &Case, repeat: usize) -> Result<Option<(u64, f64, f64)>, St
     let bare = || {
         let _hits: usize = tiles.par_iter().map(|t| accel.trace_bare(t)).sum();
     };
+    // One sample per pixel, as the bare rays are (and as the "embree" row's passes).
+    let one_spp = with_spp(&case.scene, 1);
     let layer = || {
-        trace_primary(&case.scene, &world);
+        trace_primary(&one_spp, &world);
     };
     let (mut bare_s, mut layer_s) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..PAIRED_BLOCKS {

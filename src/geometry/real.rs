@@ -28,6 +28,10 @@ pub trait Real:
     fn le(self, other: Self) -> Self::Mask;
     /// `if m { a } else { b }`, lane by lane.
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    /// Both masks, lane by lane (both evaluated, so the scalar form does not branch either).
+    /// (The Embree backend's rule for directions uses it, `accel::embree::scale`.)
+    #[cfg_attr(not(feature = "embree"), expect(dead_code))]
+    fn both(a: Self::Mask, b: Self::Mask) -> Self::Mask;
 }
 
 impl Real for f64 {
@@ -75,5 +79,9 @@ impl Real for f64 {
         } else {
             b
         }
+    }
+    #[inline(always)]
+    fn both(a: bool, b: bool) -> bool {
+        a & b
     }
 }

@@ -141,4 +141,8 @@ impl Real for F4 {
         // SAFETY: as for `F4::store`.
         F4(unsafe { _mm256_blendv_pd(b.0, a.0, m.0) })
     }
+    #[inline(always)]
+    fn both(a: F4, b: F4) -> F4 {
+        a.and(b)
+    }
 }

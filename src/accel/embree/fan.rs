@@ -15,7 +15,7 @@
 use super::exact::Lanes;
 use super::f64x4::F4;
 use super::packet::{flush_denormals, Reused, Valid};
-use super::{lane_geometry, EmbreeAccel, AS_THEY_ARE};
+use super::{lane_geometry, scale, EmbreeAccel, AS_THEY_ARE};
 use crate::accel::{Fan, FanHits, Ray, NO_HIT};
 use crate::geometry::Real;
 use crate::geometry::PACKET;
@@ -88,10 +88,7 @@ macro_rules! fan_packet {
                         let (org, du, tnear) = if raw {
                             lane_geometry(o, dir, splat(1.0), splat(0.0), pullback)
                         } else {
-                            let near_one =
-                                s.ge(splat(1.0 / AS_THEY_ARE)).and(s.le(splat(AS_THEY_ARE)));
-                            let k = F4::select(near_one, splat(1.0), s);
-                            lane_geometry(o, dir, k, splat(0.0), pullback)
+                            lane_geometry(o, dir, scale(s), splat(0.0), pullback)
                         };
                         let f32s = |x: F4, col: &mut [f32; N]| {
                             x.store_f32((&mut col[c..c + 4]).try_into().expect("four lanes"))
@@ -142,12 +139,11 @@ macro_rules! fan_packet {
                         // whether a lane hit: lanes hit or miss about at random, and the
                         // general read-back below cost ~1.5 ns per primary ray more.
                         for i in 0..n {
-                            let (g, t) = (rh.hit.geomID[i], ctx.exact_t(i));
-                            let hit = g != RTC_INVALID_GEOMETRY_ID;
-                            debug_assert!(!hit || (t > 0.0 && t < f64::INFINITY));
-                            let prim = runs.prim(g, rh.hit.primID[i]);
+                            let t = ctx.exact_t(i);
+                            let prim = runs.hit(rh.hit.geomID[i], rh.hit.primID[i]);
+                            debug_assert!(prim.is_none() || (t > 0.0 && t < f64::INFINITY));
                             out.t[first + i] = t;
-                            out.prim[first + i] = if hit { prim } else { NO_HIT };
+                            out.prim[first + i] = prim.unwrap_or(NO_HIT);
                         }
                         return;
                     }

@@ -120,14 +120,15 @@ const AS_THEY_ARE: f64 = 16.0;
 /// null directions are so long up to 0.99c, as a camera's unit ones are); else `len`, the
 /// unit direction, since far from 1 an unnormalised one would pull the origin back by that
 /// much more or less, out where f32 is coarser or into the rounding. Embree's t is then
-/// t · scale + pullback.
+/// t · scale + pullback. Written once for one ray or four (`Real`), so that the fans' lanes
+/// follow the rule of rays made one by one to the bit.
 #[inline(always)]
-fn scale(len: f64) -> f64 {
-    if (1.0 / AS_THEY_ARE..=AS_THEY_ARE).contains(&len) {
-        1.0
-    } else {
-        len
-    }
+fn scale<R: Real>(len: R) -> R {
+    let near = R::both(
+        len.ge(R::splat(1.0 / AS_THEY_ARE)),
+        len.le(R::splat(AS_THEY_ARE)),
+    );
+    R::select(near, R::splat(1.0), len)
 }
 
 /// A ray as it goes into Embree's f32 packet, before the cast, written once for one ray or
@@ -185,13 +186,13 @@ impl EmbreeAccel {
     /// t · `scale(r.len)` + pullback).
     #[inline(always)]
     fn to_hit(&self, r: &Ray, t_embree: f32, geom: u32, prim: u32, exact_t: f64) -> Option<Hit> {
-        let len = scale(r.len);
+        let k = scale(r.len);
         let (prim, exact) = self.scene.prim(geom, prim)?;
         if exact {
             return (exact_t > r.tmin && exact_t < r.tmax).then_some(Hit { t: exact_t, prim });
         }
-        let t = (t_embree as f64 - self.pullback) / len;
-        let slack = 1e-4 * t.abs().max(self.pullback / len) + 4.0 * self.pullback / len;
+        let t = (t_embree as f64 - self.pullback) / k;
+        let slack = 1e-4 * t.abs().max(self.pullback / k) + 4.0 * self.pullback / k;
         let p = &self.geometry.prims[prim as usize];
         let refined = p.intersect(
             r.origin,

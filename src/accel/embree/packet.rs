@@ -90,11 +90,17 @@ macro_rules! packet_fns {
                         // As the fans read hits back (`ExactRuns`): every hit exact, within the
                         // ray's (tmin, tmax), its primitive with no lookup.
                         for (i, r) in rays.iter().enumerate() {
-                            let (g, t) = (rh.hit.geomID[i], ctx.exact_t(i));
-                            let hit = valid.0[i] != 0 && g != RTC_INVALID_GEOMETRY_ID;
+                            let t = ctx.exact_t(i);
+                            let prim = runs.hit(rh.hit.geomID[i], rh.hit.primID[i]);
+                            let hit = valid.0[i] != 0 && prim.is_some();
                             debug_assert!(!hit || (t > r.tmin && t < r.tmax));
-                            let prim = runs.prim(g, rh.hit.primID[i]);
-                            hits[i] = hit.then_some(Hit { t, prim });
+                            // The hit made whether or not it is kept, so nothing branches
+                            // (`prim.filter(..).map(..)` measured 0.6 ns per ray slower).
+                            let h = Hit {
+                                t,
+                                prim: prim.unwrap_or_default(),
+                            };
+                            hits[i] = hit.then_some(h);
                         }
                         return;
                     }

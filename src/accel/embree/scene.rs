@@ -28,8 +28,9 @@ pub struct PrimMap {
 /// The scene primitives of an Embree scene whose every geometry is user geometry with exact
 /// hits and holds a run of the scene's primitives (`PrimMap::prims[i] = first + i`): the
 /// firsts, by geomID. A hit's primitive is then `first + primID` and its t the context's, read
-/// back with no lookup and no branch on whether a lane hit (`fan.rs`; the paper's lattice, the
-/// bar array and every scene of spheres and rods are such).
+/// back with no lookup and no branch on whether a lane hit (the fans in `fan.rs` and the
+/// packets in `packet.rs`; the paper's lattice, the bar array and every scene of spheres and
+/// rods are such).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ExactRuns([u32; ExactRuns::MAX]);
 
@@ -54,11 +55,12 @@ impl ExactRuns {
         Some(ExactRuns(firsts))
     }
 
-    /// The scene primitive an Embree hit names, for a geomID of the scene; some number for
-    /// any other (no hit), which the caller discards.
+    /// The scene primitive Embree's (geomID, primID) names, None for no hit: worked out
+    /// whether or not the lane hit, so that the callers' selects need no branch.
     #[inline(always)]
-    pub fn prim(&self, geom: u32, prim: u32) -> u32 {
-        self.0[geom as usize % ExactRuns::MAX].wrapping_add(prim)
+    pub fn hit(&self, geom: u32, prim: u32) -> Option<u32> {
+        let p = self.0[geom as usize % ExactRuns::MAX].wrapping_add(prim);
+        (geom != RTC_INVALID_GEOMETRY_ID).then_some(p)
     }
 }
 
@@ -281,10 +283,14 @@ mod tests {
     fn runs_of_exact_geometries_only() {
         let runs = ExactRuns::of(&[map(&[0, 1, 2], true), map(&[3, 4], true)]).unwrap();
         assert_eq!(
-            (runs.prim(0, 2), runs.prim(1, 0), runs.prim(1, 1)),
-            (2, 3, 4)
+            (runs.hit(0, 2), runs.hit(1, 0), runs.hit(1, 1)),
+            (Some(2), Some(3), Some(4))
         );
-        assert_eq!(ExactRuns::of(&[map(&[5], true)]).unwrap().prim(0, 0), 5);
+        assert_eq!(runs.hit(RTC_INVALID_GEOMETRY_ID, 0), None);
+        assert_eq!(
+            ExactRuns::of(&[map(&[5], true)]).unwrap().hit(0, 0),
+            Some(5)
+        );
         // Interleaved kinds (a sphere, a box, a sphere), a geometry refined after Embree
         // (triangles), an empty map, no geometry, more than there are kinds.
         for maps in [
