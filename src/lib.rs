@@ -15,3 +15,4 @@ pub mod render;
 pub mod rng;
 pub mod scene;
 pub mod spacetime;
+pub mod spectrum;

@@ -1,0 +1,172 @@
+//! The camera's spectral response: CIE 1931 2° colour matching to XYZ, then linear sRGB
+//! (IEC 61966-2-1 primaries, D65 white, no chromatic adaptation).
+//!
+//! The camera reads radiance at [`SAMPLES`] fixed wavelengths, the centres of equal bins over
+//! 380-780 nm; bin i weighs by the integral of x̄, ȳ, z̄ over the bin (trapezoids on the 1 nm
+//! table). Radiance that is constant over each bin is integrated exactly; docs/physics.md gives
+//! the error against the 1 nm integral for blackbodies, lines and the white.
+
+use super::cie_data::{CMF_1931, CMF_START, D65, D65_START, D65_STEP};
+use super::{planck, Sampled, SAMPLES};
+use glam::{DMat3, DVec3};
+use std::sync::OnceLock;
+
+/// The band the camera sees, nm.
+pub const BAND: (f64, f64) = (380.0, 780.0);
+
+/// XYZ to linear sRGB (IEC 61966-2-1's matrix, rows R, G, B).
+pub const XYZ_TO_SRGB: DMat3 = DMat3::from_cols_array(&[
+    3.2406, -0.9689, 0.0557, -1.5372, 1.8758, -0.2040, -0.4986, 0.0415, 1.0570,
+]);
+
+/// sRGB's chromaticities (red, green, blue, white) as the EXR header states them.
+pub const SRGB_CHROMATICITIES: [[f32; 2]; 4] =
+    [[0.64, 0.33], [0.30, 0.60], [0.15, 0.06], [0.3127, 0.3290]];
+
+struct Response {
+    lambda: [f64; SAMPLES],
+    /// x̄, ȳ, z̄ integrated over each bin.
+    xyz: [DVec3; SAMPLES],
+    /// The same weights carried to linear sRGB.
+    rgb: [DVec3; SAMPLES],
+    /// D65 over the quadrature's Y, so the white has Y = 1 exactly as the camera reads it.
+    white_scale: f64,
+}
+
+fn cmf_at(nm: f64) -> DVec3 {
+    let x = nm - CMF_START;
+    if x < 0.0 || x > (CMF_1931.len() - 1) as f64 {
+        return DVec3::ZERO;
+    }
+    let k = (x as usize).min(CMF_1931.len() - 2);
+    let t = x - k as f64;
+    DVec3::from(CMF_1931[k]).lerp(DVec3::from(CMF_1931[k + 1]), t)
+}
+
+fn response() -> &'static Response {
+    static R: OnceLock<Response> = OnceLock::new();
+    R.get_or_init(|| {
+        let width = (BAND.1 - BAND.0) / SAMPLES as f64;
+        let mut lambda = [0.0; SAMPLES];
+        let mut xyz = [DVec3::ZERO; SAMPLES];
+        for i in 0..SAMPLES {
+            let (a, b) = (BAND.0 + i as f64 * width, BAND.0 + (i + 1) as f64 * width);
+            lambda[i] = 0.5 * (a + b);
+            // Trapezoids through the table's points inside the bin and its two ends.
+            let mut pts = vec![a];
+            pts.extend((a.ceil() as i64..=b.floor() as i64).map(|n| n as f64));
+            pts.push(b);
+            pts.dedup();
+            xyz[i] = pts
+                .windows(2)
+                .map(|w| 0.5 * (cmf_at(w[0]) + cmf_at(w[1])) * (w[1] - w[0]))
+                .sum();
+        }
+        let rgb = xyz.map(|w| XYZ_TO_SRGB * w);
+        let y: f64 = (0..SAMPLES)
+            .map(|i| xyz[i].y * d65_extended(lambda[i]))
+            .sum();
+        Response {
+            lambda,
+            xyz,
+            rgb,
+            white_scale: 1.0 / y,
+        }
+    })
+}
+
+/// D65's relative power at `nm`, linear between its 5 nm table entries; beyond the table
+/// (300-780 nm) the Planck curve at 6504 K matched to the end value, so the white is defined,
+/// smooth and physically plausible at every wavelength.
+fn d65_extended(nm: f64) -> f64 {
+    let last = D65_START + D65_STEP * (D65.len() - 1) as f64;
+    if nm <= D65_START {
+        return D65[0] * planck(nm, 6504.0) / planck(D65_START, 6504.0);
+    }
+    if nm >= last {
+        return D65[D65.len() - 1] * planck(nm, 6504.0) / planck(last, 6504.0);
+    }
+    let x = (nm - D65_START) / D65_STEP;
+    let k = (x as usize).min(D65.len() - 2);
+    let t = x - k as f64;
+    D65[k] + t * (D65[k + 1] - D65[k])
+}
+
+/// The camera's wavelengths, nm (bin centres, increasing).
+pub fn wavelengths() -> &'static [f64; SAMPLES] {
+    &response().lambda
+}
+
+/// The white of RGB emitters at `nm`: D65 (extended by Planck's law at 6504 K beyond 300-780 nm),
+/// scaled so the camera reads it as Y = 1, which is linear sRGB (1, 1, 1) to the matrix's
+/// four digits.
+pub fn white(nm: f64) -> f64 {
+    d65_extended(nm) * response().white_scale
+}
+
+/// CIE XYZ of radiance sampled at the camera's wavelengths.
+pub fn xyz(s: &Sampled) -> DVec3 {
+    let r = response();
+    (0..SAMPLES).map(|i| r.xyz[i] * s.0[i]).sum()
+}
+
+/// Linear sRGB of radiance sampled at the camera's wavelengths.
+pub fn rgb(s: &Sampled) -> DVec3 {
+    let r = response();
+    let mut acc = DVec3::ZERO;
+    for i in 0..SAMPLES {
+        acc += r.rgb[i] * s.0[i];
+    }
+    acc
+}
+
+/// Linear sRGB of the radiance `f(nm)` at rest.
+pub fn rgb_of(f: impl Fn(f64) -> f64) -> DVec3 {
+    rgb(&Sampled(wavelengths().map(f)))
+}
+
+/// Chromaticity (x, y) of XYZ.
+pub fn chromaticity(xyz: DVec3) -> (f64, f64) {
+    let s = xyz.x + xyz.y + xyz.z;
+    (xyz.x / s, xyz.y / s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The white reads as Y = 1 and as sRGB (1, 1, 1) to the matrix's precision.
+    #[test]
+    fn the_white_is_white() {
+        let w = rgb_of(white);
+        assert!((w - DVec3::ONE).abs().max_element() < 1e-3, "{w}");
+        let y = xyz(&Sampled(wavelengths().map(white))).y;
+        assert!((y - 1.0).abs() < 1e-12, "{y}");
+    }
+
+    /// The 6504 K continuation meets D65's table at both ends.
+    #[test]
+    fn d65_is_continuous_at_its_ends() {
+        for end in [300.0, 780.0] {
+            let (a, b) = (d65_extended(end - 1e-9), d65_extended(end + 1e-9));
+            assert!((a - b).abs() < 1e-6 * a, "{end}: {a} vs {b}");
+        }
+        assert!(d65_extended(5000.0) > 0.0 && d65_extended(100.0) > 0.0);
+    }
+
+    /// The bins' weights hold the CMFs' integrals over the band (checked against the 1 nm
+    /// sum over 380-780 nm).
+    #[test]
+    fn weights_integrate_the_cmfs() {
+        let total: DVec3 = response().xyz.iter().sum();
+        let start = (BAND.0 - CMF_START) as usize;
+        let end = (BAND.1 - CMF_START) as usize;
+        let table: DVec3 = (start..=end)
+            .map(|k| {
+                let w = if k == start || k == end { 0.5 } else { 1.0 };
+                DVec3::from(CMF_1931[k]) * w
+            })
+            .sum();
+        assert!((total - table).abs().max_element() < 1e-9 * table.max_element());
+    }
+}
