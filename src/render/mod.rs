@@ -3,6 +3,7 @@
 //! shading in the rest frame of the surface hit.
 
 mod apparent_tree;
+mod band;
 mod camera;
 mod frame;
 mod group_tree;
@@ -14,6 +15,7 @@ mod tile;
 mod world;
 
 pub use apparent_tree::{apparent_box, ApparentTree};
+pub use band::{needs_spectra, Band, Seen};
 pub use camera::CameraRays;
 pub use frame::{Frame, PixelValue, CHANNELS};
 pub use group_tree::{world_box, GroupTree, SlicedGroupTree};
@@ -23,6 +25,8 @@ pub use world::{PrimaryHits, SurfaceHit, World, WorldOptions, GROUP_TREE_MIN};
 
 use crate::accel::Backend;
 use crate::scene::Scene;
+use crate::spectrum::Sampled;
+use glam::DVec3;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
@@ -124,6 +128,7 @@ pub fn render_world_passes(scene: &Scene, world: &World, passes: Passes) -> (Fra
     let (w, h) = scene.image.frame_size();
     let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
     let cull = ScreenCull::new(world, &cam);
+    let spectral = needs_spectra(scene);
     let mut frame = Frame::new(w, h);
     let band = (w * TILE) as usize;
     let per_band: Vec<(u64, u64)> = frame
@@ -135,8 +140,15 @@ pub fn render_world_passes(scene: &Scene, world: &World, passes: Passes) -> (Fra
             let (mut counts, mut scratch) = ((0, 0), tile::TileScratch::default());
             for x0 in (0..w).step_by(TILE as usize) {
                 let xy = (x0, y0);
-                let tile =
-                    tile::render_tile(scene, world, &cam, cull.as_ref(), xy, passes, &mut scratch);
+                let cull = cull.as_ref();
+                let tile = if spectral {
+                    let seen = Seen::of(scene);
+                    let s = &mut scratch;
+                    tile::render_tile::<Sampled>(seen, scene, world, &cam, cull, xy, passes, s)
+                } else {
+                    let s = &mut scratch;
+                    tile::render_tile::<DVec3>(Seen::NONE, scene, world, &cam, cull, xy, passes, s)
+                };
                 counts.0 += tile.primary_rays;
                 counts.1 += tile.nonfinite;
                 for p in tile.pixels {

@@ -1,11 +1,19 @@
 //! Whitted shading in the rest frame of the surface hit: Phong with shadow rays to point lights
 //! on their own worldlines, mirror reflection, and refraction with Fresnel. Every secondary ray
 //! is again a past-directed null ray, spawned in the surface's frame and boosted back.
+//!
+//! Shading works at the surface's rest-frame wavelengths, `shift` times the camera's. Light
+//! crossing into the surface's frame (from a light, or from another surface along a reflected
+//! or refracted ray) is shifted by the frequency ratio of the two frames along that ray, which
+//! the boosts give for free: a frame's lookback factor `s` for a world-frame direction is the
+//! photon's frequency there over its world-frame frequency ([`Boost::null_dir`]).
 
+use super::band::{Band, Seen};
 use super::world::{SurfaceHit, World};
 use crate::scene::{Light, Scene};
 use crate::spacetime::{Boost, Event, NullRay};
 use glam::DVec3;
+use std::marker::PhantomData;
 
 struct LightRt<'a> {
     light: &'a Light,
@@ -13,10 +21,12 @@ struct LightRt<'a> {
     from_light: Boost,
 }
 
-pub struct Shader<'a> {
+pub struct Shader<'a, B> {
     scene: &'a Scene,
     world: &'a World,
     lights: Vec<LightRt<'a>>,
+    seen: Seen,
+    band: PhantomData<B>,
 }
 
 fn reflect(v: DVec3, n: DVec3) -> DVec3 {
@@ -48,8 +58,9 @@ fn fresnel_refract(v: DVec3, n: DVec3, eta: f64) -> (f64, Option<DVec3>) {
     (0.5 * (rs * rs + rp * rp), Some(t))
 }
 
-impl<'a> Shader<'a> {
-    pub fn new(scene: &'a Scene, world: &'a World) -> Self {
+impl<'a, B: Band> Shader<'a, B> {
+    /// A shader whose changes of frame do what `seen` says (use [`Seen::NONE`] for RGB).
+    pub fn new(scene: &'a Scene, world: &'a World, seen: Seen) -> Self {
         let lights = scene
             .lights
             .iter()
@@ -63,15 +74,48 @@ impl<'a> Shader<'a> {
             scene,
             world,
             lights,
+            seen,
+            band: PhantomData,
         }
     }
 
-    /// The colour arriving along a world-frame null ray.
-    fn trace(&self, ray: &NullRay, depth: u32) -> DVec3 {
+    /// The light arriving along a world-frame null ray at a receiver whose lookback factor
+    /// for the ray's direction is `receiver_s` and whose wavelengths are `shift` times the
+    /// camera's, in the receiver's frame.
+    pub fn trace(&self, ray: &NullRay, receiver_s: f64, shift: f64, depth: u32) -> B {
         match self.world.closest_hit(ray, 0.0) {
-            Some(h) => self.shade(ray, &h, depth),
-            None => self.scene.image.background,
+            Some(h) => {
+                let (shift, k) = self.arriving(receiver_s, h.s, shift);
+                self.shade(ray, &h, shift, depth) * k
+            }
+            None => self.background(receiver_s, shift),
         }
+    }
+
+    /// The background (a sky at rest in the world frame, lookback factor 1) as a receiver
+    /// with lookback factor `receiver_s` and wavelengths `shift` times the camera's sees it.
+    pub fn background(&self, receiver_s: f64, shift: f64) -> B {
+        let (shift, k) = self.arriving(receiver_s, 1.0, shift);
+        B::of(&self.scene.image.background, shift) * k
+    }
+
+    /// Radiance from a sender with lookback factor `sender_s` reaching a receiver with
+    /// `receiver_s` (both for the ray's world-frame direction; D = ν_receiver / ν_sender is
+    /// their ratio): the sender's wavelength shift, and the factor on its radiance.
+    pub fn arriving(&self, receiver_s: f64, sender_s: f64, shift: f64) -> (f64, f64) {
+        if !self.seen.any() {
+            return (shift, 1.0);
+        }
+        self.seen.radiance(receiver_s / sender_s, shift)
+    }
+
+    /// A group's lookback factor for a world-frame direction (1 where no change of frame
+    /// alters light, so it need not be computed).
+    fn lookback_factor(&self, group: usize, dir_w: DVec3) -> f64 {
+        if !self.seen.any() {
+            return 1.0;
+        }
+        self.world.groups[group].boost.null_dir(dir_w).1
     }
 
     /// Spawn a secondary ray at a hit: rest-frame direction `dir`, origin pushed off the
@@ -84,17 +128,23 @@ impl<'a> Shader<'a> {
         NullRay::new(hit_event + offset, dir_w)
     }
 
-    /// The colour of a hit: its light from each light not in shadow, and what it reflects
-    /// and transmits.
-    pub fn shade(&self, ray: &NullRay, hit: &SurfaceHit, depth: u32) -> DVec3 {
+    /// The light leaving a hit toward the ray's origin, in the surface's frame at wavelengths
+    /// `shift` times the camera's: its light from each light not in shadow, and what it
+    /// reflects and transmits.
+    pub fn shade(&self, ray: &NullRay, hit: &SurfaceHit, shift: f64, depth: u32) -> B {
         let mut shadows = Vec::with_capacity(self.lights.len());
-        let lit = self.prepare(ray, hit, &mut shadows);
+        let lit = self.prepare(ray, hit, shift, &mut shadows);
         self.finish(
             &lit,
             &shadows,
             |light, q| !self.world.shadowed(light, &q.ray, q.tmax),
             depth,
         )
+    }
+
+    /// Whether changes of frame alter light (else every receiver's lookback factor may be 1).
+    pub fn follows_frames(&self) -> bool {
+        self.seen.any()
     }
 
     pub fn light_count(&self) -> usize {
@@ -104,12 +154,14 @@ impl<'a> Shader<'a> {
     /// Everything about a hit's shading that does not depend on other rays: the ambient and
     /// emitted light, and (appended to `shadows`, one entry per light, None where the light
     /// cannot reach the surface) each light's contribution and the shadow ray that decides it.
+    /// `shift`: the surface frame's wavelengths over the camera's.
     pub fn prepare(
         &self,
         ray: &NullRay,
         hit: &SurfaceHit,
-        shadows: &mut Vec<Option<ShadowQuery>>,
-    ) -> Lit<'a> {
+        shift: f64,
+        shadows: &mut Vec<Option<ShadowQuery<B>>>,
+    ) -> Lit<'a, B> {
         let scene = self.scene;
         let g = &self.world.groups[hit.group];
         let prim = &g.geometry.prims[hit.prim as usize];
@@ -119,20 +171,30 @@ impl<'a> Shader<'a> {
         let inside = n.dot(v) > 0.0;
         let nf = if inside { -n } else { n };
         let event = ray.at(hit.lambda);
-        let mut lit = Lit {
+        if let Some(e) = &mat.emission {
+            shadows.extend(self.lights.iter().map(|_| None));
+            return Lit {
+                mat,
+                group: hit.group,
+                event,
+                v,
+                nf,
+                inside,
+                shift,
+                base: B::of(e, shift),
+            };
+        }
+        let color = B::of(&mat.color, shift);
+        let lit = Lit {
             mat,
             group: hit.group,
             event,
             v,
             nf,
             inside,
-            base: scene.render.ambient * mat.color,
+            shift,
+            base: B::of(&scene.render.ambient, shift) * color,
         };
-        if let Some(e) = mat.emission {
-            lit.base = e;
-            shadows.extend(self.lights.iter().map(|_| None));
-            return lit;
-        }
         if self.lights.is_empty() {
             return lit;
         }
@@ -147,7 +209,7 @@ impl<'a> Shader<'a> {
                 return None;
             }
             let (dir_w, k) = l.from_light.view_dir(delta / dist);
-            let to_light = g.boost.view_dir(dir_w).0;
+            let (to_light, s_surface) = g.boost.view_dir(dir_w);
             let ndl = nf.dot(to_light);
             if ndl <= 0.0 {
                 return None;
@@ -157,15 +219,21 @@ impl<'a> Shader<'a> {
             } else {
                 1.0
             };
-            let mut term = mat.color * ndl;
-            if mat.specular != DVec3::ZERO {
+            let mut term = color * ndl;
+            if !mat.specular.is_black() {
                 let r = reflect(-to_light, nf);
-                term += mat.specular * highlight(r.dot(-v).max(0.0), mat.shininess);
+                term += B::of(&mat.specular, shift) * highlight(r.dot(-v).max(0.0), mat.shininess);
             }
+            // D_in = ν_surface / ν_light: k is ν_world / ν_light, s_surface ν_surface / ν_world.
+            let (light_shift, k_in) = if self.seen.any() {
+                self.seen.irradiance(k * s_surface, shift)
+            } else {
+                (shift, 1.0)
+            };
             Some(ShadowQuery {
                 ray: NullRay::new(from, dir_w),
                 tmax: dist * k * (1.0 - 1e-9),
-                light: l.light.radiance * atten * term,
+                light: B::of(&l.light.radiance, light_shift) * atten * term * k_in,
             })
         }));
         lit
@@ -175,11 +243,11 @@ impl<'a> Shader<'a> {
     /// that light's shadow ray reaches it.
     pub fn finish(
         &self,
-        lit: &Lit,
-        shadows: &[Option<ShadowQuery>],
-        reaches: impl Fn(usize, &ShadowQuery) -> bool,
+        lit: &Lit<B>,
+        shadows: &[Option<ShadowQuery<B>>],
+        reaches: impl Fn(usize, &ShadowQuery<B>) -> bool,
         depth: u32,
-    ) -> DVec3 {
+    ) -> B {
         let mat = lit.mat;
         if mat.emission.is_some() {
             return lit.base;
@@ -213,33 +281,37 @@ impl<'a> Shader<'a> {
         }
         if kr > 0.0 {
             let r = self.spawn(lit.group, event, nf, reflect(v, nf));
-            color += kr * self.trace(&r, depth + 1);
+            let s = self.lookback_factor(lit.group, r.dir);
+            color += self.trace(&r, s, lit.shift, depth + 1) * kr;
         }
         if let (Some(t), true) = (refracted, kt > 0.0) {
             let r = self.spawn(lit.group, event, -nf, t);
-            color += kt * self.trace(&r, depth + 1);
+            let s = self.lookback_factor(lit.group, r.dir);
+            color += self.trace(&r, s, lit.shift, depth + 1) * kt;
         }
         color
     }
 }
 
 /// A shadow ray to one light, and the light it brings if nothing is in the way.
-pub struct ShadowQuery {
+pub struct ShadowQuery<B> {
     pub ray: NullRay,
     pub tmax: f64,
-    light: DVec3,
+    light: B,
 }
 
 /// A hit prepared for shading: see [`Shader::prepare`].
-pub struct Lit<'a> {
+pub struct Lit<'a, B> {
     mat: &'a crate::scene::Material,
     group: usize,
     event: Event,
     v: DVec3,
     nf: DVec3,
     inside: bool,
+    /// The surface frame's wavelengths over the camera's.
+    shift: f64,
     /// Ambient (or emitted) light.
-    base: DVec3,
+    base: B,
 }
 
 #[cfg(test)]

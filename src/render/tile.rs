@@ -1,6 +1,7 @@
 //! A tile of pixels: its primary rays (in 4 × 4 blocks, so a 16-wide packet is a square of
 //! neighbouring pixels), traced together through every group, then shaded one by one.
 
+use super::band::{Band, Seen};
 use super::camera::CameraRays;
 use super::frame::PixelValue;
 use super::sampler::sample_offset;
@@ -189,23 +190,37 @@ pub fn trace_tile(
     (n as u64 * t.total as u64, found)
 }
 
-/// The colours of primary hits (background where none), with the shadow rays of all of them
-/// traced together, light by light, so they go to the backends in packets.
-fn shade_hits(
-    shader: &Shader,
+/// The colours (linear sRGB) of primary hits (background where none), with the shadow rays of
+/// all of them traced together, light by light, so they go to the backends in packets.
+fn shade_hits<B: Band>(
+    shader: &Shader<B>,
     world: &World,
+    cam: &CameraRays,
     primary: &PrimaryHits,
-    background: DVec3,
 ) -> Vec<DVec3> {
     // One entry per light and hit (None where there is no shadow ray), hit-major.
     let lights = shader.light_count();
+    let follows = shader.follows_frames();
     let mut shadows = Vec::with_capacity(lights * primary.len());
+    // Each ray's hit prepared for shading with the factor its light gains on the way to the
+    // camera, or the camera's lookback factor along a ray that meets nothing.
     let lits: Vec<_> = (0..primary.len())
-        .map(|i| match primary.hit(i) {
-            Some(h) => Some(shader.prepare(&primary.ray(i), &h, &mut shadows)),
-            None => {
-                shadows.extend((0..lights).map(|_| None));
-                None
+        .map(|i| {
+            let ray = primary.ray(i);
+            let camera_s = if follows {
+                cam.lookback_factor(ray.dir)
+            } else {
+                1.0
+            };
+            match primary.hit(i) {
+                Some(h) => {
+                    let (shift, k) = shader.arriving(camera_s, h.s, 1.0);
+                    Ok((shader.prepare(&ray, &h, shift, &mut shadows), k))
+                }
+                None => {
+                    shadows.extend((0..lights).map(|_| None));
+                    Err(camera_s)
+                }
             }
         })
         .collect();
@@ -230,11 +245,14 @@ fn shade_hits(
     }
     lits.iter()
         .enumerate()
-        .map(|(k, lit)| {
-            let mine = k * lights..(k + 1) * lights;
-            lit.as_ref().map_or(background, |l| {
-                shader.finish(l, &shadows[mine], |light, _| visible[k * lights + light], 0)
-            })
+        .map(|(k, lit)| match lit {
+            Ok((l, factor)) => {
+                let mine = k * lights..(k + 1) * lights;
+                let seen =
+                    shader.finish(l, &shadows[mine], |light, _| visible[k * lights + light], 0);
+                (seen * *factor).to_rgb()
+            }
+            Err(camera_s) => shader.background(*camera_s, 1.0).to_rgb(),
         })
         .collect()
 }
@@ -251,7 +269,11 @@ pub struct TileResult {
     pub nonfinite: u64,
 }
 
-pub fn render_tile(
+/// Render one tile, carrying light as `B` (RGB, or radiance at the camera's wavelengths) with
+/// changes of frame doing what `seen` says.
+#[allow(clippy::too_many_arguments)]
+pub fn render_tile<B: Band>(
+    seen: Seen,
     scene: &Scene,
     world: &World,
     cam: &CameraRays,
@@ -265,9 +287,28 @@ pub fn render_tile(
     let (w, h) = scene.image.frame_size();
     let coords = tile_pixels(x0, y0, w, h);
     let n = scene.image.samples;
-    let shader = Shader::new(scene, world);
-    // Pixels left out by the cull see the background in every sample.
-    let mut sum = vec![n as f64 * scene.image.background; coords.len()];
+    let shader = Shader::<B>::new(scene, world, seen);
+    // Pixels left out by the cull see the background in every sample: the same everywhere
+    // unless the camera moves through a background that is not black (then each pixel's, as
+    // seen along its centre ray).
+    let still = scene.camera.velocity.is_zero()
+        || !shader.follows_frames()
+        || scene.image.background.is_black();
+    let mut sum = if still {
+        vec![n as f64 * shader.background(1.0, 1.0).to_rgb(); coords.len()]
+    } else {
+        coords
+            .iter()
+            .map(|&(x, y)| {
+                let (ox, oy) = offset;
+                let ray = cam.ray((x + ox) as f64 + 0.5, (y + oy) as f64 + 0.5);
+                n as f64
+                    * shader
+                        .background(cam.lookback_factor(ray.dir), 1.0)
+                        .to_rgb()
+            })
+            .collect()
+    };
     for &k in live {
         sum[k] = DVec3::ZERO;
     }
@@ -292,7 +333,7 @@ pub fn render_tile(
         let colors = if centre {
             Vec::new()
         } else {
-            shade_hits(&shader, world, primary, scene.image.background)
+            shade_hits(&shader, world, cam, primary)
         };
         for (j, &k) in live.iter().enumerate() {
             if !centre {

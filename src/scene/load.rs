@@ -7,6 +7,7 @@ use super::reader::{Table, R};
 use super::SceneError;
 use crate::geometry::{Geometry, Primitive};
 use crate::spacetime::Velocity;
+use crate::spectrum::{Colour, Role};
 use glam::DVec3;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -73,7 +74,7 @@ fn build(doc: &Doc) -> R<Scene> {
             width: 512,
             height: 512,
             samples: 1,
-            background: DVec3::ZERO,
+            background: Colour::grey(0.0, Role::Emitter),
             crop: None,
         },
     };
@@ -81,7 +82,9 @@ fn build(doc: &Doc) -> R<Scene> {
         Some(t) => render_settings(&t)?,
         None => RenderSettings {
             max_depth: 5,
-            ambient: DVec3::splat(0.1),
+            ambient: Colour::grey(0.1, Role::Emitter),
+            doppler: true,
+            searchlight: true,
         },
     };
     let mut materials = vec![Material::default_white()];
@@ -338,7 +341,9 @@ fn image(t: &Table) -> R<ImageSettings> {
         width,
         height,
         samples: t.uint("samples", Some(1), 1, 4096)? as u32,
-        background: t.color("background")?.unwrap_or(DVec3::ZERO),
+        background: t
+            .colour("background", Role::Emitter)?
+            .unwrap_or_else(|| Colour::grey(0.0, Role::Emitter)),
         crop,
     };
     let (fw, fh) = s.frame_size();
@@ -355,9 +360,13 @@ fn image(t: &Table) -> R<ImageSettings> {
 fn render_settings(t: &Table) -> R<RenderSettings> {
     let s = RenderSettings {
         max_depth: t.uint("max_depth", Some(5), 0, 64)? as u32,
-        ambient: t.color("ambient")?.unwrap_or(DVec3::splat(0.1)),
+        ambient: t
+            .colour("ambient", Role::Emitter)?
+            .unwrap_or_else(|| Colour::grey(0.1, Role::Emitter)),
+        doppler: t.bool_or("doppler", true)?,
+        searchlight: t.bool_or("searchlight", true)?,
     };
-    t.finish(&["max_depth", "ambient"])?;
+    t.finish(&["max_depth", "ambient", "doppler", "searchlight"])?;
     Ok(s)
 }
 
@@ -366,13 +375,15 @@ fn material(t: &Table) -> R<Material> {
     let unit = |v: f64| (0.0..=1.0).contains(&v);
     let m = Material {
         name: t.req_string("name")?.to_string(),
-        color: t.color("color")?.unwrap_or(d.color),
-        specular: t.color("specular")?.unwrap_or(d.specular),
+        color: t.colour("color", Role::Reflectance)?.unwrap_or(d.color),
+        specular: t
+            .colour("specular", Role::Reflectance)?
+            .unwrap_or(d.specular),
         shininess: t.f64_where("shininess", Some(d.shininess), |v| v >= 0.0, "0 or more")?,
         reflect: t.f64_where("reflect", Some(0.0), unit, "between 0 and 1")?,
         transmit: t.f64_where("transmit", Some(0.0), unit, "between 0 and 1")?,
         ior: t.f64_where("ior", Some(d.ior), |v| v >= 1.0, "1 or more")?,
-        emission: t.color("emission")?,
+        emission: t.colour("emission", Role::Emitter)?,
     };
     t.finish(&[
         "name",
@@ -390,7 +401,9 @@ fn material(t: &Table) -> R<Material> {
 fn light(t: &Table, groups: &[Group]) -> R<Light> {
     let position = t.req_vec3("position")?;
     let intensity = t.f64_where("intensity", Some(1.0), |v| v >= 0.0, "0 or more")?;
-    let color = t.color("color")?.unwrap_or(DVec3::ONE);
+    let color = t
+        .colour("color", Role::Emitter)?
+        .unwrap_or_else(|| Colour::grey(1.0, Role::Emitter));
     let own = velocity(t, "velocity_direction")?;
     let velocity = match (t.string("group")?, own) {
         (Some(_), Some(_)) => {
@@ -438,7 +451,7 @@ fn light(t: &Table, groups: &[Group]) -> R<Light> {
     ])?;
     Ok(Light {
         position,
-        radiance: color * intensity,
+        radiance: color.scaled(intensity),
         velocity,
         inverse_square,
     })

@@ -1,6 +1,7 @@
 //! The scene: its description (camera, image, materials, lights, velocity groups), the TOML
 //! loader with errors that name file, line and key, `--set` overrides, and procedural objects.
 
+mod colour;
 mod doc;
 mod error;
 mod load;

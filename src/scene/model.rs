@@ -1,5 +1,6 @@
 use crate::geometry::Geometry;
 use crate::spacetime::{Boost, Event, Velocity};
+use crate::spectrum::{Colour, Role};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -38,7 +39,8 @@ pub struct ImageSettings {
     pub width: u32,
     pub height: u32,
     pub samples: u32,
-    pub background: DVec3,
+    /// What a ray that meets nothing sees: radiance of a sky at rest in the world frame.
+    pub background: Colour,
     /// Render only this window `[x, y, width, height]` of the full image (pixels).
     pub crop: Option<[u32; 4]>,
 }
@@ -60,28 +62,45 @@ impl ImageSettings {
 pub struct RenderSettings {
     /// Reflection/refraction bounces after the primary hit.
     pub max_depth: u32,
-    pub ambient: DVec3,
+    /// Light every surface receives in its own rest frame (a rendering convenience, not
+    /// shifted), times its reflectance.
+    pub ambient: Colour,
+    /// Shift wavelengths at every change of frame along a path (the Doppler effect).
+    pub doppler: bool,
+    /// Scale radiance by D⁴ (and a point light's irradiance by D²) at every change of frame
+    /// (the searchlight effect).
+    pub searchlight: bool,
+}
+
+impl RenderSettings {
+    /// Whether any change of frame alters the light (either switch on).
+    pub fn shifts_light(&self) -> bool {
+        self.doppler || self.searchlight
+    }
 }
 
 /// A rest-frame surface description: Phong plus Whitted mirror and dielectric terms.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
-    pub color: DVec3,
-    pub specular: DVec3,
+    /// Diffuse reflectance.
+    pub color: Colour,
+    /// Phong highlight's reflectance.
+    pub specular: Colour,
     pub shininess: f64,
     pub reflect: f64,
     pub transmit: f64,
     pub ior: f64,
-    pub emission: Option<DVec3>,
+    /// Radiance emitted in the surface's rest frame (the surface then reflects nothing).
+    pub emission: Option<Colour>,
 }
 
 impl Material {
     pub fn default_white() -> Material {
         Material {
             name: "default".into(),
-            color: DVec3::splat(0.8),
-            specular: DVec3::ZERO,
+            color: Colour::grey(0.8, Role::Reflectance),
+            specular: Colour::grey(0.0, Role::Reflectance),
             shininess: 32.0,
             reflect: 0.0,
             transmit: 0.0,
@@ -96,7 +115,8 @@ impl Material {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Light {
     pub position: DVec3,
-    pub radiance: DVec3,
+    /// Radiant intensity in the light's rest frame: its colour times its intensity.
+    pub radiance: Colour,
     pub velocity: Velocity,
     pub inverse_square: bool,
 }
