@@ -65,16 +65,19 @@ fn mismatch_share(a: &Frame, b: &Frame) -> f64 {
 fn objects_moving_at_v_equal_camera_moving_at_minus_v() {
     let v = DVec3::new(0.6, -0.3, 0.2);
     let (t0, x0) = (14.0, DVec3::new(0.5, -3.0, 0.7));
-    // Scene A: world = the camera's frame; the group moves at v; the light moves with the group.
+    // Scene A: world = the camera's frame; the group moves at v; one light moves with the
+    // group, a blackbody light stays with the camera (so light crosses frames on every leg:
+    // the colours are spectral, Doppler-shifted and searchlight-scaled in both scenes).
     let a_text = scene_text(
         &format!(
             "position = [{}, {}, {}]\ntime = {t0}\ndirection = [0.1, 1, 0.05]",
             x0.x, x0.y, x0.z
         ),
         v,
-        "position = [3, 2, 8]\ngroup = \"g\"",
+        "position = [3, 2, 8]\ngroup = \"g\"\n[[light]]\nposition = [-2, 1, 6]\ncolor = { blackbody = 4500, luminance = 0.6 }",
     );
-    // Scene B: world = the group's frame; the same imaging event, boosted; the camera moves at −v.
+    // Scene B: world = the group's frame; the same imaging event, boosted; the camera and the
+    // second light move at −v (that light's frame is A's world, so its position is the same).
     let e = Boost::to_rest(&Velocity::from_beta_vec(v).unwrap()).event(Event::new(t0, x0));
     let b_text = scene_text(
         &format!(
@@ -82,11 +85,16 @@ fn objects_moving_at_v_equal_camera_moving_at_minus_v() {
             e.x.x, e.x.y, e.x.z, e.t, -v.x, -v.y, -v.z
         ),
         DVec3::ZERO,
-        "position = [3, 2, 8]",
+        &format!(
+            "position = [3, 2, 8]\n[[light]]\nposition = [-2, 1, 6]\ncolor = {{ blackbody = 4500, luminance = 0.6 }}\nvelocity = [{}, {}, {}]",
+            -v.x, -v.y, -v.z
+        ),
     );
     for backend in backends() {
-        let a = render_with(&scene(&a_text), backend);
-        let b = render_with(&scene(&b_text), backend);
+        let (sa, sb) = (scene(&a_text), scene(&b_text));
+        assert!(rest_embree::render::needs_spectra(&sa) && rest_embree::render::needs_spectra(&sb));
+        let a = render_with(&sa, backend);
+        let b = render_with(&sb, backend);
         let hit = a.pixels.iter().filter(|p| p.object_id != 0).count();
         assert!(
             hit > a.pixels.len() / 25,
