@@ -71,7 +71,7 @@ fn a_moving_blackbody_looks_like_a_blackbody_at_d_t() {
     let t = 5000.0;
     let emission = |k: f64| format!("{{ blackbody = {k:?}, scale = 1e-7 }}");
     for backend in backends() {
-        for beta in [-0.3, 0.3, -0.6] {
+        for beta in [-0.3f64, 0.3, -0.6] {
             // β < 0: approaching (D > 1); β > 0: receding.
             let moving = render_with(
                 &scene(&glowing_sphere(&emission(t), rest_x(beta), beta)),
@@ -79,7 +79,7 @@ fn a_moving_blackbody_looks_like_a_blackbody_at_d_t() {
             );
             let p = centre(&moving);
             let d = f64::from(p.doppler);
-            let phi = (-beta as f64).atanh();
+            let phi = (-beta).atanh();
             assert_rel(d, phi.exp(), 1e-6, "head-on D = e^φ");
             let still = render_with(
                 &scene(&glowing_sphere(&emission(d * t), 50.0, 0.0)),
@@ -106,7 +106,7 @@ fn a_moving_blackbody_looks_like_a_blackbody_at_d_t() {
 #[test]
 fn a_moving_line_is_a_shifted_line() {
     for backend in backends() {
-        for beta in [-0.2, 0.25] {
+        for beta in [-0.2f64, 0.25] {
             let line = "{ line = 560, fwhm = 60, scale = 0.05 }";
             let moving = render_with(&scene(&glowing_sphere(line, rest_x(beta), beta)), backend);
             let p = centre(&moving);
@@ -194,9 +194,9 @@ fn bb_light(position: &str, kelvin: f64, scale: f64, group: bool) -> String {
 fn a_plate_approaching_a_light_at_the_camera() {
     let (t, s, d) = (4000.0, 1e-2, 20.0);
     for backend in backends() {
-        for beta in [0.1, 0.5, -0.5] {
+        for beta in [0.1f64, 0.5, -0.5] {
             // β > 0: the plate approaches (moves along −x toward the camera).
-            let phi = (beta as f64).atanh();
+            let phi = beta.atanh();
             // Front face seen at distance d now: reflected at t = −d at x = d, moving at −β:
             // x' = γ(x + βt) = d e^{−φ}.
             let front = d * (-phi).exp();
@@ -245,8 +245,8 @@ fn a_plate_approaching_a_light_at_the_camera() {
 fn a_plate_passing_sideways_dims_by_gamma_cubed() {
     let (t, s, d) = (5500.0, 1e-2, 20.0);
     for backend in backends() {
-        for beta in [0.5, 0.9] {
-            let g = 1.0 / (1.0 - beta * beta as f64).sqrt();
+        for beta in [0.5f64, 0.9] {
+            let g = 1.0 / (1.0 - beta * beta).sqrt();
             // Reflected at t = −d at (0, d, 0), moving at +β along x: x' = γ(x − βt) = γβd.
             let x = g * beta * d;
             let moving = plate(
@@ -283,8 +283,8 @@ fn a_plate_passing_sideways_dims_by_gamma_cubed() {
 fn a_light_riding_with_the_plate_shifts_by_d_out_alone() {
     let (t, s, d) = (4000.0, 1e-2, 20.0);
     for backend in backends() {
-        for beta in [0.5, -0.3] {
-            let phi = (beta as f64).atanh();
+        for beta in [0.5f64, -0.3] {
+            let phi = beta.atanh();
             let front = d * (-phi).exp();
             // The light 3 units in front of the plate and 1 up, in the plate's frame.
             let light = format!("[{:?}, 0, 1]", front - 3.0);
