@@ -19,6 +19,25 @@ pub trait Band:
     fn of(c: &Colour, shift: f64) -> Self;
     /// What the camera records of it (linear sRGB).
     fn to_rgb(&self) -> DVec3;
+
+    /// The light a point light sends off a surface: `light · atten · (diffuse · ndl +
+    /// specular · highlight) · k`, where `glint` is the specular reflectance and highlight.
+    /// The default is the RGB render's order of operations; a band may fuse it.
+    #[inline]
+    fn lit_by(
+        light: Self,
+        atten: f64,
+        diffuse: Self,
+        ndl: f64,
+        glint: Option<(Self, f64)>,
+        k: f64,
+    ) -> Self {
+        let mut term = diffuse * ndl;
+        if let Some((spec, h)) = glint {
+            term += spec * h;
+        }
+        light * atten * term * k
+    }
 }
 
 impl Band for DVec3 {
@@ -34,10 +53,37 @@ impl Band for DVec3 {
 impl Band for Sampled {
     const ZERO: Self = Sampled::ZERO;
     fn of(c: &Colour, shift: f64) -> Self {
-        Sampled::of(&c.spectrum, shift)
+        c.sampled(shift)
     }
     fn to_rgb(&self) -> DVec3 {
         camera::rgb(self)
+    }
+
+    /// One pass over the wavelengths.
+    #[inline]
+    fn lit_by(
+        light: Self,
+        atten: f64,
+        diffuse: Self,
+        ndl: f64,
+        glint: Option<(Self, f64)>,
+        k: f64,
+    ) -> Self {
+        let a = atten * k;
+        let mut out = light;
+        match glint {
+            Some((spec, h)) => {
+                for i in 0..out.0.len() {
+                    out.0[i] *= (diffuse.0[i] * ndl + spec.0[i] * h) * a;
+                }
+            }
+            None => {
+                for i in 0..out.0.len() {
+                    out.0[i] *= diffuse.0[i] * (ndl * a);
+                }
+            }
+        }
+        out
     }
 }
 

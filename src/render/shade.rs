@@ -147,6 +147,11 @@ impl<'a, B: Band> Shader<'a, B> {
         self.seen.any()
     }
 
+    /// Whether the background is black at every wavelength (then a miss needs no spectrum).
+    pub fn black_background(&self) -> bool {
+        self.scene.image.background.is_black()
+    }
+
     pub fn light_count(&self) -> usize {
         self.lights.len()
     }
@@ -160,8 +165,8 @@ impl<'a, B: Band> Shader<'a, B> {
         ray: &NullRay,
         hit: &SurfaceHit,
         shift: f64,
-        shadows: &mut Vec<Option<ShadowQuery<B>>>,
-    ) -> Lit<'a, B> {
+        shadows: &mut Vec<Option<ShadowQuery>>,
+    ) -> Lit<'a> {
         let scene = self.scene;
         let g = &self.world.groups[hit.group];
         let prim = &g.geometry.prims[hit.prim as usize];
@@ -171,20 +176,6 @@ impl<'a, B: Band> Shader<'a, B> {
         let inside = n.dot(v) > 0.0;
         let nf = if inside { -n } else { n };
         let event = ray.at(hit.lambda);
-        if let Some(e) = &mat.emission {
-            shadows.extend(self.lights.iter().map(|_| None));
-            return Lit {
-                mat,
-                group: hit.group,
-                event,
-                v,
-                nf,
-                inside,
-                shift,
-                base: B::of(e, shift),
-            };
-        }
-        let color = B::of(&mat.color, shift);
         let lit = Lit {
             mat,
             group: hit.group,
@@ -193,11 +184,15 @@ impl<'a, B: Band> Shader<'a, B> {
             nf,
             inside,
             shift,
-            base: B::of(&scene.render.ambient, shift) * color,
         };
+        if mat.emission.is_some() {
+            shadows.extend(self.lights.iter().map(|_| None));
+            return lit;
+        }
         if self.lights.is_empty() {
             return lit;
         }
+        let glints = !mat.specular.is_black();
         let from = self.spawn(hit.group, event, nf, nf).origin;
         shadows.extend(self.lights.iter().map(|l| {
             // The emission event on the light's worldline that lies on `from`'s past light
@@ -219,11 +214,10 @@ impl<'a, B: Band> Shader<'a, B> {
             } else {
                 1.0
             };
-            let mut term = color * ndl;
-            if !mat.specular.is_black() {
+            let highlight = glints.then(|| {
                 let r = reflect(-to_light, nf);
-                term += B::of(&mat.specular, shift) * highlight(r.dot(-v).max(0.0), mat.shininess);
-            }
+                highlight(r.dot(-v).max(0.0), mat.shininess)
+            });
             // D_in = ν_surface / ν_light: k is ν_world / ν_light, s_surface ν_surface / ν_world.
             let (light_shift, k_in) = if self.seen.any() {
                 self.seen.irradiance(k * s_surface, shift)
@@ -233,7 +227,13 @@ impl<'a, B: Band> Shader<'a, B> {
             Some(ShadowQuery {
                 ray: NullRay::new(from, dir_w),
                 tmax: dist * k * (1.0 - 1e-9),
-                light: B::of(&l.light.radiance, light_shift) * atten * term * k_in,
+                term: LightTerm {
+                    shift: light_shift,
+                    atten,
+                    ndl,
+                    highlight,
+                    k: k_in,
+                },
             })
         }));
         lit
@@ -243,19 +243,24 @@ impl<'a, B: Band> Shader<'a, B> {
     /// that light's shadow ray reaches it.
     pub fn finish(
         &self,
-        lit: &Lit<B>,
-        shadows: &[Option<ShadowQuery<B>>],
-        reaches: impl Fn(usize, &ShadowQuery<B>) -> bool,
+        lit: &Lit,
+        shadows: &[Option<ShadowQuery>],
+        reaches: impl Fn(usize, &ShadowQuery) -> bool,
         depth: u32,
     ) -> B {
-        let mat = lit.mat;
-        if mat.emission.is_some() {
-            return lit.base;
+        let (mat, shift) = (lit.mat, lit.shift);
+        if let Some(e) = &mat.emission {
+            return B::of(e, shift);
         }
-        let mut color = lit.base;
+        let diffuse = B::of(&mat.color, shift);
+        let mut color = B::of(&self.scene.render.ambient, shift) * diffuse;
+        let specular = (!mat.specular.is_black()).then(|| B::of(&mat.specular, shift));
         for (l, q) in shadows.iter().enumerate() {
             if let Some(q) = q.as_ref().filter(|q| reaches(l, q)) {
-                color += q.light;
+                let t = &q.term;
+                let light = B::of(&self.lights[l].light.radiance, t.shift);
+                let glint = specular.zip(t.highlight);
+                color += B::lit_by(light, t.atten, diffuse, t.ndl, glint, t.k);
             }
         }
         if depth >= self.scene.render.max_depth {
@@ -293,15 +298,27 @@ impl<'a, B: Band> Shader<'a, B> {
     }
 }
 
-/// A shadow ray to one light, and the light it brings if nothing is in the way.
-pub struct ShadowQuery<B> {
+/// A shadow ray to one light, and what decides the light it brings if nothing is in the way.
+pub struct ShadowQuery {
     pub ray: NullRay,
     pub tmax: f64,
-    light: B,
+    term: LightTerm,
+}
+
+/// A light's term at a hit, but for the spectra (evaluated only if the light is seen):
+/// `light(shift) · atten · (diffuse · ndl + specular · highlight) · k`.
+struct LightTerm {
+    /// The light's wavelengths over the camera's.
+    shift: f64,
+    atten: f64,
+    ndl: f64,
+    highlight: Option<f64>,
+    /// What the change of frame from the light's to the surface's does to its irradiance.
+    k: f64,
 }
 
 /// A hit prepared for shading: see [`Shader::prepare`].
-pub struct Lit<'a, B> {
+pub struct Lit<'a> {
     mat: &'a crate::scene::Material,
     group: usize,
     event: Event,
@@ -310,8 +327,6 @@ pub struct Lit<'a, B> {
     inside: bool,
     /// The surface frame's wavelengths over the camera's.
     shift: f64,
-    /// Ambient (or emitted) light.
-    base: B,
 }
 
 #[cfg(test)]

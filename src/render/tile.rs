@@ -201,6 +201,7 @@ fn shade_hits<B: Band>(
     // One entry per light and hit (None where there is no shadow ray), hit-major.
     let lights = shader.light_count();
     let follows = shader.follows_frames();
+    let black_sky = shader.black_background();
     let mut shadows = Vec::with_capacity(lights * primary.len());
     // Each ray's hit prepared for shading with the factor its light gains on the way to the
     // camera, or the camera's lookback factor along a ray that meets nothing.
@@ -252,6 +253,7 @@ fn shade_hits<B: Band>(
                     shader.finish(l, &shadows[mine], |light, _| visible[k * lights + light], 0);
                 (seen * *factor).to_rgb()
             }
+            Err(_) if black_sky => DVec3::ZERO,
             Err(camera_s) => shader.background(*camera_s, 1.0).to_rgb(),
         })
         .collect()

@@ -1,10 +1,12 @@
 //! The camera's spectral response: CIE 1931 2° colour matching to XYZ, then linear sRGB
 //! (IEC 61966-2-1 primaries, D65 white, no chromatic adaptation).
 //!
-//! The camera reads radiance at [`SAMPLES`] fixed wavelengths, the centres of equal bins over
-//! 380-780 nm; bin i weighs by the integral of x̄, ȳ, z̄ over the bin (trapezoids on the 1 nm
-//! table). Radiance that is constant over each bin is integrated exactly; docs/physics.md gives
-//! the error against the 1 nm integral for blackbodies, lines and the white.
+//! The camera reads radiance at [`SAMPLES`] fixed wavelengths, the geometric centres of bins of
+//! equal width in ln λ over 380-780 nm (so a Doppler shift, a factor on every wavelength, moves
+//! them all by the same distance in ln λ); bin i weighs by the integral of x̄, ȳ, z̄ over the bin
+//! (trapezoids on the 1 nm table). Radiance that is constant over each bin is integrated
+//! exactly; docs/physics.md gives the error against the 1 nm integral for blackbodies, lines
+//! and the white.
 
 use super::cie_data::{CMF_1931, CMF_START, D65, D65_START, D65_STEP};
 use super::{planck, Sampled, SAMPLES};
@@ -23,14 +25,23 @@ pub const XYZ_TO_SRGB: DMat3 = DMat3::from_cols_array(&[
 pub const SRGB_CHROMATICITIES: [[f32; 2]; 4] =
     [[0.64, 0.33], [0.30, 0.60], [0.15, 0.06], [0.3127, 0.3290]];
 
+/// The bins' width in ln λ.
+pub fn ln_step() -> f64 {
+    (BAND.1 / BAND.0).ln() / SAMPLES as f64
+}
+
 struct Response {
     lambda: [f64; SAMPLES],
+    /// The linear sRGB weights by channel, for vectorised sums.
+    rgb_rows: [[f64; SAMPLES]; 3],
     /// x̄, ȳ, z̄ integrated over each bin.
     xyz: [DVec3; SAMPLES],
-    /// The same weights carried to linear sRGB.
-    rgb: [DVec3; SAMPLES],
     /// D65 over the quadrature's Y, so the white has Y = 1 exactly as the camera reads it.
     white_scale: f64,
+    /// The white's Planck continuations below and above D65's table: its end value over
+    /// Planck's law there, times `white_scale`.
+    below: f64,
+    above: f64,
 }
 
 fn cmf_at(nm: f64) -> DVec3 {
@@ -46,12 +57,20 @@ fn cmf_at(nm: f64) -> DVec3 {
 fn response() -> &'static Response {
     static R: OnceLock<Response> = OnceLock::new();
     R.get_or_init(|| {
-        let width = (BAND.1 - BAND.0) / SAMPLES as f64;
+        let h = ln_step();
         let mut lambda = [0.0; SAMPLES];
         let mut xyz = [DVec3::ZERO; SAMPLES];
         for i in 0..SAMPLES {
-            let (a, b) = (BAND.0 + i as f64 * width, BAND.0 + (i + 1) as f64 * width);
-            lambda[i] = 0.5 * (a + b);
+            let edge = |k: usize| BAND.0 * (k as f64 * h).exp();
+            let (a, b) = (
+                edge(i),
+                if i + 1 == SAMPLES {
+                    BAND.1
+                } else {
+                    edge(i + 1)
+                },
+            );
+            lambda[i] = BAND.0 * ((i as f64 + 0.5) * h).exp();
             // Trapezoids through the table's points inside the bin and its two ends.
             let mut pts = vec![a];
             pts.extend((a.ceil() as i64..=b.floor() as i64).map(|n| n as f64));
@@ -62,34 +81,66 @@ fn response() -> &'static Response {
                 .map(|w| 0.5 * (cmf_at(w[0]) + cmf_at(w[1])) * (w[1] - w[0]))
                 .sum();
         }
-        let rgb = xyz.map(|w| XYZ_TO_SRGB * w);
+        let rgb = xyz.map(|w| (XYZ_TO_SRGB * w).to_array());
+        let (below, above) = (
+            D65[0] / planck(D65_START, WHITE_KELVIN),
+            D65[D65.len() - 1] / planck(D65_END, WHITE_KELVIN),
+        );
         let y: f64 = (0..SAMPLES)
-            .map(|i| xyz[i].y * d65_extended(lambda[i]))
+            .map(|i| xyz[i].y * d65_extended(lambda[i], below, above))
             .sum();
+        let rgb_rows = [0, 1, 2].map(|c| rgb.map(|w| w[c]));
         Response {
             lambda,
+            rgb_rows,
             xyz,
-            rgb,
             white_scale: 1.0 / y,
+            below: below / y,
+            above: above / y,
         }
     })
 }
 
+/// The temperature of the Planck curve that continues D65 beyond its table.
+const WHITE_KELVIN: f64 = 6504.0;
+const D65_END: f64 = D65_START + D65_STEP * (D65.len() - 1) as f64;
+
 /// D65's relative power at `nm`, linear between its 5 nm table entries; beyond the table
-/// (300-780 nm) the Planck curve at 6504 K matched to the end value, so the white is defined,
-/// smooth and physically plausible at every wavelength.
-fn d65_extended(nm: f64) -> f64 {
-    let last = D65_START + D65_STEP * (D65.len() - 1) as f64;
+/// (300-780 nm) the Planck curve at 6504 K times `below` or `above` (matching the end values),
+/// so the white is defined, smooth and physically plausible at every wavelength.
+#[inline]
+fn d65_extended(nm: f64, below: f64, above: f64) -> f64 {
     if nm <= D65_START {
-        return D65[0] * planck(nm, 6504.0) / planck(D65_START, 6504.0);
+        return below * planck(nm, WHITE_KELVIN);
     }
-    if nm >= last {
-        return D65[D65.len() - 1] * planck(nm, 6504.0) / planck(last, 6504.0);
+    if nm >= D65_END {
+        return above * planck(nm, WHITE_KELVIN);
     }
     let x = (nm - D65_START) / D65_STEP;
     let k = (x as usize).min(D65.len() - 2);
     let t = x - k as f64;
     D65[k] + t * (D65[k + 1] - D65[k])
+}
+
+/// The white at `nm` (see [`white`]), for loops that hold the response.
+#[inline]
+fn white_in(r: &Response, nm: f64) -> f64 {
+    if nm <= D65_START {
+        r.below * planck(nm, WHITE_KELVIN)
+    } else if nm >= D65_END {
+        r.above * planck(nm, WHITE_KELVIN)
+    } else {
+        d65_extended(nm, 0.0, 0.0) * r.white_scale
+    }
+}
+
+/// `scale · σ(c, shift·λ_i) · white(shift·λ_i)` at every camera wavelength: an RGB emitter.
+pub(crate) fn illuminant(coeffs: &[f64; 3], scale: f64, shift: f64) -> [f64; SAMPLES] {
+    let r = response();
+    std::array::from_fn(|i| {
+        let nm = shift * r.lambda[i];
+        scale * super::sigmoid_poly(coeffs, nm) * white_in(r, nm)
+    })
 }
 
 /// The camera's wavelengths, nm (bin centres, increasing).
@@ -101,7 +152,7 @@ pub fn wavelengths() -> &'static [f64; SAMPLES] {
 /// scaled so the camera reads it as Y = 1, which is linear sRGB (1, 1, 1) to the matrix's
 /// four digits.
 pub fn white(nm: f64) -> f64 {
-    d65_extended(nm) * response().white_scale
+    white_in(response(), nm)
 }
 
 /// CIE XYZ of radiance sampled at the camera's wavelengths.
@@ -112,12 +163,18 @@ pub fn xyz(s: &Sampled) -> DVec3 {
 
 /// Linear sRGB of radiance sampled at the camera's wavelengths.
 pub fn rgb(s: &Sampled) -> DVec3 {
-    let r = response();
-    let mut acc = DVec3::ZERO;
-    for i in 0..SAMPLES {
-        acc += r.rgb[i] * s.0[i];
-    }
-    acc
+    let rows = &response().rgb_rows;
+    let dot = |w: &[f64; SAMPLES]| {
+        // Four partial sums, so the loop vectorises without reassociating by itself.
+        let mut acc = [0.0; 4];
+        for (w, v) in w.chunks_exact(4).zip(s.0.chunks_exact(4)) {
+            for k in 0..4 {
+                acc[k] += w[k] * v[k];
+            }
+        }
+        (acc[0] + acc[1]) + (acc[2] + acc[3])
+    };
+    DVec3::new(dot(&rows[0]), dot(&rows[1]), dot(&rows[2]))
 }
 
 /// Linear sRGB of the radiance `f(nm)` at rest.
@@ -148,10 +205,10 @@ mod tests {
     #[test]
     fn d65_is_continuous_at_its_ends() {
         for end in [300.0, 780.0] {
-            let (a, b) = (d65_extended(end - 1e-9), d65_extended(end + 1e-9));
+            let (a, b) = (white(end - 1e-9), white(end + 1e-9));
             assert!((a - b).abs() < 1e-6 * a, "{end}: {a} vs {b}");
         }
-        assert!(d65_extended(5000.0) > 0.0 && d65_extended(100.0) > 0.0);
+        assert!(white(5000.0) > 0.0 && white(100.0) > 0.0);
     }
 
     /// The bins' weights hold the CMFs' integrals over the band (checked against the 1 nm

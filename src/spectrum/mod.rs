@@ -12,6 +12,7 @@
 pub mod camera;
 mod cie_data;
 mod sampled;
+mod table;
 mod uplift;
 
 pub use sampled::{Sampled, SAMPLES};
@@ -123,27 +124,53 @@ pub enum Role {
 
 /// A colour of the scene: its spectrum, and the linear sRGB it has at rest (what the RGB
 /// renderer uses, and exactly the RGB given where the colour was given as RGB).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct Colour {
     pub rgb: DVec3,
     pub spectrum: Spectrum,
     /// Whether it was given as RGB (a scene of RGB colours only, all at rest relative to each
     /// other, needs no spectral rendering).
     pub from_rgb: bool,
+    /// The spectrum on a logarithmic grid, for the smooth kinds (see [`table`]).
+    table: Option<Arc<table::LogTable>>,
+}
+
+impl PartialEq for Colour {
+    fn eq(&self, o: &Colour) -> bool {
+        self.rgb == o.rgb && self.spectrum == o.spectrum && self.from_rgb == o.from_rgb
+    }
 }
 
 impl Colour {
+    fn new(rgb: DVec3, spectrum: Spectrum, from_rgb: bool) -> Colour {
+        let smooth = matches!(
+            spectrum,
+            Spectrum::Sigmoid { .. } | Spectrum::Illuminant { .. } | Spectrum::Blackbody { .. }
+        );
+        let table = smooth.then(|| Arc::new(table::LogTable::new(&spectrum)));
+        Colour {
+            rgb,
+            spectrum,
+            from_rgb,
+            table,
+        }
+    }
+
+    /// The colour at the camera's wavelengths times `shift`.
+    pub fn sampled(&self, shift: f64) -> Sampled {
+        match &self.table {
+            Some(t) => t.sample(shift, &self.spectrum),
+            None => Sampled::of(&self.spectrum, shift),
+        }
+    }
+
     /// An RGB colour (linear sRGB, every channel ≥ 0), uplifted to a smooth spectrum.
     pub fn rgb(rgb: DVec3, role: Role) -> Colour {
         let spectrum = match role {
             Role::Reflectance => uplift::reflectance(rgb),
             Role::Emitter => uplift::emitter(rgb),
         };
-        Colour {
-            rgb,
-            spectrum,
-            from_rgb: true,
-        }
+        Colour::new(rgb, spectrum, true)
     }
 
     /// A grey: the flat spectrum of `v` as a reflectance, `v` times the white as an emitter.
@@ -158,11 +185,7 @@ impl Colour {
             Role::Emitter => camera::rgb_of(|nm| spectrum.at(nm)),
             Role::Reflectance => camera::rgb_of(|nm| spectrum.at(nm) * camera::white(nm)),
         };
-        Colour {
-            rgb,
-            spectrum,
-            from_rgb: false,
-        }
+        Colour::new(rgb, spectrum, false)
     }
 
     /// This colour times `k` (a light's intensity).
@@ -198,11 +221,7 @@ impl Colour {
                 values: values.iter().map(|v| v * k).collect(),
             },
         };
-        Colour {
-            rgb: self.rgb * k,
-            spectrum,
-            from_rgb: self.from_rgb,
-        }
+        Colour::new(self.rgb * k, spectrum, self.from_rgb)
     }
 
     /// Whether it is black at every wavelength.

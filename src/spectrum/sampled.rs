@@ -4,7 +4,7 @@ use super::{camera, Spectrum};
 use std::ops::{Add, AddAssign, Mul};
 
 /// How many wavelengths the camera reads (see [`camera`]).
-pub const SAMPLES: usize = 48;
+pub const SAMPLES: usize = 64;
 
 /// Values at the camera's wavelengths: in a frame whose wavelengths are `shift` times the
 /// camera's, the i-th value belongs to wavelength `shift · camera::wavelengths()[i]`.
@@ -16,11 +16,21 @@ impl Sampled {
 
     /// `spectrum` read at the camera's wavelengths times `shift`.
     pub fn of(spectrum: &Spectrum, shift: f64) -> Sampled {
-        if let Spectrum::Flat(v) = spectrum {
-            return Sampled([*v; SAMPLES]);
-        }
         let l = camera::wavelengths();
-        Sampled(std::array::from_fn(|i| spectrum.at(shift * l[i])))
+        // One loop per kind, so each is a tight loop the compiler can vectorise.
+        match spectrum {
+            Spectrum::Flat(v) => Sampled([*v; SAMPLES]),
+            Spectrum::Sigmoid { coeffs, scale } => Sampled(std::array::from_fn(|i| {
+                scale * super::sigmoid_poly(coeffs, shift * l[i])
+            })),
+            Spectrum::Illuminant { coeffs, scale } => {
+                Sampled(camera::illuminant(coeffs, *scale, shift))
+            }
+            Spectrum::Blackbody { kelvin, scale } => Sampled(std::array::from_fn(|i| {
+                scale * super::planck(shift * l[i], *kelvin)
+            })),
+            _ => Sampled(std::array::from_fn(|i| spectrum.at(shift * l[i]))),
+        }
     }
 
     pub fn is_finite(&self) -> bool {
@@ -28,10 +38,12 @@ impl Sampled {
     }
 }
 
+// The operators are plain loops over the lanes, which the compiler vectorises.
 impl Add for Sampled {
     type Output = Sampled;
-    fn add(self, o: Sampled) -> Sampled {
-        Sampled(std::array::from_fn(|i| self.0[i] + o.0[i]))
+    fn add(mut self, o: Sampled) -> Sampled {
+        self += o;
+        self
     }
 }
 
@@ -45,14 +57,20 @@ impl AddAssign for Sampled {
 
 impl Mul for Sampled {
     type Output = Sampled;
-    fn mul(self, o: Sampled) -> Sampled {
-        Sampled(std::array::from_fn(|i| self.0[i] * o.0[i]))
+    fn mul(mut self, o: Sampled) -> Sampled {
+        for (a, b) in self.0.iter_mut().zip(o.0) {
+            *a *= b;
+        }
+        self
     }
 }
 
 impl Mul<f64> for Sampled {
     type Output = Sampled;
-    fn mul(self, k: f64) -> Sampled {
-        Sampled(self.0.map(|v| v * k))
+    fn mul(mut self, k: f64) -> Sampled {
+        for a in self.0.iter_mut() {
+            *a *= k;
+        }
+        self
     }
 }
