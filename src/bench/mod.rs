@@ -67,8 +67,9 @@ pub struct Case {
     pub bare: bool,
     /// Compare with a 16-spp f64 render (costly for the large cases).
     pub hi_reference: bool,
-    /// For many groups: the same boxes in one group, measured beside them (`one_group_beside`).
-    pub one_group: Option<Scene>,
+    /// A scene measured beside this one (`beside`), with what it is: the same boxes in one
+    /// group beside many groups, or the same scene with the Doppler and searchlight effects off.
+    pub beside: Option<(String, Scene)>,
 }
 
 impl Case {
@@ -80,11 +81,12 @@ impl Case {
             extra_spp: Vec::new(),
             bare: false,
             hi_reference: true,
-            one_group: None,
+            beside: None,
         }
     }
-    pub fn against_one_group(mut self, scene: Scene) -> Case {
-        self.one_group = Some(scene);
+    /// Measure `scene`, which is `what`, beside this case (`beside`).
+    pub fn beside(mut self, what: &str, scene: Scene) -> Case {
+        self.beside = Some((what.to_string(), scene));
         self
     }
     pub fn with_bare(mut self) -> Case {
@@ -121,13 +123,15 @@ pub struct Row {
     pub vs_same: Option<Comparison>,
     /// Against the f64 BVH at 16 samples per pixel.
     pub vs_hi: Option<Comparison>,
-    /// For many groups: the same boxes in one group on the same setting.
-    pub one_group: Option<OneGroup>,
+    /// The case's other scene on the same setting (`Case::beside`).
+    pub beside: Option<Beside>,
 }
 
-/// What the same boxes in one group cost beside a row of many groups (`one_group_beside`).
-#[derive(Clone, Copy, Debug)]
-pub struct OneGroup {
+/// What the case's other scene costs beside a row (`beside`).
+#[derive(Clone, Debug)]
+pub struct Beside {
+    /// What the other scene is.
+    pub what: String,
     pub build_s: f64,
     pub first_render_s: f64,
     pub render_s: f64,
@@ -239,25 +243,24 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
             peak_mib,
             vs_same: None,
             vs_hi: None,
-            one_group: None,
+            beside: None,
         },
         frame,
     ))
 }
 
-/// The same boxes in one group (`one`) beside a row of `case`'s many groups on `setting`: the
-/// one group's frame measured as `measure` measures one, then the warm renders of both in
-/// alternating blocks, each the fastest of its passes, which count among the row's (as
-/// `bare_embree` sets the layer beside bare Embree). Measured as two cases seconds apart, a
-/// render of 25 ms was once the fastest of ten at 29 on one side only, and the ratio read 3.4
-/// instead of 2.8.
-fn one_group_beside(
+/// The case's other scene (`other`, which is `what`) beside a row of `case` on `setting`: its
+/// frame measured as `measure` measures one, then the warm renders of both in alternating
+/// blocks, each the fastest of its passes, which count among the row's (as `bare_embree` sets
+/// the layer beside bare Embree). Measured as two cases seconds apart, a render of 25 ms was
+/// once the fastest of ten at 29 on one side only, and a ratio read 3.4 instead of 2.8.
+fn beside(
     case: &Case,
-    one: &Scene,
+    (what, one): (&str, &Scene),
     setting: &str,
     repeat: usize,
     row: &mut Row,
-) -> Result<OneGroup, String> {
+) -> Result<Beside, String> {
     let alone = Case::new(&case.name, one.clone(), &[setting]).without_hi_reference();
     let (one_row, _) = measure(&alone, setting, 1, repeat)?;
     let (backend_name, options, passes) = parse_setting(setting);
@@ -276,7 +279,8 @@ fn one_group_beside(
         one_s = one_s.min(fastest(repeat, || render(&one, &one_world)));
     }
     row.render_s = many_s;
-    Ok(OneGroup {
+    Ok(Beside {
+        what: what.to_string(),
         build_s: one_row.build_s,
         first_render_s: one_row.first_render_s,
         render_s: one_s,
@@ -309,8 +313,7 @@ pub fn bare_rays<'w>(
     Some((accel, tiles))
 }
 
-/// Blocks of each side where two measurements are set side by side (`bare_embree`,
-/// `one_group_beside`).
+/// Blocks of each side where two measurements are set side by side (`bare_embree`, `beside`).
 const PAIRED_BLOCKS: usize = 3;
 
 /// Bare Embree on the rest-frame primary rays of the scene's one group, and the layer's
@@ -377,8 +380,11 @@ pub fn run(
                 .collect();
             for spp in spps {
                 let (mut row, frame) = measure(case, setting, spp, repeat)?;
-                if let (Some(one), 1, "embree" | "bvh") = (&case.one_group, spp, setting.as_str()) {
-                    row.one_group = Some(one_group_beside(case, one, setting, repeat, &mut row)?);
+                if let (Some((what, other)), 1, "embree" | "bvh") =
+                    (&case.beside, spp, setting.as_str())
+                {
+                    let b = beside(case, (what, other), setting, repeat, &mut row)?;
+                    row.beside = Some(b);
                 }
                 if !refs.iter().any(|(s, _)| *s == spp) {
                     refs.push((spp, reference(&case.scene, spp)?));
@@ -415,7 +421,7 @@ pub fn run(
                     peak_mib: None,
                     vs_same: None,
                     vs_hi: None,
-                    one_group: None,
+                    beside: None,
                 });
             }
         }
@@ -520,17 +526,19 @@ pub fn summary(rows: &[Row]) -> String {
             );
         }
     }
-    // Many groups against the same boxes in one group, measured beside them.
+    // Rows against the scene measured beside them: many groups against the same boxes in one
+    // group, light as a camera records it against the RGB render.
     for r in rows.iter() {
-        if let Some(o) = r.one_group {
+        if let Some(o) = &r.beside {
             let _ = writeln!(
                 s,
-                "- {} ({}): render time {:.3} s = {:.2}x that of the same boxes in one group \
-                 ({:.3} s); build + first render {:.3} s = {:.2}x ({:.3} s)",
+                "- {} ({}): render time {:.3} s = {:.2}x that of {} ({:.3} s); \
+                 build + first render {:.3} s = {:.2}x ({:.3} s)",
                 r.case,
                 r.setting,
                 r.render_s,
                 r.render_s / o.render_s,
+                o.what,
                 o.render_s,
                 r.build_s + r.first_render_s,
                 (r.build_s + r.first_render_s) / (o.build_s + o.first_render_s),

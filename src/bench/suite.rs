@@ -159,6 +159,20 @@ pub fn cases(quick: bool) -> Vec<LazyCase> {
             &["embree", "bvh"],
         ))
     }));
+    // Light as a camera records it (Doppler shift and searchlight on every leg of a path)
+    // against the RGB render of the same scene, measured side by side.
+    out.push(LazyCase::new("lattice beta=0.9, spectral", move || {
+        let mut s = size(px);
+        s.push("group.lattice.velocity=[-0.9,0,0]".into());
+        let rgb = paper("lattice", &s)?;
+        s.extend(sets(&["render.doppler=true", "render.searchlight=true"]));
+        Ok(Case::new(
+            "lattice beta=0.9, spectral",
+            paper("lattice", &s)?,
+            &["embree", "bvh"],
+        )
+        .beside("the same scene in RGB (both effects off)", rgb))
+    }));
     // What the EXR passes cost: a PNG takes colour alone (with several samples the passes have
     // a ray of their own through each pixel's centre).
     out.push(LazyCase::new("lattice beta=0.9, passes", move || {
@@ -225,7 +239,7 @@ pub fn cases(quick: bool) -> Vec<LazyCase> {
                     settings,
                 )
                 .without_hi_reference()
-                .against_one_group(many_groups(g, true, gpx)?))
+                .beside("the same boxes in one group", many_groups(g, true, gpx)?))
             },
         ));
     }

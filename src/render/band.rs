@@ -69,20 +69,9 @@ impl Band for Sampled {
         glint: Option<(Self, f64)>,
         k: f64,
     ) -> Self {
-        let a = atten * k;
         let mut out = light;
-        match glint {
-            Some((spec, h)) => {
-                for i in 0..out.0.len() {
-                    out.0[i] *= (diffuse.0[i] * ndl + spec.0[i] * h) * a;
-                }
-            }
-            None => {
-                for i in 0..out.0.len() {
-                    out.0[i] *= diffuse.0[i] * (ndl * a);
-                }
-            }
-        }
+        let glint = glint.as_ref().map(|(s, h)| (&s.0, *h));
+        crate::spectrum::kernels::lit(&mut out.0, &diffuse.0, ndl, glint, atten * k);
         out
     }
 }

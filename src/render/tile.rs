@@ -251,7 +251,8 @@ fn shade_hits<B: Band>(
                 let mine = k * lights..(k + 1) * lights;
                 let seen =
                     shader.finish(l, &shadows[mine], |light, _| visible[k * lights + light], 0);
-                (seen * *factor).to_rgb()
+                // The camera leg's factor, on the RGB (linear, so as on every wavelength).
+                seen.to_rgb() * *factor
             }
             Err(_) if black_sky => DVec3::ZERO,
             Err(camera_s) => shader.background(*camera_s, 1.0).to_rgb(),

@@ -163,18 +163,7 @@ pub fn xyz(s: &Sampled) -> DVec3 {
 
 /// Linear sRGB of radiance sampled at the camera's wavelengths.
 pub fn rgb(s: &Sampled) -> DVec3 {
-    let rows = &response().rgb_rows;
-    let dot = |w: &[f64; SAMPLES]| {
-        // Four partial sums, so the loop vectorises without reassociating by itself.
-        let mut acc = [0.0; 4];
-        for (w, v) in w.chunks_exact(4).zip(s.0.chunks_exact(4)) {
-            for k in 0..4 {
-                acc[k] += w[k] * v[k];
-            }
-        }
-        (acc[0] + acc[1]) + (acc[2] + acc[3])
-    };
-    DVec3::new(dot(&rows[0]), dot(&rows[1]), dot(&rows[2]))
+    DVec3::from(super::kernels::dot3(&response().rgb_rows, &s.0))
 }
 
 /// Linear sRGB of the radiance `f(nm)` at rest.

@@ -11,6 +11,7 @@
 
 pub mod camera;
 mod cie_data;
+pub(crate) mod kernels;
 mod sampled;
 mod table;
 mod uplift;

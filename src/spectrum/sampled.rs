@@ -38,7 +38,7 @@ impl Sampled {
     }
 }
 
-// The operators are plain loops over the lanes, which the compiler vectorises.
+// The operators are the loops of `kernels`, vectorised.
 impl Add for Sampled {
     type Output = Sampled;
     fn add(mut self, o: Sampled) -> Sampled {
@@ -49,18 +49,14 @@ impl Add for Sampled {
 
 impl AddAssign for Sampled {
     fn add_assign(&mut self, o: Sampled) {
-        for (a, b) in self.0.iter_mut().zip(o.0) {
-            *a += b;
-        }
+        super::kernels::add(&mut self.0, &o.0);
     }
 }
 
 impl Mul for Sampled {
     type Output = Sampled;
     fn mul(mut self, o: Sampled) -> Sampled {
-        for (a, b) in self.0.iter_mut().zip(o.0) {
-            *a *= b;
-        }
+        super::kernels::mul(&mut self.0, &o.0);
         self
     }
 }
@@ -68,9 +64,7 @@ impl Mul for Sampled {
 impl Mul<f64> for Sampled {
     type Output = Sampled;
     fn mul(mut self, k: f64) -> Sampled {
-        for a in self.0.iter_mut() {
-            *a *= k;
-        }
+        super::kernels::scale(&mut self.0, k);
         self
     }
 }

@@ -78,9 +78,7 @@ impl LogTable {
             };
             let hi = &self.rows[p1 * self.row_len + b1..][..SAMPLES];
             let mut out = Sampled::ZERO;
-            for i in 0..SAMPLES {
-                out.0[i] = lo[i] + t * (hi[i] - lo[i]);
-            }
+            super::kernels::lerp(lo, hi, t, &mut out.0);
             return out;
         }
         Sampled::of(exact, shift)
