@@ -159,6 +159,17 @@ fn good_scene_writes_png_and_exr_with_the_passes() {
         doppler[hit]
     );
     assert!(ids.contains(&0.0), "background is id 0");
+    // The colour channels say what they are: linear Rec. 709 / sRGB primaries, D65 white.
+    let meta = exr::meta::MetaData::read_from_file(&exr, false).unwrap();
+    let c = meta.headers[0]
+        .shared_attributes
+        .chromaticities
+        .expect("a chromaticities attribute");
+    let xy = |v: exr::math::Vec2<f32>| (v.0, v.1);
+    assert_eq!(
+        [xy(c.red), xy(c.green), xy(c.blue), xy(c.white)],
+        [(0.64, 0.33), (0.30, 0.60), (0.15, 0.06), (0.3127, 0.3290)]
+    );
     assert_eq!(
         d.entries().len(),
         3,

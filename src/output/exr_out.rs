@@ -26,7 +26,16 @@ pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), String> {
         ..Encoding::FAST_LOSSLESS
     };
     let layer = Layer::new(size, attrs, encoding, AnyChannels::sort(list));
-    Image::from_layer(layer)
+    let mut image = Image::from_layer(layer);
+    // R, G, B are linear sRGB / Rec. 709 (the camera's CIE XYZ through IEC 61966-2-1's matrix).
+    let [r, g, b, w] = crate::spectrum::camera::SRGB_CHROMATICITIES.map(|[x, y]| Vec2(x, y));
+    image.attributes.chromaticities = Some(attribute::Chromaticities {
+        red: r,
+        green: g,
+        blue: b,
+        white: w,
+    });
+    image
         .write()
         .to_file(path)
         .map_err(|e| e.to_string())
