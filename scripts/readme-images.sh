@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Render the README's pictures (docs/img) from the paper scenes. Needs a release build.
+# Render the README's pictures (docs/img) from the scenes. Needs a release build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 r=./target/release/rest-embree
@@ -13,4 +13,9 @@ for b in 0 0.5 0.9 0.99; do
 done
 $r render scenes/lattice.toml -o "$o/lattice-up-0.5.png" "${size[@]}" --set 'group.lattice.velocity=[-0.5, 0, 0]' --set 'camera.direction=[1, 0, 1]'
 $r render scenes/lattice.toml -o "$o/lattice-upright-0.5.png" "${size[@]}" --set 'group.lattice.velocity=[-0.5, 0, 0]' --set 'camera.direction=[1, -1, 1]'
+# Light as a camera records it: the same scene with neither effect, the Doppler shift alone, both.
+wide=(--width 576 --height 192 --samples 4 --quiet)
+$r render scenes/passing_spheres.toml -o "$o/spheres-rgb.png" "${wide[@]}" --set render.doppler=false --set render.searchlight=false
+$r render scenes/passing_spheres.toml -o "$o/spheres-doppler.png" "${wide[@]}" --set render.searchlight=false
+$r render scenes/passing_spheres.toml -o "$o/spheres-doppler-searchlight.png" "${wide[@]}"
 echo "wrote $(ls "$o" | wc -l) images to $o"
