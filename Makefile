@@ -9,13 +9,15 @@ OUT ?= out
 setup:
 	@scripts/setup.sh
 
-# Render the paper's lattice (Hsiung & Dunn 1989, Figure 16: beta = 0.9) to PNG and EXR.
+# Render the paper's lattice (Hsiung & Dunn 1989, Figure 16: beta = 0.9) to PNG and EXR, and
+# white spheres passing at 0.5c as a camera records them (Doppler shift and searchlight).
 demo: setup
 	$(CARGO) build --release
 	mkdir -p $(OUT)
 	./target/release/rest-embree render scenes/lattice.toml -o $(OUT)/lattice-0.9.png --set 'group.lattice.velocity=[-0.9, 0, 0]'
 	./target/release/rest-embree render scenes/lattice.toml -o $(OUT)/lattice-0.9.exr --set 'group.lattice.velocity=[-0.9, 0, 0]'
-	@echo "demo: wrote $(OUT)/lattice-0.9.png and $(OUT)/lattice-0.9.exr"
+	./target/release/rest-embree render scenes/passing_spheres.toml -o $(OUT)/passing-spheres.png
+	@echo "demo: wrote $(OUT)/lattice-0.9.png, $(OUT)/lattice-0.9.exr and $(OUT)/passing-spheres.png"
 
 # Every test, optimised (Cargo.toml's test profile), with the Embree backend and without it.
 test: setup

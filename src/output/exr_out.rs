@@ -35,10 +35,7 @@ pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), String> {
         blue: b,
         white: w,
     });
-    image
-        .write()
-        .to_file(path)
-        .map_err(|e| e.to_string())
+    image.write().to_file(path).map_err(|e| e.to_string())
 }
 
 /// Width, height and every channel by name (f32, row-major) of an EXR file's first layer.

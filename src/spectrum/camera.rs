@@ -171,6 +171,24 @@ pub fn rgb_of(f: impl Fn(f64) -> f64) -> DVec3 {
     rgb(&Sampled(wavelengths().map(f)))
 }
 
+/// Linear sRGB of the radiance `f(nm)` by the 1 nm sum of the CIE table over 360-830 nm: the
+/// reference the camera's quadrature is measured against (docs/physics.md).
+pub fn reference_rgb_of(f: impl Fn(f64) -> f64) -> DVec3 {
+    let xyz: DVec3 = CMF_1931
+        .iter()
+        .enumerate()
+        .map(|(k, c)| DVec3::from(*c) * f(CMF_START + k as f64))
+        .sum();
+    XYZ_TO_SRGB * xyz
+}
+
+/// The camera's error on `f`: the largest channel difference from [`reference_rgb_of`], over
+/// the reference's largest channel.
+pub fn quadrature_error(f: impl Fn(f64) -> f64) -> f64 {
+    let (got, want) = (rgb_of(&f), reference_rgb_of(&f));
+    (got - want).abs().max_element() / want.abs().max_element()
+}
+
 /// Chromaticity (x, y) of XYZ.
 pub fn chromaticity(xyz: DVec3) -> (f64, f64) {
     let s = xyz.x + xyz.y + xyz.z;
@@ -198,6 +216,31 @@ mod tests {
             assert!((a - b).abs() < 1e-6 * a, "{end}: {a} vs {b}");
         }
         assert!(white(5000.0) > 0.0 && white(100.0) > 0.0);
+    }
+
+    /// The camera's wavelengths integrate what the cases show within 1% of the 1 nm
+    /// CIE sum: blackbodies from 1625 K to 26000 K, the white, and Gaussian lines at least
+    /// 20 nm wide anywhere in 420-680 nm.
+    #[test]
+    fn the_quadrature_is_within_one_percent() {
+        for k in [
+            1625.0, 3250.0, 4875.0, 6500.0, 9750.0, 13000.0, 19500.0, 26000.0,
+        ] {
+            let e = quadrature_error(|nm| planck(nm, k));
+            assert!(e < 0.01, "{k} K: {e}");
+        }
+        assert!(quadrature_error(white) < 0.01);
+        for fwhm in [20.0, 40.0, 60.0] {
+            for c in (0..=260).map(|i| 420.0 + i as f64) {
+                let line = super::super::Spectrum::Line {
+                    centre: c,
+                    fwhm,
+                    scale: 1.0,
+                };
+                let e = quadrature_error(|nm| line.at(nm));
+                assert!(e < 0.01, "line at {c} nm, FWHM {fwhm}: {e}");
+            }
+        }
     }
 
     /// The bins' weights hold the CMFs' integrals over the band (checked against the 1 nm
