@@ -346,3 +346,138 @@ fn blackbody_chromaticities_match_the_table() {
         }
     }
 }
+
+/// A mirror at rest facing the camera at 45° and a glowing sphere coming at the mirror head-on
+/// along the reflected direction: the mirror, in the camera's frame, shows the sphere's
+/// blackbody at D·T with D = e^φ of the sphere seen along the reflected ray. With the mirror
+/// riding along with the sphere instead, the light crosses no frame between them, and the
+/// mirror shows the blackbody at D_out·T, D_out the mirror's own Doppler factor (the pass).
+#[test]
+fn a_mirror_between_frames_passes_the_shift_on() {
+    let mirror_scene = |beta: f64, mirror_rides: bool, sphere_x: f64, kelvin: f64| {
+        // A moving mirror is seen where it was 10 time units ago: shifted by β·10 along x in
+        // the world, so its rest-frame centre is put where that brings it onto the view axis.
+        let dx = if mirror_rides {
+            10.0 * beta / (1.0 - beta * beta).sqrt()
+        } else {
+            0.0
+        };
+        let mirror = format!(
+            r#"
+[[group.object]]
+type = "mesh"
+vertices = [[{a:?}, 7, -3], [{b:?}, 13, -3], [{b:?}, 13, 3], [{a:?}, 7, 3]]
+indices = [[0, 1, 2], [0, 2, 3]]
+material = "mirror"
+"#,
+            a = dx - 3.0,
+            b = dx + 3.0
+        );
+        let mirror = mirror.as_str();
+        let (still, riding) = if mirror_rides {
+            ("", mirror)
+        } else {
+            (mirror, "")
+        };
+        format!(
+            r#"
+[camera]
+position = [0, 0, 0]
+direction = [0, 1, 0]
+fov_y = 0.5
+[image]
+width = 9
+height = 9
+[render]
+ambient = 0
+[[material]]
+name = "mirror"
+color = 0
+reflect = 1
+[[material]]
+name = "glow"
+emission = {{ blackbody = {kelvin:?}, scale = 1e-7 }}
+[[group]]
+name = "moving"
+velocity = [{beta:?}, 0, 0]
+[[group.object]]
+type = "sphere"
+center = [{sphere_x:?}, 10, 0]
+radius = 5
+material = "glow"
+{riding}
+[[group]]
+name = "still"
+{still}
+"#
+        )
+    };
+    let t = 5000.0;
+    for backend in backends() {
+        // The mirror (the plane x − y + 10 = 0 through (0, 10, 0)) sends the view along +y to
+        // +x: the sphere's near side is seen at x = 40 (50 along the path), and the sphere
+        // comes toward the mirror at −β. Its centre was at x = 45 at t = −50.
+        let beta: f64 = 0.4;
+        let g = 1.0 / (1.0 - beta * beta).sqrt();
+        // x(t) = 45 − β(t + 50); moving at −β, its rest-frame x' = γ(x + βt) = γ(45 − 50β).
+        let rest = g * (45.0 - 50.0 * beta);
+        let a = render_with(&scene(&mirror_scene(-beta, false, rest, t)), backend);
+        let d = (beta.atanh()).exp();
+        let b = render_with(&scene(&mirror_scene(0.0, false, 45.0, d * t)), backend);
+        same_colour(
+            rgb(&centre(&a)),
+            rgb(&centre(&b)),
+            0.005,
+            &format!("{backend} still mirror"),
+        );
+        // The mirror riding with the sphere (group "moving"), slower and closer, so that the
+        // view, aberrated in their frame, still meets the sphere after the mirror: only the
+        // mirror's own D_out.
+        let (beta, near) = (0.2, 18.0);
+        let c = render_with(&scene(&mirror_scene(-beta, true, near, t)), backend);
+        let p = centre(&c);
+        assert!(p.object_id == 2, "{backend}: the centre sees the mirror");
+        let d_out = f64::from(p.doppler);
+        assert!(
+            (d_out - 1.0).abs() > 0.01,
+            "{backend}: the mirror moves ({d_out})"
+        );
+        let ref_scene = mirror_scene(0.0, false, near, d_out * t);
+        let e = render_with(&scene(&ref_scene), backend);
+        same_colour(
+            rgb(&p),
+            rgb(&centre(&e)),
+            0.005,
+            &format!("{backend} riding mirror"),
+        );
+    }
+}
+
+/// The spectral path runs only where something needs it.
+#[test]
+fn spectral_work_only_where_needed() {
+    use rest_embree::render::needs_spectra;
+    let base = glowing_sphere("[1, 0.5, 0.2]", 50.0, 0.0);
+    assert!(!needs_spectra(&scene(&base)), "all at rest, all RGB");
+    let moving = glowing_sphere("[1, 0.5, 0.2]", 50.0, 0.5);
+    assert!(needs_spectra(&scene(&moving)), "a moving group");
+    let bb = glowing_sphere("{ blackbody = 3000 }", 50.0, 0.0);
+    assert!(needs_spectra(&scene(&bb)), "a spectrum");
+    for (d, s) in [(false, false)] {
+        let off = format!("{moving}\n").replace(
+            "ambient = 0",
+            &format!("ambient = 0\ndoppler = {d}\nsearchlight = {s}"),
+        );
+        assert!(!needs_spectra(&scene(&off)), "both switches off");
+    }
+    let doppler_only = moving.replace("ambient = 0", "ambient = 0\nsearchlight = false");
+    assert!(needs_spectra(&scene(&doppler_only)), "one switch on");
+    // A moving camera and a background that is not black: the sky is seen shifted.
+    let sky = base
+        .replace("fov_y = 1", "fov_y = 1\nvelocity = [0, 0.3, 0]")
+        .replace("height = 9", "height = 9\nbackground = 0.2");
+    assert!(
+        needs_spectra(&scene(&sky)),
+        "a moving camera against the sky"
+    );
+}
