@@ -27,21 +27,23 @@ fn same_colour(a: [f64; 3], b: [f64; 3], rel: f64, what: &str) {
     }
 }
 
+/// A 9 × 9 view from the origin along `direction`, `fov_y` degrees high, with no ambient light
+/// (each scene's light is its own): the head of every scene here.
+fn narrow_view(direction: [f64; 3], fov_y: f64) -> String {
+    let [x, y, z] = direction;
+    format!(
+        "[camera]\nposition = [0, 0, 0]\ndirection = [{x:?}, {y:?}, {z:?}]\nfov_y = {fov_y:?}\n\
+         [image]\nwidth = 9\nheight = 9\n[render]\nambient = 0\n"
+    )
+}
+
 /// A 9 × 9 view along +x from the origin, narrow enough that a sphere of radius 5 at distance
 /// 50 fills it; one emissive sphere whose rest-frame centre is `x` and whose group moves at
 /// `beta` along x.
 fn glowing_sphere(emission: &str, x: f64, beta: f64) -> String {
+    let head = narrow_view([1.0, 0.0, 0.0], 1.0);
     format!(
-        r#"
-[camera]
-position = [0, 0, 0]
-direction = [1, 0, 0]
-fov_y = 1
-[image]
-width = 9
-height = 9
-[render]
-ambient = 0
+        r#"{head}
 [[material]]
 name = "glow"
 emission = {emission}
@@ -138,18 +140,9 @@ fn plate(
     light: &str,
     direction: [f64; 3],
 ) -> String {
+    let head = narrow_view(direction, 0.5);
     format!(
-        r#"
-[camera]
-position = [0, 0, 0]
-direction = [{dx:?}, {dy:?}, {dz:?}]
-fov_y = 0.5
-[image]
-width = 9
-height = 9
-[render]
-ambient = 0
-max_depth = 0
+        r#"{head}max_depth = 0
 [[material]]
 name = "grey"
 color = 0.5
@@ -171,9 +164,6 @@ material = "grey"
         max[0],
         max[1],
         max[2],
-        dx = direction[0],
-        dy = direction[1],
-        dz = direction[2],
         vx = velocity[0],
         vy = velocity[1],
         vz = velocity[2],
@@ -379,17 +369,9 @@ material = "mirror"
         } else {
             (mirror, "")
         };
+        let head = narrow_view([0.0, 1.0, 0.0], 0.5);
         format!(
-            r#"
-[camera]
-position = [0, 0, 0]
-direction = [0, 1, 0]
-fov_y = 0.5
-[image]
-width = 9
-height = 9
-[render]
-ambient = 0
+            r#"{head}
 [[material]]
 name = "mirror"
 color = 0
@@ -472,7 +454,7 @@ fn spectral_work_only_where_needed() {
     assert!(needs_spectra(&scene(&doppler_only)), "one switch on");
     // A moving camera and a background that is not black: the sky is seen shifted.
     let sky = base
-        .replace("fov_y = 1", "fov_y = 1\nvelocity = [0, 0.3, 0]")
+        .replace("fov_y = 1.0", "fov_y = 1.0\nvelocity = [0, 0.3, 0]")
         .replace("height = 9", "height = 9\nbackground = 0.2");
     assert!(
         needs_spectra(&scene(&sky)),

@@ -120,7 +120,7 @@ impl Seen {
 
     /// Radiance seen across a change of frame with frequency ratio `d` = ν_receiver/ν_sender,
     /// by a receiver whose wavelengths are `shift` times the camera's: the sender's shift, and
-    /// the factor on the sender's radiance.
+    /// the factor on the sender's radiance (`(shift, 1)` exactly for [`Seen::NONE`]).
     pub fn radiance(&self, d: f64, shift: f64) -> (f64, f64) {
         self.shifted(d, shift, 4)
     }

@@ -103,9 +103,6 @@ impl<'a, B: Band> Shader<'a, B> {
     /// `receiver_s` (both for the ray's world-frame direction; D = ν_receiver / ν_sender is
     /// their ratio): the sender's wavelength shift, and the factor on its radiance.
     pub fn arriving(&self, receiver_s: f64, sender_s: f64, shift: f64) -> (f64, f64) {
-        if !self.seen.any() {
-            return (shift, 1.0);
-        }
         self.seen.radiance(receiver_s / sender_s, shift)
     }
 
@@ -219,11 +216,7 @@ impl<'a, B: Band> Shader<'a, B> {
                 highlight(r.dot(-v).max(0.0), mat.shininess)
             });
             // D_in = ν_surface / ν_light: k is ν_world / ν_light, s_surface ν_surface / ν_world.
-            let (light_shift, k_in) = if self.seen.any() {
-                self.seen.irradiance(k * s_surface, shift)
-            } else {
-                (shift, 1.0)
-            };
+            let (light_shift, k_in) = self.seen.irradiance(k * s_surface, shift);
             Some(ShadowQuery {
                 ray: NullRay::new(from, dir_w),
                 tmax: dist * k * (1.0 - 1e-9),
