@@ -1,4 +1,4 @@
-//! The Hsiung–Dunn calibration (PHYSICS.md §2.4), measured on rendered images: a unit cube moving
+//! The Hsiung–Dunn calibration (docs/physics.md §2.4), measured on rendered images: a unit cube moving
 //! along +x, seen perpendicularly from the origin with f = 1000 px, placed so that its near face
 //! is imaged symmetrically about the axis. The near face is exactly f/(γh) wide; the trailing
 //! face turns into view.

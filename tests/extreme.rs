@@ -6,7 +6,7 @@ use common::*;
 use glam::DVec3;
 use rest_embree::spacetime::{Boost, Event, Velocity};
 
-/// Rest-frame x of the rear face that images the near face symmetrically (PHYSICS.md §2.4):
+/// Rest-frame x of the rear face that images the near face symmetrically (docs/physics.md §2.4):
 /// X_centre = γβ·sqrt(1/(4γ²) + h²), from the stable rapidity form.
 fn rear_x(v: &Velocity, h: f64) -> f64 {
     let g = v.gamma();

@@ -7,7 +7,7 @@
 //! Scott & Viner (1965) drew diagrams of where a point observer sees a plane grid: the apparent
 //! (retarded) positions, in which lines perpendicular to the motion become hyperbolas. The P
 //! pass holds exactly those positions, so an orthographic top view of the P pass is their
-//! diagram; every hit must satisfy x_app = γ(X − β·sqrt(X² + ρ²)) (PHYSICS.md §2.1, §4.2).
+//! diagram; every hit must satisfy x_app = γ(X − β·sqrt(X² + ρ²)) (docs/physics.md §2.1, §4.2).
 
 mod common;
 use common::*;

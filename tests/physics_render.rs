@@ -1,4 +1,4 @@
-//! Render-based physics tests (PHYSICS.md §2–§5): the image is rendered on every backend, then
+//! Render-based physics tests (docs/physics.md §2–§5): the image is rendered on every backend, then
 //! measured, and compared with the known answer. Run with `-- --nocapture` to see each
 //! measurement as a row of docs/ACCURACY.md.
 

@@ -1,4 +1,4 @@
-//! Spacetime math against PHYSICS.md §1, §5.1 and §8, plus property tests.
+//! Spacetime math against docs/physics.md §1, §5.1 and §8, plus property tests.
 
 mod common;
 use common::*;
@@ -223,7 +223,7 @@ fn boost_matrix_1_3() {
     let beta = DVec3::new(0.3, -0.4, 0.5);
     let v = Velocity::from_beta_vec(beta).unwrap();
     let e = Boost::to_rest(&v).event(Event::new(2.0, 2.0 * beta));
-    // 2/γ = 1.41421356 for this β (PHYSICS.md §1.3).
+    // 2/γ = 1.41421356 for this β (docs/physics.md §1.3).
     assert_close(e.t, std::f64::consts::SQRT_2, 1e-10, "t'");
     assert!(e.x.length() < 1e-14, "worldline maps to x' = 0");
     // Λ(β)^-1 = Λ(−β).
@@ -340,7 +340,7 @@ fn doppler_table_5_1() {
 
 #[test]
 fn speed_forms_agree_and_stay_exact_near_light_8() {
-    // γ for ε = 1 − β = 1e-12 is 707106.781186724 (PHYSICS.md §8.1).
+    // γ for ε = 1 − β = 1e-12 is 707106.781186724 (docs/physics.md §8.1).
     let v = Velocity::from_one_minus_beta(DVec3::X, 1e-12).unwrap();
     assert_rel(
         v.gamma(),
@@ -372,7 +372,7 @@ fn speed_forms_agree_and_stay_exact_near_light_8() {
     let (_, s) = Boost::to_rest(&v).null_dir(-DVec3::X);
     assert_rel(1.0 / s, (v.rapidity()).exp(), 1e-14, "head-on Doppler");
     // Aberration near 180°: true angle 168.578813725° (naive formula gives 168.583223°). The
-    // view angle PHYSICS.md rounds to "π − 1.414e-7" is π − √2·1e-7 (checked with mpmath: with
+    // view angle the physics notes round to "π − 1.414e-7" is π − √2·1e-7 (checked with mpmath: with
     // 1.414e-7 exactly the true answer is 168.5805270°).
     let th = std::f64::consts::PI - 2f64.sqrt() * 1e-7;
     let (a, _) = Boost::to_rest(&v).view_dir(DVec3::new(th.cos(), th.sin(), 0.0));
@@ -431,13 +431,13 @@ fn retarded_position_2_1_both_branches() {
         "receding: Δ = d/(1+β)",
     );
     // Abeam (r0 ⟂ v): |r0 − βΔ| = Δ gives 1 + β²Δ² = Δ², Δ = γ |r0| — where r0² − |β × r0|²
-    // would be 1 − β², lost to cancellation (PHYSICS.md §8).
+    // would be 1 − β², lost to cancellation (docs/physics.md §8).
     for one_minus in [1e-6, 1e-9, 1e-12] {
         let v = Velocity::from_one_minus_beta(DVec3::X, one_minus).unwrap();
         let abeam = retarded_delay(DVec3::new(0.0, 3.0, -4.0), &v);
         assert_rel(abeam, 5.0 * v.gamma(), 1e-12, "abeam: Δ = γ|r0|");
     }
-    // The rest-frame form x_app = γ(X − β sqrt(X² + ρ²)) agrees (PHYSICS.md §2.1).
+    // The rest-frame form x_app = γ(X − β sqrt(X² + ρ²)) agrees (docs/physics.md §2.1).
     let v = Velocity::from_beta(DVec3::X, 0.9).unwrap();
     for (x0, rho) in [(5.0, 10.0), (-5.0, 10.0), (0.0, 3.0), (40.0, 1.0)] {
         let app = retarded_position(DVec3::new(x0, rho, 0.0), &v);
@@ -450,7 +450,7 @@ fn retarded_position_2_1_both_branches() {
 
 #[test]
 fn gamma_minus_one_at_small_speeds_8_1() {
-    // PHYSICS.md §8.1: naive γ − 1 gives 2.2e-16 at β = 1e-8 (truth 5e-17) and 0 at 1e-9.
+    // docs/physics.md §8.1: naive γ − 1 gives 2.2e-16 at β = 1e-8 (truth 5e-17) and 0 at 1e-9.
     for beta in [1e-8f64, 1e-9, 1e-4] {
         let v = Velocity::from_beta(DVec3::X, beta).unwrap();
         let want = 0.5 * beta * beta * (1.0 + 0.75 * beta * beta);

@@ -3,7 +3,7 @@
 //! The renderer boosts every ray into a group's rest frame before it gets here, so a backend
 //! only ever sees static geometry and static rays `o + t d`. `d` is unnormalised: its length is
 //! the boost's lookback factor, so `t` is already the world-frame lookback time and hits of all
-//! groups compare directly (DESIGN.md, "the one trick").
+//! groups compare directly (docs/physics.md §7.1).
 //!
 //! A backend also builds the culling structures over many velocity groups (`BoxCuller`): boxes
 //! in the world frame that rays from one origin traverse, the renderer testing each candidate

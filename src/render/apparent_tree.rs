@@ -1,6 +1,6 @@
 //! Culling for primary rays among many groups: every primary ray starts at the imaging event
 //! E0, and from there a group is seen exactly where its apparent (retarded) shape is. That shape
-//! lies in a box computed from the retarded-position map of PHYSICS.md §2.1 (see
+//! lies in a box computed from the retarded-position map of docs/physics.md §2.1 (see
 //! [`apparent_box`]). A static BVH over those boxes, traversed by the spatial ray x0 + λa (λ
 //! is the lookback, so it doubles as the distance), finds the groups a primary ray can meet.
 
@@ -16,7 +16,7 @@ pub struct ApparentTree {
     tree: Box<dyn BoxCuller>,
 }
 
-/// x_app = γ(X − β·sqrt(X² + ρ²)) (PHYSICS.md §2.1), without cancellation for X > 0.
+/// x_app = γ(X − β·sqrt(X² + ρ²)) (docs/physics.md §2.1), without cancellation for X > 0.
 fn x_app(g: f64, b: f64, x: f64, rho: f64) -> f64 {
     let s = (x * x + rho * rho).sqrt();
     if x <= 0.0 {

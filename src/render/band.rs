@@ -6,73 +6,103 @@
 //! shifts the wavelengths and scales the radiance (docs/physics.md, "Light and colour").
 
 use crate::scene::Scene;
-use crate::spectrum::{camera, Colour, Sampled};
+use crate::spectrum::{camera, kernels, Colour, Sampled, Shift};
 use glam::DVec3;
-use std::ops::{Add, AddAssign, Mul};
+use std::ops::Mul;
 
-/// Light along a ray: in a frame whose wavelengths are `shift` times the camera's.
-pub trait Band:
-    Copy + Add<Output = Self> + AddAssign + Mul<Output = Self> + Mul<f64, Output = Self>
-{
+/// Light along a ray: in a frame whose wavelengths are `shift` times the camera's. Large bands
+/// are combined in place and by reference (a spectrum is 64 numbers).
+pub trait Band: Copy + Mul<f64, Output = Self> {
     const ZERO: Self;
-    /// The colour `c` in a frame whose wavelengths are `shift` times the camera's.
-    fn of(c: &Colour, shift: f64) -> Self;
+    /// A frame's shift as this band reads colours with it (prepared once per frame).
+    type At: Copy;
+    /// The frame whose wavelengths are `shift` times the camera's.
+    fn at(shift: f64) -> Self::At;
+    /// The colour `c` in that frame.
+    fn of(c: &Colour, at: Self::At) -> Self;
     /// What the camera records of it (linear sRGB).
     fn to_rgb(&self) -> DVec3;
-
-    /// The light a point light sends off a surface: `light · atten · (diffuse · ndl +
+    /// `self *= o`, wavelength by wavelength.
+    fn mul_by(&mut self, o: &Self);
+    /// `self += o`.
+    fn add(&mut self, o: &Self);
+    /// `self +=` the light a point light sends off a surface: `light · atten · (diffuse · ndl +
     /// specular · highlight) · k`, where `glint` is the specular reflectance and highlight.
-    /// The default is the RGB render's order of operations; a band may fuse it.
-    #[inline]
-    fn lit_by(
-        light: Self,
+    fn add_lit(
+        &mut self,
+        light: &Self,
         atten: f64,
-        diffuse: Self,
+        diffuse: &Self,
         ndl: f64,
-        glint: Option<(Self, f64)>,
+        glint: Option<(&Self, f64)>,
         k: f64,
-    ) -> Self {
-        let mut term = diffuse * ndl;
-        if let Some((spec, h)) = glint {
-            term += spec * h;
-        }
-        light * atten * term * k
-    }
+    );
 }
 
 impl Band for DVec3 {
     const ZERO: Self = DVec3::ZERO;
-    fn of(c: &Colour, _shift: f64) -> Self {
+    type At = ();
+    fn at(_shift: f64) {}
+    fn of(c: &Colour, _: ()) -> Self {
         c.rgb
     }
     fn to_rgb(&self) -> DVec3 {
         *self
     }
+    fn mul_by(&mut self, o: &Self) {
+        *self *= *o;
+    }
+    fn add(&mut self, o: &Self) {
+        *self += *o;
+    }
+    /// In the order of operations the RGB render has always used.
+    fn add_lit(
+        &mut self,
+        light: &Self,
+        atten: f64,
+        diffuse: &Self,
+        ndl: f64,
+        glint: Option<(&Self, f64)>,
+        k: f64,
+    ) {
+        let mut term = *diffuse * ndl;
+        if let Some((spec, h)) = glint {
+            term += *spec * h;
+        }
+        *self += *light * atten * term * k;
+    }
 }
 
 impl Band for Sampled {
     const ZERO: Self = Sampled::ZERO;
-    fn of(c: &Colour, shift: f64) -> Self {
-        c.sampled(shift)
+    type At = Shift;
+    fn at(shift: f64) -> Shift {
+        Shift::new(shift)
+    }
+    fn of(c: &Colour, at: Shift) -> Self {
+        c.sampled(at)
     }
     fn to_rgb(&self) -> DVec3 {
         camera::rgb(self)
     }
-
+    fn mul_by(&mut self, o: &Self) {
+        kernels::mul(&mut self.0, &o.0);
+    }
+    fn add(&mut self, o: &Self) {
+        kernels::add(&mut self.0, &o.0);
+    }
     /// One pass over the wavelengths.
-    #[inline]
-    fn lit_by(
-        light: Self,
+    fn add_lit(
+        &mut self,
+        light: &Self,
         atten: f64,
-        diffuse: Self,
+        diffuse: &Self,
         ndl: f64,
-        glint: Option<(Self, f64)>,
+        glint: Option<(&Self, f64)>,
         k: f64,
-    ) -> Self {
-        let mut out = light;
-        let glint = glint.as_ref().map(|(s, h)| (&s.0, *h));
-        crate::spectrum::kernels::lit(&mut out.0, &diffuse.0, ndl, glint, atten * k);
-        out
+    ) {
+        let glint = glint.map(|(s, h)| (&s.0, h));
+        kernels::add_lit(&mut self.0, &light.0, &diffuse.0, ndl, glint, atten * k);
     }
 }
 

@@ -4,7 +4,7 @@ use glam::DVec3;
 use std::f64::consts::PI;
 
 /// Primary rays: a pixel's direction is defined in the camera's rest frame and boosted into the
-/// world frame, so a moving camera sees the aberrated sky (DESIGN.md, "Frames and conventions").
+/// world frame, so a moving camera sees the aberrated sky (docs/physics.md §7.2).
 pub struct CameraRays {
     camera: Camera,
     event: Event,

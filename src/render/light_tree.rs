@@ -4,7 +4,7 @@
 //! read forward, its spatial track is light going out from L, on the future light cone of
 //! (t_e, L). A group can meet the ray only where that cone meets the group's worldtube: at the
 //! points x with x − v|x − L| ∈ B(t_e), B(t) the group's world-frame box at time t, moving at v.
-//! Time reversed, that is the apparent shape of PHYSICS.md §2.1 seen from L by a body moving at
+//! Time reversed, that is the apparent shape of docs/physics.md §2.1 seen from L by a body moving at
 //! −v, so [`apparent_box_along`] bounds it; and for emission times in a slice [t_a, t_b] the points
 //! obey x − v|x − L| ∈ B(t_a) ∪ … ∪ B(t_b), inside the box around B(t_a) and B(t_b). So a static
 //! culling structure per slice of emission times holds every group's reachable shape, and a shadow

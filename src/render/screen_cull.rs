@@ -5,7 +5,7 @@
 //! looking directions (the cap holding the directions to its eight corners). A Lorentz
 //! transformation acts on directions as a Möbius map of the celestial sphere, which takes
 //! circles to circles, so that cone, carried into the world frame and on into the camera's rest
-//! frame (the aberration of PHYSICS.md §1.1 each time), is again a cone, found exactly from
+//! frame (the aberration of docs/physics.md §1.1 each time), is again a cone, found exactly from
 //! three of its boundary directions. A 4 × 4 block of pixels (one ray packet) whose directions
 //! all lie outside every group's cone is background, with no camera ray, boost or bounds test
 //! spent on it: one dot product per block and group, and first one per tile and group (a tile

@@ -96,7 +96,7 @@ impl<'a, B: Band> Shader<'a, B> {
     /// with lookback factor `receiver_s` and wavelengths `shift` times the camera's sees it.
     pub fn background(&self, receiver_s: f64, shift: f64) -> B {
         let (shift, k) = self.arriving(receiver_s, 1.0, shift);
-        B::of(&self.scene.image.background, shift) * k
+        B::of(&self.scene.image.background, B::at(shift)) * k
     }
 
     /// Radiance from a sender with lookback factor `sender_s` reaching a receiver with
@@ -241,19 +241,20 @@ impl<'a, B: Band> Shader<'a, B> {
         reaches: impl Fn(usize, &ShadowQuery) -> bool,
         depth: u32,
     ) -> B {
-        let (mat, shift) = (lit.mat, lit.shift);
+        let (mat, at) = (lit.mat, B::at(lit.shift));
         if let Some(e) = &mat.emission {
-            return B::of(e, shift);
+            return B::of(e, at);
         }
-        let diffuse = B::of(&mat.color, shift);
-        let mut color = B::of(&self.scene.render.ambient, shift) * diffuse;
-        let specular = (!mat.specular.is_black()).then(|| B::of(&mat.specular, shift));
+        let diffuse = B::of(&mat.color, at);
+        let mut color = B::of(&self.scene.render.ambient, at);
+        color.mul_by(&diffuse);
+        let specular = (!mat.specular.is_black()).then(|| B::of(&mat.specular, at));
         for (l, q) in shadows.iter().enumerate() {
             if let Some(q) = q.as_ref().filter(|q| reaches(l, q)) {
                 let t = &q.term;
-                let light = B::of(&self.lights[l].light.radiance, t.shift);
-                let glint = specular.zip(t.highlight);
-                color += B::lit_by(light, t.atten, diffuse, t.ndl, glint, t.k);
+                let light = B::of(&self.lights[l].light.radiance, B::at(t.shift));
+                let glint = specular.as_ref().zip(t.highlight);
+                color.add_lit(&light, t.atten, &diffuse, t.ndl, glint, t.k);
             }
         }
         if depth >= self.scene.render.max_depth {
@@ -280,12 +281,12 @@ impl<'a, B: Band> Shader<'a, B> {
         if kr > 0.0 {
             let r = self.spawn(lit.group, event, nf, reflect(v, nf));
             let s = self.lookback_factor(lit.group, r.dir);
-            color += self.trace(&r, s, lit.shift, depth + 1) * kr;
+            color.add(&(self.trace(&r, s, lit.shift, depth + 1) * kr));
         }
         if let (Some(t), true) = (refracted, kt > 0.0) {
             let r = self.spawn(lit.group, event, -nf, t);
             let s = self.lookback_factor(lit.group, r.dir);
-            color += self.trace(&r, s, lit.shift, depth + 1) * kt;
+            color.add(&(self.trace(&r, s, lit.shift, depth + 1) * kt));
         }
         color
     }

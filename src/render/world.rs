@@ -371,7 +371,7 @@ impl World {
 
     /// Boost into group g's rest frame; None when the ray misses the group's bounds in
     /// (tmin, tmax). The origin moves along the ray to where it enters the bounds, so the
-    /// backend never sees large coordinates (DESIGN.md).
+    /// backend never sees large coordinates (docs/physics.md §7.1).
     #[inline(always)]
     fn rest_ray(&self, g: &GroupRt, ray: &NullRay, tmin: f64, tmax: f64) -> Option<RestRay> {
         // Every primary ray starts at the imaging event: its rest-frame origin is per group.

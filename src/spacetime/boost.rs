@@ -3,7 +3,7 @@ use crate::geometry::Real;
 use glam::DVec3;
 
 /// A passive Lorentz boost along any direction, evaluated in light-cone coordinates along the
-/// boost axis (PHYSICS.md §8.2 item 4): `u = t − x∥`, `w = t + x∥`, `u' = e^{φ} u`, `w' = e^{−φ} w`,
+/// boost axis (docs/physics.md §8.2 item 4): `u = t − x∥`, `w = t + x∥`, `u' = e^{φ} u`, `w' = e^{−φ} w`,
 /// `x⊥' = x⊥`. No step subtracts nearly equal numbers, so speeds like 1 − 1e-12 stay exact.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Boost {
@@ -26,7 +26,7 @@ impl Boost {
     };
 
     /// The boost from a frame into the frame that moves at `v` relative to it
-    /// (`X' = Λ(β) X`, PHYSICS.md §1.3).
+    /// (`X' = Λ(β) X`, docs/physics.md §1.3).
     pub fn to_rest(v: &Velocity) -> Boost {
         if v.is_zero() {
             return Self::IDENTITY;
@@ -75,7 +75,7 @@ impl Boost {
     /// Transform the past-directed null vector `(−1, a)` with `a` a unit vector. Returns the
     /// spatial part `d'` (unnormalised) and `s = −t' = |d'|`, the factor by which the frame's
     /// lookback time exceeds the original one: for a boost into a frame moving at β,
-    /// `s = γ(1 + β·a)` (DESIGN.md, "the one trick").
+    /// `s = γ(1 + β·a)` (docs/physics.md §7.1).
     pub fn null_dir(&self, a: DVec3) -> (DVec3, f64) {
         if self.identity {
             return (a, 1.0);

@@ -1,7 +1,7 @@
 //! Special-relativistic kinematics in f64: events, velocities stored by rapidity, Lorentz boosts
 //! in any direction, past-directed null rays and the Doppler factor.
 //!
-//! Conventions (DESIGN.md, PHYSICS.md §0): c = 1; a boost `Boost::to_rest(v)` is the passive
+//! Conventions (docs/physics.md §0): c = 1; a boost `Boost::to_rest(v)` is the passive
 //! transformation from the world frame W into the frame that moves at `v` relative to W.
 
 mod boost;

@@ -1,4 +1,4 @@
-//! The apparent (retarded) position of a uniformly moving point (PHYSICS.md §2.1), in the
+//! The apparent (retarded) position of a uniformly moving point (docs/physics.md §2.1), in the
 //! sign-split form that never subtracts nearly equal numbers.
 
 use super::Velocity;

@@ -57,20 +57,27 @@ pub fn scale(a: &mut Lanes, k: f64) {
     }
 }
 
-/// A light's term: `light[i] · (diffuse[i] · ndl + spec[i] · h) · a`, or without the
-/// specular part `light[i] · (diffuse[i] · (ndl · a))`.
+/// `acc[i] += light[i] · (diffuse[i] · ndl + spec[i] · h) · a`, or without the specular part
+/// `acc[i] += light[i] · (diffuse[i] · (ndl · a))`: a light's term at a surface.
 #[multiversion(targets("x86_64+avx2"))]
-pub fn lit(light: &mut Lanes, diffuse: &Lanes, ndl: f64, glint: Option<(&Lanes, f64)>, a: f64) {
+pub fn add_lit(
+    acc: &mut Lanes,
+    light: &Lanes,
+    diffuse: &Lanes,
+    ndl: f64,
+    glint: Option<(&Lanes, f64)>,
+    a: f64,
+) {
     match glint {
         Some((spec, h)) => {
             for i in 0..SAMPLES {
-                light[i] *= (diffuse[i] * ndl + spec[i] * h) * a;
+                acc[i] += light[i] * ((diffuse[i] * ndl + spec[i] * h) * a);
             }
         }
         None => {
             let k = ndl * a;
             for i in 0..SAMPLES {
-                light[i] *= diffuse[i] * k;
+                acc[i] += light[i] * (diffuse[i] * k);
             }
         }
     }

@@ -26,6 +26,23 @@ const C1L: f64 = 1.191_042_972_397_188_4e-16;
 /// Planck's second radiation constant hc/k (m·K; CODATA 2018, exact).
 const C2: f64 = 1.438_776_877_503_933_8e-2;
 
+/// A frame's wavelengths over the camera's, with its logarithm (what a log-wavelength table
+/// needs), computed once for all the colours read in that frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shift {
+    pub factor: f64,
+    pub ln: f64,
+}
+
+impl Shift {
+    pub fn new(factor: f64) -> Shift {
+        Shift {
+            factor,
+            ln: factor.ln(),
+        }
+    }
+}
+
 /// A spectrum: a non-negative function of wavelength (nm), defined at every wavelength.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Spectrum {
@@ -158,10 +175,10 @@ impl Colour {
     }
 
     /// The colour at the camera's wavelengths times `shift`.
-    pub fn sampled(&self, shift: f64) -> Sampled {
+    pub fn sampled(&self, shift: Shift) -> Sampled {
         match &self.table {
             Some(t) => t.sample(shift, &self.spectrum),
-            None => Sampled::of(&self.spectrum, shift),
+            None => Sampled::of(&self.spectrum, shift.factor),
         }
     }
 

@@ -1,7 +1,7 @@
 //! Radiance (or a reflectance) at the camera's wavelengths, followed back along a path.
 
 use super::{camera, Spectrum};
-use std::ops::{Add, AddAssign, Mul};
+use std::ops::Mul;
 
 /// How many wavelengths the camera reads (see [`camera`]).
 pub const SAMPLES: usize = 64;
@@ -38,29 +38,7 @@ impl Sampled {
     }
 }
 
-// The operators are the loops of `kernels`, vectorised.
-impl Add for Sampled {
-    type Output = Sampled;
-    fn add(mut self, o: Sampled) -> Sampled {
-        self += o;
-        self
-    }
-}
-
-impl AddAssign for Sampled {
-    fn add_assign(&mut self, o: Sampled) {
-        super::kernels::add(&mut self.0, &o.0);
-    }
-}
-
-impl Mul for Sampled {
-    type Output = Sampled;
-    fn mul(mut self, o: Sampled) -> Sampled {
-        super::kernels::mul(&mut self.0, &o.0);
-        self
-    }
-}
-
+// Scaling is the loop of `kernels`, vectorised (the rest is in `render::band`, by reference).
 impl Mul<f64> for Sampled {
     type Output = Sampled;
     fn mul(mut self, k: f64) -> Sampled {

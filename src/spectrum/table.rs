@@ -10,7 +10,7 @@
 //! for (RGB uplifts and blackbodies; D65's 5 nm table is itself linear, so the white is within
 //! 1e-3 at its kinks).
 
-use super::{camera, Sampled, Spectrum, SAMPLES};
+use super::{camera, Sampled, Shift, Spectrum, SAMPLES};
 use std::sync::OnceLock;
 
 /// Grid steps per camera bin.
@@ -61,9 +61,9 @@ impl LogTable {
     }
 
     /// The spectrum at the camera's wavelengths times `shift` (`exact` off the grid).
-    pub fn sample(&self, shift: f64, exact: &Spectrum) -> Sampled {
+    pub fn sample(&self, shift: Shift, exact: &Spectrum) -> Sampled {
         let g = grid();
-        let offset = shift.ln() / g.step + g.below as f64;
+        let offset = shift.ln / g.step + g.below as f64;
         let q = offset.floor();
         // Grid position of wavelength i: q + i·PHASES + t.
         if q >= 0.0 && q + ((SAMPLES - 1) * PHASES + 1) as f64 <= (self.row_len * PHASES - 1) as f64
@@ -81,14 +81,14 @@ impl LogTable {
             super::kernels::lerp(lo, hi, t, &mut out.0);
             return out;
         }
-        Sampled::of(exact, shift)
+        Sampled::of(exact, shift.factor)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spectrum::{Colour, Role};
+    use crate::spectrum::{Colour, Role, Shift};
     use glam::DVec3;
 
     /// Within 1e-4 of the spectrum's peak (1e-3 for the white, whose D65 table has kinks) at
@@ -125,7 +125,7 @@ mod tests {
             for shift in [
                 0.01, 0.0626, 0.07, 0.5, 0.98, 1.0, 1.7, 9.0, 15.9, 16.1, 40.0,
             ] {
-                let got = table.sample(shift, &s);
+                let got = table.sample(Shift::new(shift), &s);
                 let want = Sampled::of(&s, shift);
                 let peak = want
                     .0

@@ -43,7 +43,7 @@ pub fn assert_rel(a: f64, b: f64, rel: f64, what: &str) {
     );
 }
 
-/// The physics cases of PHYSICS.md (a copy of shared/physics/cases.json).
+/// The worked cases of docs/physics.md §2-§4 (tests/data/cases.json; its "source" says where they come from).
 pub fn cases() -> serde_json::Value {
     serde_json::from_str(include_str!("../data/cases.json")).expect("cases.json parses")
 }

@@ -2,7 +2,7 @@
 //! Embree as 16-wide packets (8-wide where the CPU has no native 16-wide support), 64-byte
 //! aligned, with the coherent flag and a valid mask; single rays and occlusion queries as well.
 //!
-//! Precision (DESIGN.md): the renderer hands over f64 rays (rebased to the near side of the
+//! Precision (docs/physics.md §7.1): the renderer hands over f64 rays (rebased to the near side of the
 //! group's bounds when they come from afar); here they are made relative to the scene's centre,
 //! given a unit direction, and only then cast to f32. Spheres, rods and boxes are user geometry
 //! tested in f64 on the caller's f64 ray (exact.rs); a triangle hit's t is converted back and

@@ -24,7 +24,7 @@ const SLACK: f64 = 1e-9;
 /// only to ~2e-16 / (1 − β) relative, and over its long ride (a lookback of ~1/(1 − β)) that
 /// moves it sideways by as much relative to its distance: below the slack only for
 /// 1 − β ≳ 2e-6. (At 1 − β = 1e-12 such rays were turned away from groups they meet; the boost
-/// works with the rapidity instead, PHYSICS.md §8.)
+/// works with the rapidity instead, docs/physics.md §8.)
 const MIN_ONE_MINUS_BETA: f64 = 1e-5;
 
 #[derive(Clone, Copy, Debug)]
@@ -196,7 +196,7 @@ mod tests {
                 }
                 let rest_dir = (p - ahead).normalize();
                 // Its rest-frame time such that its world time is near t_ref, as a shading
-                // point's would be: t = γ(τ + β x) (PHYSICS.md §1.3).
+                // point's would be: t = γ(τ + β x) (docs/physics.md §1.3).
                 let t_world = 120.0 - rng.range(0.0, 50.0);
                 let tau = t_world / v.gamma() - v.beta() * ahead.x;
                 let rest_event = Event::new(tau, ahead);
