@@ -136,16 +136,19 @@ impl Seen {
     }
 
     fn shifted(&self, d: f64, shift: f64, searchlight_power: i32) -> (f64, f64) {
-        let mut power = 0;
-        let mut sender_shift = shift;
+        if !self.any() {
+            return (shift, 1.0);
+        }
+        let (mut sender_shift, mut k) = (shift, 1.0);
         if self.doppler {
-            power += 1;
             sender_shift = d * shift;
+            k = d;
         }
         if self.searchlight {
-            power += searchlight_power;
+            let d2 = d * d;
+            k *= if searchlight_power == 4 { d2 * d2 } else { d2 };
         }
-        (sender_shift, d.powi(power))
+        (sender_shift, k)
     }
 
     /// Radiance seen across a change of frame with frequency ratio `d` = ν_receiver/ν_sender,

@@ -151,6 +151,8 @@ pub struct Colour {
     pub from_rgb: bool,
     /// The spectrum on a logarithmic grid, for the smooth kinds (see [`table`]).
     table: Option<Arc<table::LogTable>>,
+    /// Black at every wavelength (asked per hit, so kept).
+    black: bool,
 }
 
 impl PartialEq for Colour {
@@ -166,11 +168,13 @@ impl Colour {
             Spectrum::Sigmoid { .. } | Spectrum::Illuminant { .. } | Spectrum::Blackbody { .. }
         );
         let table = smooth.then(|| Arc::new(table::LogTable::new(&spectrum)));
+        let black = spectrum == Spectrum::Flat(0.0) || rgb == DVec3::ZERO && from_rgb;
         Colour {
             rgb,
             spectrum,
             from_rgb,
             table,
+            black,
         }
     }
 
@@ -244,7 +248,7 @@ impl Colour {
 
     /// Whether it is black at every wavelength.
     pub fn is_black(&self) -> bool {
-        self.spectrum == Spectrum::Flat(0.0) || self.rgb == DVec3::ZERO && self.from_rgb
+        self.black
     }
 }
 
