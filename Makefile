@@ -4,7 +4,7 @@
 CARGO ?= cargo
 OUT ?= out
 
-.PHONY: setup demo test bench images
+.PHONY: setup demo test bench images docs
 
 setup:
 	@scripts/setup.sh
@@ -27,6 +27,15 @@ test: setup
 bench: setup
 	$(CARGO) build --release
 	./target/release/rest-embree bench --threads 2
+
+# Everything in docs/ that is generated: the bench's figures (docs/bench, docs/performance.md),
+# the accuracy table (docs/ACCURACY.md) and the README's pictures (docs/img).
+docs: setup
+	$(CARGO) build --release
+	./target/release/rest-embree bench --threads 2 --out docs/bench
+	scripts/performance-doc.sh
+	scripts/accuracy-table.sh
+	scripts/readme-images.sh
 
 # The pictures in the README (docs/img).
 images: setup

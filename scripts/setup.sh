@@ -21,6 +21,6 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 if ! command -v cargo >/dev/null 2>&1; then
-  echo "setup: Rust is not installed. Install Rust 1.80 or newer (https://rustup.rs), then run this again." >&2
+  echo "setup: Rust is not installed. Install Rust 1.87 or newer (https://rustup.rs), then run this again." >&2
   exit 1
 fi

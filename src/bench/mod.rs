@@ -196,10 +196,9 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
     memory::reset_peak();
     // The cold cost of a frame: the build, then the first render, which also builds whatever is
     // built on first use (the time slices of many groups). Before that render one untimed
-    // primary pass (thread pools, page faults; renders right after a build were measured 1.5x
-    // slow while Embree's build threads wind down). Frames of milliseconds vary by tens of
-    // percent (one of 12 ms was once measured at 24): on fresh worlds, one at a time, keep the
-    // fastest build and the fastest first render.
+    // primary pass (thread pools, page faults; renders right after a build are slow while
+    // Embree's build threads wind down). Frames of milliseconds vary by tens of percent: on
+    // fresh worlds, one at a time, keep the fastest build and the fastest first render.
     let (mut build_s, mut first_render_s) = (f64::INFINITY, f64::INFINITY);
     let mut kept = None;
     for i in 0..repeat.max(1) {
@@ -252,8 +251,8 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, 
 /// The case's other scene (`other`, which is `what`) beside a row of `case` on `setting`: its
 /// frame measured as `measure` measures one, then the warm renders of both in alternating
 /// blocks, each the fastest of its passes, which count among the row's (as `bare_embree` sets
-/// the layer beside bare Embree). Measured as two cases seconds apart, a render of 25 ms was
-/// once the fastest of ten at 29 on one side only, and a ratio read 3.4 instead of 2.8.
+/// the layer beside bare Embree). Measured as two cases seconds apart, a slow spell of the
+/// machine can fall on one side only.
 fn beside(
     case: &Case,
     (what, one): (&str, &Scene),
@@ -321,9 +320,9 @@ const PAIRED_BLOCKS: usize = 3;
 /// blocks, each block the fastest of its warm passes (`fastest`): (rays, bare Embree's best
 /// seconds, the layer's). Both trace the one Embree scene in the same stretch of time, so
 /// neither the memory layout of two scenes built apart nor the machine's drift from one second
-/// to the next falls on one side alone (measured apart, the layer's best pass varied by 7%
-/// from run to run, bare Embree's by 2%). Passes alternated one by one instead would start
-/// each with the other's data in the caches.
+/// to the next falls on one side alone (measured apart, the layer's best pass varied far more
+/// from run to run than bare Embree's). Passes alternated one by one instead would start each
+/// with the other's data in the caches.
 #[cfg(feature = "embree")]
 fn bare_embree(case: &Case, repeat: usize) -> Result<Option<(u64, f64, f64)>, String> {
     use rayon::prelude::*;

@@ -212,9 +212,9 @@ impl Primitive {
 /// segment, else where it enters the end ball on that side; likewise for the exit.
 ///
 /// A rod along x, y or z (every rod of a lattice) takes [`aligned_capsule_hit`]: the same
-/// arithmetic with the axis's components known to be zero. Alone it measured about 1% faster;
-/// it is here because the Embree backend tests such rods four rays at a time with the same
-/// [`cylinder_crossings`], and the two must agree to the bit.
+/// arithmetic with the axis's components known to be zero. It is here because the Embree
+/// backend tests such rods four rays at a time with the same [`cylinder_crossings`], and the
+/// two must agree to the bit.
 #[inline]
 pub(crate) fn capsule_hit(
     a: DVec3,

@@ -37,7 +37,7 @@ pub struct GroupTree {
 /// each piece asks the tree nearest in time, so a node's bounds grow by at most v_max times
 /// half the slice spacing (plus the ends, beyond which the outermost trees serve). The inner
 /// trees test each node's static box over their span first (a plain slab test, a fraction of
-/// the cost of the moving bounds'): shadow rays among 10,000 groups 13% faster.
+/// the cost of the moving bounds', which it spares most nodes a ray does not meet).
 pub struct SlicedGroupTree {
     slices: Vec<GroupTree>,
 }
@@ -52,8 +52,7 @@ impl SlicedGroupTree {
     ) -> SlicedGroupTree {
         let count = count.max(1);
         // One SAH build per slice: groups that are neighbours at one time drift apart at
-        // another, so a shared topology (refitted) overlaps badly (measured: 50x slower
-        // shadow rays with 10,000 groups).
+        // another, so a shared topology (refitted) overlaps badly and rays visit most of it.
         use rayon::prelude::*;
         let slices = (0..count)
             .into_par_iter()

@@ -118,8 +118,8 @@ impl ScreenCull {
             cones.push(widened(c.axis, c.half_angle, block_radius));
             tile_cones.push(widened(c.axis, c.half_angle, tile_radius));
         }
-        // A cull that keeps every block is all cost (4% of a primary ray where the lattice
-        // fills the view). A cone narrower than a hemisphere is convex on the sphere, and a
+        // A cull that keeps every block is all cost (a test per block where a group fills the
+        // view). A cone narrower than a hemisphere is convex on the sphere, and a
         // pinhole's image is the convex hull of its corners' directions (lines on the image
         // plane look along great circles), so a cone that holds the four corners holds the
         // centre of every block.

@@ -34,7 +34,7 @@ fn reflect(v: DVec3, n: DVec3) -> DVec3 {
 }
 
 /// Phong's highlight, `cos^shininess` (cos ≥ 0): by repeated multiplication for a whole-number
-/// exponent, the usual case (`powf` cost a sixth of shading the lattice), else `powf`.
+/// exponent, the usual case (`powf` is a large share of shading), else `powf`.
 fn highlight(cos: f64, shininess: f64) -> f64 {
     if shininess.fract() == 0.0 && shininess <= 1024.0 {
         cos.powi(shininess as i32)

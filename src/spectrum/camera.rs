@@ -218,7 +218,7 @@ mod tests {
         assert!(white(5000.0) > 0.0 && white(100.0) > 0.0);
     }
 
-    /// The camera's wavelengths integrate what the cases show within 1% of the 1 nm
+    /// The camera's wavelengths integrate what the physics tests use within 1% of the 1 nm
     /// CIE sum: blackbodies from 1625 K to 26000 K, the white, and Gaussian lines at least
     /// 20 nm wide anywhere in 420-680 nm.
     #[test]

@@ -5,8 +5,8 @@
 //!
 //! Made one by one, a primary ray runs a chain of square roots and divisions (the camera's
 //! unit direction, the boost, the packet's unit direction) and goes through three layouts (the
-//! world-frame ray, the rest-frame ray, Embree's lane): ~25 ns of the layer's own per ray on the
-//! paper's lattice, before the fans, against bare Embree's ~40. Here the same arithmetic
+//! world-frame ray, the rest-frame ray, Embree's lane): most of the layer's own cost per ray,
+//! set beside bare Embree's (the bench's `embree no-fused` row). Here the same arithmetic
 //! (`Pinhole::look`, `Boost::null_dir_lanes`, `lane_geometry`, each written once for one lane or
 //! four) runs on columns, so every lane's values are the scalar path's to the bit and images do
 //! not depend on which path made them (tests/fused_primary.rs); the columns (`FanHits`) are
@@ -136,8 +136,8 @@ macro_rules! fan_packet {
                     if let Some(runs) = self.scene.exact_runs {
                         // Every hit exact, so as `to_hit` reads it (the callbacks record only
                         // a t in the rays' lookback (0, ∞)), but with no lookup and no branch on
-                        // whether a lane hit: lanes hit or miss about at random, and the
-                        // general read-back below cost ~1.5 ns per primary ray more.
+                        // whether a lane hit: lanes hit or miss about at random, so the general
+                        // read-back below mispredicts often.
                         for i in 0..n {
                             let t = ctx.exact_t(i);
                             let prim = runs.hit(rh.hit.geomID[i], rh.hit.primID[i]);

@@ -72,8 +72,8 @@ unsafe fn near_avx2<const N: usize>(ray: *const f32, lo: DVec3, hi: DVec3) -> u3
 /// Bit i set unless lane i's line provably misses the box (padded): one of the three axes
 /// perpendicular to both the line and a box edge separates them (|w × d| against the box's
 /// projected half widths, w the origin relative to the box's centre). Lines, not rays: the
-/// frustum traversal already keeps boxes behind a packet out, and testing the rays' ends as
-/// well measured no faster.
+/// frustum traversal already keeps boxes behind a packet out, so testing the rays' ends as
+/// well would add work that rarely drops a lane.
 ///
 /// # Safety
 /// `ray` points to an N-wide SoA ray, N a multiple of 8 (at most 32).

@@ -27,8 +27,8 @@ pub(super) const MAX: usize = 16;
 /// its packet lane and its interval (tmin, tmax).
 ///
 /// Left uninitialised but for the fours that hold the entries set (the rest zeros): Embree
-/// calls back for each primitive a ray may meet, and clearing all 1.1 kB each time measured as
-/// much as the tests it feeds at 0.99c.
+/// calls back for each primitive a ray may meet, and clearing all of it each time costs as much
+/// as the few tests it feeds where packets are sparse (near c).
 pub(super) struct LaneRays {
     /// Origin x, y, z, direction x, y, z, tmin, tmax.
     cols: [[MaybeUninit<f64>; MAX]; 8],

@@ -95,7 +95,7 @@ macro_rules! packet_fns {
                             let hit = valid.0[i] != 0 && prim.is_some();
                             debug_assert!(!hit || (t > r.tmin && t < r.tmax));
                             // The hit made whether or not it is kept, so nothing branches
-                            // (`prim.filter(..).map(..)` measured 0.6 ns per ray slower).
+                            // (lanes hit or miss about at random).
                             let h = Hit {
                                 t,
                                 prim: prim.unwrap_or_default(),

@@ -104,8 +104,8 @@ impl World {
 
 /// A tile's primary rays and their visible hits (`World::primary_hits`), ray by ray: made one
 /// by one, as rays and hits; or from fans, as the backend left them, in its columns, read back
-/// when asked for (writing out every ray and hit had cost ~3.5 ns of a ~54 ns primary ray on
-/// the paper's lattice, and the renderer reads each once or twice). Kept from one tile to the
+/// when asked for (writing out every ray and hit costs more than reading the few the renderer
+/// asks for, once or twice each). Kept from one tile to the
 /// next, so its buffers are allocated once.
 #[derive(Default)]
 pub struct PrimaryHits {
@@ -147,7 +147,7 @@ impl PrimaryHits {
         if self.fan.is_none() {
             return self.hits.iter().filter(|h| h.is_some()).count();
         }
-        // Packet by packet (a flat iterator over the lanes cost ~1% of a primary ray).
+        // Packet by packet (a flat iterator over the lanes adds a division per lane).
         let (whole, rest) = (self.len / PACKET, self.len % PACKET);
         let count = |prim: &[u32]| {
             prim.iter()
