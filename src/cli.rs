@@ -1,6 +1,6 @@
 //! The command line: `rest-embree render SCENE -o OUT.{exr,png} [options]`.
 
-use crate::{accel, bench, output, render, scene};
+use crate::{accel, bench, output, render, scene, Error};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -126,7 +126,7 @@ pub fn run(cli: Cli) -> ExitCode {
     }
 }
 
-fn report(r: Result<(), String>) -> ExitCode {
+fn report(r: crate::Result<()>) -> ExitCode {
     match r {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -136,15 +136,15 @@ fn report(r: Result<(), String>) -> ExitCode {
     }
 }
 
-fn set_threads(threads: Option<usize>) -> Result<(), String> {
+fn set_threads(threads: Option<usize>) -> crate::Result<()> {
     if let Some(n) = threads {
         if n == 0 {
-            return Err("--threads: must be at least 1".into());
+            return Err(Error::flag("--threads", "must be at least 1"));
         }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()
-            .map_err(|e| format!("--threads: {e}"))?;
+            .map_err(|e| Error::flag("--threads", e))?;
     }
     Ok(())
 }
@@ -152,7 +152,7 @@ fn set_threads(threads: Option<usize>) -> Result<(), String> {
 /// The cases `--case` asks for: for each text, the case of that name, or where no case has it,
 /// every case whose name contains it (so `lattice beta=0.9` is that case alone, `beta=0.9` also
 /// its variants and 0.99).
-fn pick_cases(all: Vec<bench::LazyCase>, texts: &[String]) -> Result<Vec<bench::LazyCase>, String> {
+fn pick_cases(all: Vec<bench::LazyCase>, texts: &[String]) -> crate::Result<Vec<bench::LazyCase>> {
     let names: Vec<String> = all.iter().map(|c| c.name.clone()).collect();
     let named = |t: &String| names.contains(t);
     let wanted = |name: &str| {
@@ -166,16 +166,19 @@ fn pick_cases(all: Vec<bench::LazyCase>, texts: &[String]) -> Result<Vec<bench::
     };
     let picked: Vec<bench::LazyCase> = all.into_iter().filter(|c| wanted(&c.name)).collect();
     if picked.is_empty() {
-        return Err(format!(
-            "--case: no case of the suite matches {}; the cases are: {}",
-            texts.join(", "),
-            names.join("; ")
+        return Err(Error::flag(
+            "--case",
+            format!(
+                "no case of the suite matches {}; the cases are: {}",
+                texts.join(", "),
+                names.join("; ")
+            ),
         ));
     }
     Ok(picked)
 }
 
-fn run_bench(args: &BenchArgs) -> Result<(), String> {
+fn run_bench(args: &BenchArgs) -> crate::Result<()> {
     set_threads(args.threads)?;
     let cases = match &args.scene {
         None => {
@@ -192,7 +195,7 @@ fn run_bench(args: &BenchArgs) -> Result<(), String> {
                 .iter()
                 .map(|s| (format!("--set {s}"), s.clone()))
                 .collect();
-            let scene = scene::load_file(path, &overrides).map_err(|e| e.to_string())?;
+            let scene = scene::load_file(path, &overrides)?;
             let names: Vec<String> = if args.backends.is_empty() {
                 accel::backend_names()
                     .iter()
@@ -203,7 +206,7 @@ fn run_bench(args: &BenchArgs) -> Result<(), String> {
             };
             for n in &names {
                 let backend = n.split_whitespace().next().unwrap_or_default();
-                accel::backend_by_name(backend).map_err(|e| format!("--backend: {e}"))?;
+                accel::backend_by_name(backend).map_err(|e| e.on_flag("--backend"))?;
             }
             let refs: Vec<&str> = names.iter().map(String::as_str).collect();
             vec![bench::LazyCase::ready(
@@ -218,15 +221,15 @@ fn run_bench(args: &BenchArgs) -> Result<(), String> {
         "threads: {}\n\n{table}\n{summary}",
         rayon::current_num_threads()
     );
-    std::fs::create_dir_all(&args.out).map_err(|e| format!("--out {}: {e}", args.out.display()))?;
+    let out_flag = format!("--out {}", args.out.display());
+    std::fs::create_dir_all(&args.out).map_err(|e| Error::flag(&out_flag, e))?;
     let md = format!(
         "Measured with `rest-embree bench{}` on {} threads.\n\n{table}\n{summary}",
         if args.quick { " --quick" } else { "" },
         rayon::current_num_threads()
     );
     let write = |name: &str, text: &str| {
-        std::fs::write(args.out.join(name), text)
-            .map_err(|e| format!("--out {}: {e}", args.out.display()))
+        std::fs::write(args.out.join(name), text).map_err(|e| Error::flag(&out_flag, e))
     };
     write("bench.md", &md)?;
     write("bench.csv", &bench::csv(&rows))?;
@@ -238,16 +241,16 @@ fn run_bench(args: &BenchArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn run_render(args: &RenderArgs) -> Result<(), String> {
+fn run_render(args: &RenderArgs) -> crate::Result<()> {
     // Check everything that can be checked before the (possibly long) render.
-    let format = output::Format::for_path(&args.output).map_err(|e| format!("-o: {e}"))?;
+    let format = output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
     let backend_name = args
         .backend
         .clone()
         .unwrap_or_else(|| accel::default_backend_name().to_string());
-    let backend = accel::backend_by_name(&backend_name).map_err(|e| format!("--backend: {e}"))?;
+    let backend = accel::backend_by_name(&backend_name).map_err(|e| e.on_flag("--backend"))?;
     set_threads(args.threads)?;
-    let scene = scene::load_file(&args.scene, &args.overrides()).map_err(|e| e.to_string())?;
+    let scene = scene::load_file(&args.scene, &args.overrides())?;
     // A PNG holds colour alone: the passes (and with several samples, their extra ray per
     // pixel) are skipped.
     let passes = match format {
@@ -284,7 +287,7 @@ fn run_render(args: &RenderArgs) -> Result<(), String> {
 mod tests {
     use super::*;
 
-    fn picked(texts: &[&str]) -> Result<Vec<String>, String> {
+    fn picked(texts: &[&str]) -> crate::Result<Vec<String>> {
         let texts: Vec<String> = texts.iter().map(|t| t.to_string()).collect();
         Ok(pick_cases(bench::cases(true), &texts)?
             .into_iter()
@@ -301,7 +304,7 @@ mod tests {
         assert!(some.contains(&"lattice beta=0.99".to_string()), "{some:?}");
         let both = picked(&["lattice beta=0", "lattice beta=0.5"]).unwrap();
         assert_eq!(both, ["lattice beta=0", "lattice beta=0.5"]);
-        let err = picked(&["no such case"]).unwrap_err();
+        let err = picked(&["no such case"]).unwrap_err().to_string();
         assert!(
             err.contains("--case") && err.contains("lattice beta=0.99"),
             "{err}"

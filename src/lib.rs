@@ -9,6 +9,7 @@ pub mod accel;
 pub mod bench;
 pub mod cli;
 pub mod compare;
+mod error;
 pub mod geometry;
 pub mod output;
 pub mod render;
@@ -16,3 +17,5 @@ pub mod rng;
 pub mod scene;
 pub mod spacetime;
 pub mod spectrum;
+
+pub use error::{Cause, Error, Result};

@@ -24,7 +24,7 @@ impl Backend for BvhBackend {
     fn name(&self) -> &'static str {
         "bvh"
     }
-    fn build(&self, geometry: Arc<Geometry>) -> Result<Box<dyn Accelerator>, String> {
+    fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>> {
         Ok(Box::new(Bvh::build(geometry)))
     }
 }

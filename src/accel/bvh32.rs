@@ -30,7 +30,7 @@ impl Backend for Bvh32Backend {
     fn name(&self) -> &'static str {
         "bvh-f32"
     }
-    fn build(&self, geometry: Arc<Geometry>) -> Result<Box<dyn Accelerator>, String> {
+    fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>> {
         Ok(Box::new(Bvh::with_f32_nodes(geometry)))
     }
 }

@@ -88,7 +88,7 @@ pub trait Accelerator: Send + Sync {
 /// Builds accelerators; one per kind of backend.
 pub trait Backend: Send + Sync {
     fn name(&self) -> &'static str;
-    fn build(&self, geometry: Arc<Geometry>) -> Result<Box<dyn Accelerator>, String>;
+    fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>>;
     /// What builds culling structures over boxes (the trees over many velocity groups), also
     /// later, on first use; by default the f64 box tree.
     fn cullers(&self) -> CullerFactory {
@@ -97,7 +97,7 @@ pub trait Backend: Send + Sync {
 }
 
 /// Builds a [`BoxCuller`] over boxes.
-pub type CullerFactory = Arc<dyn Fn(&[Aabb]) -> Result<Box<dyn BoxCuller>, String> + Send + Sync>;
+pub type CullerFactory = Arc<dyn Fn(&[Aabb]) -> crate::Result<Box<dyn BoxCuller>> + Send + Sync>;
 
 /// A culling structure over boxes, one per item, that packets of rays from one origin `o`
 /// traverse (directions `dirs`, each searched in `(tmin[i], tmax[i])`): `visit(item, ray, tmax)`
@@ -170,7 +170,7 @@ pub fn default_backend_name() -> &'static str {
 }
 
 /// The backend of that name, or an error that lists the choices.
-pub fn backend_by_name(name: &str) -> Result<Box<dyn Backend>, String> {
+pub fn backend_by_name(name: &str) -> crate::Result<Box<dyn Backend>> {
     match name {
         "bvh" => Ok(Box::new(BvhBackend)),
         // The f64 BVH's tree with f32 nodes, for comparisons.
@@ -185,13 +185,12 @@ pub fn backend_by_name(name: &str) -> Result<Box<dyn Backend>, String> {
         #[cfg(feature = "embree")]
         "embree-single" => Ok(Box::new(EmbreeBackend::with_packet_width(1))),
         #[cfg(not(feature = "embree"))]
-        "embree" | "embree-16" | "embree-8" | "embree-single" => Err(
-            "backend 'embree' is not in this build: rebuild with `--features embree` (needs libembree-dev and libclang-dev)"
-                .to_string(),
-        ),
-        other => Err(format!(
+        "embree" | "embree-16" | "embree-8" | "embree-single" => Err(crate::Error::backend(
+            "backend 'embree' is not in this build: rebuild with `--features embree` (needs libembree-dev and libclang-dev)",
+        )),
+        other => Err(crate::Error::backend(format!(
             "unknown backend '{other}' (choose one of: {})",
             backend_names().join(", ")
-        )),
+        ))),
     }
 }

@@ -168,7 +168,7 @@ fn with_spp(scene: &Scene, spp: u32) -> Scene {
     s
 }
 
-fn reference(scene: &Scene, spp: u32) -> Result<Frame, String> {
+fn reference(scene: &Scene, spp: u32) -> crate::Result<Frame> {
     let s = with_spp(scene, spp);
     let bvh = backend_by_name("bvh")?;
     Ok(render_world(&s, &World::build(&s, bvh.as_ref())?).0)
@@ -189,7 +189,7 @@ fn fastest(repeat: usize, mut f: impl FnMut()) -> f64 {
     best
 }
 
-fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> Result<(Row, Frame), String> {
+fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result<(Row, Frame)> {
     let (backend_name, options, passes) = parse_setting(setting);
     let backend = backend_by_name(backend_name)?;
     let scene = with_spp(&case.scene, spp);
@@ -259,7 +259,7 @@ fn beside(
     setting: &str,
     repeat: usize,
     row: &mut Row,
-) -> Result<Beside, String> {
+) -> crate::Result<Beside> {
     let alone = Case::new(&case.name, one.clone(), &[setting]).without_hi_reference();
     let (one_row, _) = measure(&alone, setting, 1, repeat)?;
     let (backend_name, options, passes) = parse_setting(setting);
@@ -324,7 +324,7 @@ const PAIRED_BLOCKS: usize = 3;
 /// from run to run than bare Embree's). Passes alternated one by one instead would start each
 /// with the other's data in the caches.
 #[cfg(feature = "embree")]
-fn bare_embree(case: &Case, repeat: usize) -> Result<Option<(u64, f64, f64)>, String> {
+fn bare_embree(case: &Case, repeat: usize) -> crate::Result<Option<(u64, f64, f64)>> {
     use rayon::prelude::*;
     let backend = backend_by_name("embree")?;
     let world = World::build(&case.scene, backend.as_ref())?;
@@ -349,7 +349,7 @@ fn bare_embree(case: &Case, repeat: usize) -> Result<Option<(u64, f64, f64)>, St
 }
 
 #[cfg(not(feature = "embree"))]
-fn bare_embree(_: &Case, _: usize) -> Result<Option<(u64, f64, f64)>, String> {
+fn bare_embree(_: &Case, _: usize) -> crate::Result<Option<(u64, f64, f64)>> {
     Ok(None)
 }
 
@@ -358,11 +358,11 @@ pub fn run(
     cases: &[LazyCase],
     repeat: usize,
     mut progress: impl FnMut(&str),
-) -> Result<Vec<Row>, String> {
+) -> crate::Result<Vec<Row>> {
     let mut rows = Vec::new();
     for lazy in cases {
         progress(&lazy.name);
-        let case = &lazy.build().map_err(|e| e.to_string())?;
+        let case = &lazy.build()?;
         let mut refs: Vec<(u32, Frame)> = Vec::new();
         let hi = if case.hi_reference {
             Some(reference(&case.scene, 16)?)

@@ -116,7 +116,7 @@ const PALETTE: [[u8; 3]; 12] = [
 ];
 
 /// Plot the rows that have a render time and an error against the 16-spp reference.
-pub fn plot_png(rows: &[Row], path: &Path) -> Result<(), String> {
+pub fn plot_png(rows: &[Row], path: &Path) -> crate::Result<()> {
     let pts: Vec<(String, f64, f64)> = rows
         .iter()
         .filter_map(|r| {
@@ -185,12 +185,19 @@ pub fn plot_png(rows: &[Row], path: &Path) -> Result<(), String> {
             c.text(x1 + 30, y, l, [0, 0, 0]);
         }
     }
-    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let failed = |e: &dyn std::fmt::Display| {
+        crate::Error::image(
+            path,
+            format!("cannot write `{}`: {e}", path.display()),
+            None,
+        )
+    };
+    let file = std::fs::File::create(path).map_err(|e| failed(&e))?;
     let mut enc = png::Encoder::new(std::io::BufWriter::new(file), W as u32, H as u32);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
     let data: Vec<u8> = c.px.iter().flatten().copied().collect();
     enc.write_header()
         .and_then(|mut w| w.write_image_data(&data))
-        .map_err(|e| format!("{}: {e}", path.display()))
+        .map_err(|e| failed(&e))
 }

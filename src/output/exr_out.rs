@@ -1,10 +1,12 @@
+use super::cause;
 use crate::render::{Frame, CHANNELS};
+use crate::{Cause, Error};
 use exr::prelude::*;
 use smallvec::SmallVec;
 use std::collections::HashMap;
 use std::path::Path;
 
-pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), String> {
+pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), Cause> {
     let size = (frame.width as usize, frame.height as usize);
     let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = CHANNELS
         .iter()
@@ -35,14 +37,14 @@ pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), String> {
         blue: b,
         white: w,
     });
-    image.write().to_file(path).map_err(|e| e.to_string())
+    image.write().to_file(path).map_err(cause)
 }
 
 /// Width, height and every channel by name (f32, row-major) of an EXR file's first layer.
 pub type Channels = (usize, usize, HashMap<String, Vec<f32>>);
 
 /// Every channel of the first layer of an EXR file.
-pub fn read_channels(path: &Path) -> std::result::Result<Channels, String> {
+pub fn read_channels(path: &Path) -> crate::Result<Channels> {
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -50,7 +52,10 @@ pub fn read_channels(path: &Path) -> std::result::Result<Channels, String> {
         .first_valid_layer()
         .all_attributes()
         .from_file(path)
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| {
+            let message = format!("cannot read `{}`: {e}", path.display());
+            Error::image(path, message, Some(cause(e)))
+        })?;
     let layer = &image.layer_data;
     let map = layer
         .channel_data

@@ -5,6 +5,7 @@ mod exr_out;
 mod png_out;
 
 use crate::render::Frame;
+use crate::{Cause, Error};
 use std::path::{Path, PathBuf};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -15,7 +16,7 @@ pub enum Format {
 
 impl Format {
     /// The format for an output path, from its extension.
-    pub fn for_path(path: &Path) -> Result<Format, String> {
+    pub fn for_path(path: &Path) -> crate::Result<Format> {
         match path
             .extension()
             .and_then(|e| e.to_str())
@@ -24,26 +25,31 @@ impl Format {
         {
             Some("exr") => Ok(Format::Exr),
             Some("png") => Ok(Format::Png),
-            _ => Err(format!(
-                "cannot tell the image format of `{}`: the name must end in .exr or .png",
-                path.display()
+            _ => Err(Error::image(
+                path,
+                format!(
+                    "cannot tell the image format of `{}`: the name must end in .exr or .png",
+                    path.display()
+                ),
+                None,
             )),
         }
     }
 }
 
 /// Write the frame; the file appears only when it is complete (written beside it, then renamed).
-pub fn write(frame: &Frame, path: &Path) -> Result<(), String> {
+pub fn write(frame: &Frame, path: &Path) -> crate::Result<()> {
     let format = Format::for_path(path)?;
     let tmp = temp_path(path);
     let result = match format {
         Format::Exr => exr_out::write(frame, &tmp),
         Format::Png => png_out::write(frame, &tmp),
     }
-    .and_then(|_| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    .and_then(|_| std::fs::rename(&tmp, path).map_err(cause));
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
-        return Err(format!("cannot write `{}`: {e}", path.display()));
+        let message = format!("cannot write `{}`: {e}", path.display());
+        return Err(Error::image(path, message, Some(e)));
     }
     Ok(())
 }
@@ -54,6 +60,11 @@ fn temp_path(path: &Path) -> PathBuf {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     path.with_file_name(format!(".{name}.partial-{}", std::process::id()))
+}
+
+/// An encoder's or the file system's error as a shared cause.
+fn cause(e: impl std::error::Error + Send + Sync + 'static) -> Cause {
+    std::sync::Arc::new(e)
 }
 
 /// Linear to sRGB-encoded, after clamping to [0, 1].

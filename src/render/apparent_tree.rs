@@ -106,7 +106,7 @@ impl ApparentTree {
         apparent: &[Aabb],
         event: Event,
         cullers: &CullerFactory,
-    ) -> Result<ApparentTree, String> {
+    ) -> crate::Result<ApparentTree> {
         Ok(ApparentTree {
             event,
             tree: cullers(apparent)?,

@@ -39,8 +39,8 @@ pub struct LightTree {
     groups: Arc<[(Aabb, Velocity)]>,
     cullers: CullerFactory,
     motions: OnceLock<Vec<Motion>>,
-    shapes: Vec<OnceLock<Result<Shape, String>>>,
-    slices: Vec<OnceLock<Result<Box<dyn BoxCuller>, String>>>,
+    shapes: Vec<OnceLock<crate::Result<Shape>>>,
+    slices: Vec<OnceLock<crate::Result<Box<dyn BoxCuller>>>>,
 }
 
 /// A run of slices' tree (at its middle slice), over the groups (`members`) the run's rays can
@@ -174,7 +174,7 @@ impl LightTree {
     /// Slice k's culling structure and the groups its items are: the build of its run of
     /// slices (at the run's middle slice, over the groups the run's rays can reach), refitted to
     /// slice k's boxes where the backend's structure allows, else built anew.
-    fn slice(&self, k: usize) -> Result<(&dyn BoxCuller, &[u32]), String> {
+    fn slice(&self, k: usize) -> crate::Result<(&dyn BoxCuller, &[u32])> {
         let s = k / SLICES_PER_SHAPE;
         let first = s * SLICES_PER_SHAPE;
         let last = (first + SLICES_PER_SHAPE).min(self.slices.len()) - 1;

@@ -55,7 +55,7 @@ pub enum Passes {
 }
 
 /// Build the acceleration structures with `backend` and render the scene, with every pass.
-pub fn render(scene: &Scene, backend: &dyn Backend) -> Result<(Frame, RenderStats), String> {
+pub fn render(scene: &Scene, backend: &dyn Backend) -> crate::Result<(Frame, RenderStats)> {
     render_passes(scene, backend, Passes::All)
 }
 
@@ -64,7 +64,7 @@ pub fn render_passes(
     scene: &Scene,
     backend: &dyn Backend,
     passes: Passes,
-) -> Result<(Frame, RenderStats), String> {
+) -> crate::Result<(Frame, RenderStats)> {
     let t0 = Instant::now();
     let world = World::build(scene, backend)?;
     let build_time = t0.elapsed();

@@ -219,7 +219,7 @@ fn merge(geos: &[&Arc<Geometry>]) -> Arc<Geometry> {
 }
 
 impl World {
-    pub fn build(scene: &Scene, backend: &dyn Backend) -> Result<World, String> {
+    pub fn build(scene: &Scene, backend: &dyn Backend) -> crate::Result<World> {
         Self::build_with(scene, backend, WorldOptions::default())
     }
 
@@ -227,7 +227,7 @@ impl World {
         scene: &Scene,
         backend: &dyn Backend,
         options: WorldOptions,
-    ) -> Result<World, String> {
+    ) -> crate::Result<World> {
         let event = scene.camera.imaging_event();
         // Which scene groups share a rest frame, in file order.
         let mut sets: Vec<(Velocity, Vec<usize>)> = Vec::new();
@@ -261,11 +261,11 @@ impl World {
                 None
             } else {
                 Some(backend.build(geometry.clone()).map_err(|e| {
-                    format!(
+                    crate::Error::backend(format!(
                         "building the {} backend for group `{}`: {e}",
                         backend.name(),
                         names.join("`, `")
-                    )
+                    ))
                 })?)
             };
             let boost = Boost::to_rest(&velocity);
@@ -311,7 +311,7 @@ impl World {
         scene: &Scene,
         groups: &[GroupRt],
         backend: &dyn Backend,
-    ) -> Result<(Kinetic, ApparentTree, Vec<Option<LightTree>>), String> {
+    ) -> crate::Result<(Kinetic, ApparentTree, Vec<Option<LightTree>>)> {
         let event = scene.camera.imaging_event();
         let items: Vec<(Aabb, Velocity)> = groups.iter().map(|g| (g.bounds, g.velocity)).collect();
         // Kinetic trees are tight near their reference times: spread them over the window in

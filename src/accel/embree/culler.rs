@@ -116,7 +116,7 @@ unsafe extern "C" fn occluded(args: *const RTCOccludedFunctionNArguments) {
 }
 
 impl EmbreeCuller {
-    pub(super) fn build(device: Arc<Device>, boxes: &[Aabb]) -> Result<EmbreeCuller, String> {
+    pub(super) fn build(device: Arc<Device>, boxes: &[Aabb]) -> crate::Result<EmbreeCuller> {
         let all = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
         let center = if all.is_empty() {
             DVec3::ZERO
@@ -140,7 +140,7 @@ impl EmbreeCuller {
         let raw = unsafe { rtcNewScene(device.raw) };
         if raw.is_null() {
             device.check("creating a culling scene")?;
-            return Err("Embree could not create a scene".into());
+            return Err(crate::Error::backend("Embree could not create a scene"));
         }
         let all = boxes.0.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
         let culler = EmbreeCuller {

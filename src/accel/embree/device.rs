@@ -1,6 +1,7 @@
 //! The Embree device: created once, with an error callback that collects messages so they can
 //! be checked after building and committing (never per ray).
 
+use crate::Error;
 use embree_sys::*;
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::sync::Mutex;
@@ -32,12 +33,14 @@ unsafe extern "C" fn on_error(user: *mut c_void, code: RTCError, msg: *const c_c
 
 impl Device {
     /// A device; `threads` limits Embree's own build threads (0: all cores).
-    pub fn new(threads: usize) -> Result<Device, String> {
+    pub fn new(threads: usize) -> crate::Result<Device> {
         let config = CString::new(format!("threads={threads},verbose=0")).expect("no NUL");
         let raw = unsafe { rtcNewDevice(config.as_ptr()) };
         if raw.is_null() {
             let code = unsafe { rtcGetDeviceError(std::ptr::null_mut()) };
-            return Err(format!("Embree could not create a device ({code:?})"));
+            return Err(Error::backend(format!(
+                "Embree could not create a device ({code:?})"
+            )));
         }
         let errors = Box::into_raw(Box::new(Mutex::new(Vec::new())));
         unsafe { rtcSetDeviceErrorFunction(raw, Some(on_error), errors as *mut c_void) };
@@ -51,10 +54,10 @@ impl Device {
     }
 
     /// Fail with the collected messages, if Embree reported any since the last check.
-    pub fn check(&self, what: &str) -> Result<(), String> {
+    pub fn check(&self, what: &str) -> crate::Result<()> {
         let mut list = unsafe { &*self.errors }
             .lock()
-            .map_err(|_| "Embree error list poisoned".to_string())?;
+            .map_err(|_| Error::backend("Embree error list poisoned"))?;
         let code = unsafe { rtcGetDeviceError(self.raw) };
         if code != RTCError::RTC_ERROR_NONE && list.is_empty() {
             list.push(format!("{code:?}"));
@@ -64,7 +67,7 @@ impl Device {
         }
         let msg = list.join("; ");
         list.clear();
-        Err(format!("Embree failed while {what}: {msg}"))
+        Err(Error::backend(format!("Embree failed while {what}: {msg}")))
     }
 }
 

@@ -31,7 +31,7 @@ use device::Device;
 use std::sync::{Arc, OnceLock};
 
 pub struct EmbreeBackend {
-    device: OnceLock<Result<Arc<Device>, String>>,
+    device: OnceLock<crate::Result<Arc<Device>>>,
     /// Packet width for batches: None picks 16 or 8 from the CPU; 1 sends single rays.
     packet_width: Option<usize>,
 }
@@ -52,7 +52,7 @@ impl EmbreeBackend {
         }
     }
 
-    fn device(&self) -> Result<Arc<Device>, String> {
+    fn device(&self) -> crate::Result<Arc<Device>> {
         // Embree's build threads follow the render's (--threads sets rayon's global pool).
         self.device
             .get_or_init(|| Device::new(rayon::current_num_threads()).map(Arc::new))
@@ -79,7 +79,7 @@ impl Backend for EmbreeBackend {
         })
     }
 
-    fn build(&self, geometry: Arc<Geometry>) -> Result<Box<dyn Accelerator>, String> {
+    fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>> {
         let device = self.device()?;
         let width = self.packet_width.unwrap_or(device.packet_width);
         let scene = scene::Scene::build(device, &geometry)?;

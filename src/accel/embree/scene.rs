@@ -91,11 +91,11 @@ impl Drop for Scene {
 pub(super) fn new_geometry(
     device: &Device,
     kind: RTCGeometryType,
-) -> Result<GeometryHandle, String> {
+) -> crate::Result<GeometryHandle> {
     let g = unsafe { rtcNewGeometry(device.raw, kind) };
     if g.is_null() {
         device.check("creating a geometry")?;
-        return Err("Embree could not create a geometry".into());
+        return Err(crate::Error::backend("Embree could not create a geometry"));
     }
     Ok(GeometryHandle(g))
 }
@@ -105,7 +105,7 @@ fn f3(p: DVec3) -> [f32; 3] {
 }
 
 impl Scene {
-    pub fn build(device: Arc<Device>, geo: &SceneGeometry) -> Result<Scene, String> {
+    pub fn build(device: Arc<Device>, geo: &SceneGeometry) -> crate::Result<Scene> {
         let center = geo.bounds().centroid();
         let center = if center.is_finite() {
             center
@@ -115,7 +115,7 @@ impl Scene {
         let raw = unsafe { rtcNewScene(device.raw) };
         if raw.is_null() {
             device.check("creating a scene")?;
-            return Err("Embree could not create a scene".into());
+            return Err(crate::Error::backend("Embree could not create a scene"));
         }
         let mut scene = Scene {
             raw,
@@ -199,7 +199,7 @@ impl Scene {
         device: &Device,
         shapes: Vec<S>,
         map: Vec<u32>,
-    ) -> Result<Option<Box<Shapes<S>>>, String> {
+    ) -> crate::Result<Option<Box<Shapes<S>>>> {
         if shapes.is_empty() {
             return Ok(None);
         }
@@ -227,12 +227,14 @@ impl Scene {
         kind: RTCBufferType,
         format: RTCFormat,
         count: usize,
-    ) -> Result<&mut [T], String> {
+    ) -> crate::Result<&mut [T]> {
         let stride = std::mem::size_of::<T>();
         let ptr = unsafe { rtcSetNewGeometryBuffer(g.0, kind, 0, format, stride, count) };
         self._device.check("allocating a buffer")?;
         if ptr.is_null() {
-            return Err("Embree could not allocate a geometry buffer".into());
+            return Err(crate::Error::backend(
+                "Embree could not allocate a geometry buffer",
+            ));
         }
         let n = count;
         // SAFETY: Embree allocated count * stride bytes, aligned for f32/u32, owned by the
@@ -246,7 +248,7 @@ impl Scene {
         g: GeometryHandle,
         prims: Vec<u32>,
         exact: bool,
-    ) -> Result<(), String> {
+    ) -> crate::Result<()> {
         unsafe { rtcCommitGeometry(g.0) };
         device.check("committing a geometry")?;
         let id = unsafe { rtcAttachGeometry(self.raw, g.0) } as usize;
