@@ -48,7 +48,7 @@ impl EmbreeAccel {
                                 ..Default::default()
                             },
                         };
-                        unsafe { rtcIntersect1(self.scene.raw, ctx, &mut rh) };
+                        unsafe { self.scene.rtc.intersect1(ctx, &mut rh) };
                         usize::from(rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
                     })
                     .sum(),

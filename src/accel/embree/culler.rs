@@ -4,11 +4,10 @@
 //! boxes are widened and the f32 rays given slack, so rounding can only add candidates, never
 //! lose one.
 
-use super::device::Device;
 use super::exact::{self, Shape, Shapes};
 use super::lane_cull::lanes_near;
 use super::packet::flush_denormals;
-use super::scene::new_geometry;
+use super::rtc::{self, field, CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
 use crate::accel::BoxCuller;
 use crate::geometry::{Aabb, PACKET};
 use embree_sys::*;
@@ -16,26 +15,18 @@ use glam::DVec3;
 use std::sync::Arc;
 
 pub struct EmbreeCuller {
-    raw: RTCScene,
-    /// Embree points into these (boxes relative to `center`, widened); dropped after the scene.
-    boxes: Box<Shapes<Aabb>>,
+    /// None when there are no boxes. Released before the boxes, which it points into (fields
+    /// drop in order).
+    rtc: Option<CommittedScene>,
+    /// The boxes, relative to `center` and widened: kept for the scene's user geometry, which
+    /// points into them.
+    _boxes: Box<Shapes<Aabb>>,
     center: DVec3,
     /// All the (widened) boxes together, relative to `center`: rays start on it, so f32 sees
     /// only coordinates of the boxes' size however far the rays come from.
     all: Aabb,
     /// Slack for f32 rounding of rays and boxes, in world units.
     slack: f64,
-    _device: Arc<Device>,
-}
-
-// The scene is only read after its commit; Embree allows concurrent queries.
-unsafe impl Send for EmbreeCuller {}
-unsafe impl Sync for EmbreeCuller {}
-
-impl Drop for EmbreeCuller {
-    fn drop(&mut self) {
-        unsafe { rtcReleaseScene(self.raw) };
-    }
 }
 
 /// The context of a culling query: Embree's first (repr(C)), then the caller's visit and the
@@ -77,9 +68,9 @@ unsafe fn offer(
             let t = (ctx.visit)(prim, i, before);
             ctx.tmax[i] = t;
             if t < ctx.tmin[i] {
-                *ray.add(8 * n + i) = f32::NEG_INFINITY;
+                *ray.add(field::TFAR * n + i) = f32::NEG_INFINITY;
             } else if t < before {
-                *ray.add(8 * n + i) = (t * ctx.len[i] - ctx.shift[i] + ctx.slack) as f32;
+                *ray.add(field::TFAR * n + i) = (t * ctx.len[i] - ctx.shift[i] + ctx.slack) as f32;
             }
         }
     }
@@ -137,40 +128,31 @@ impl EmbreeCuller {
                 .map(|b| Aabb::new(b.min - center - pad, b.max - center + pad))
                 .collect::<Vec<_>>(),
         ));
-        let raw = unsafe { rtcNewScene(device.raw) };
-        if raw.is_null() {
-            device.check("creating a culling scene")?;
-            return Err(crate::Error::backend("Embree could not create a scene"));
-        }
         let all = boxes.0.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
-        let culler = EmbreeCuller {
-            raw,
-            boxes,
+        let rtc = if boxes.0.is_empty() {
+            None
+        } else {
+            let mut builder = SceneBuilder::new(&device)?;
+            let mut g = Geometry::new(&device, RTC_GEOMETRY_TYPE_USER)?;
+            let ptr = &*boxes as *const Shapes<Aabb> as *mut std::ffi::c_void;
+            let functions = UserFunctions {
+                bounds: exact::bounds::<Aabb>,
+                intersect,
+                occluded,
+            };
+            // SAFETY: the boxes (boxed, so they never move) are kept in the culler and dropped
+            // after its scene is released; the bounds callback reads them as `Shapes<Aabb>`.
+            unsafe { g.set_user(boxes.0.len() as u32, ptr, functions) };
+            builder.attach(g)?;
+            Some(builder.commit()?)
+        };
+        Ok(EmbreeCuller {
+            rtc,
+            _boxes: boxes,
             center,
             all,
             slack,
-            _device: device.clone(),
-        };
-
-        if !culler.boxes.0.is_empty() {
-            let g = new_geometry(&device, RTC_GEOMETRY_TYPE_USER)?;
-            let ptr = &*culler.boxes as *const Shapes<Aabb> as *mut std::ffi::c_void;
-            // SAFETY: the boxes (boxed, so they never move) outlive the scene (dropped after it
-            // is released), and the bounds callback reads them as `Shapes<Aabb>`.
-            unsafe {
-                rtcSetGeometryUserPrimitiveCount(g.0, culler.boxes.0.len() as u32);
-                rtcSetGeometryUserData(g.0, ptr);
-                rtcSetGeometryBoundsFunction(g.0, Some(exact::bounds::<Aabb>), ptr);
-                rtcSetGeometryIntersectFunction(g.0, Some(intersect));
-                rtcSetGeometryOccludedFunction(g.0, Some(occluded));
-                rtcCommitGeometry(g.0);
-                rtcAttachGeometry(raw, g.0);
-            }
-            device.check("attaching a culling geometry")?;
-        }
-        unsafe { rtcCommitScene(raw) };
-        device.check("committing a culling scene")?;
-        Ok(culler)
+        })
     }
 }
 
@@ -183,13 +165,13 @@ impl BoxCuller for EmbreeCuller {
         tmax: &mut [f64],
         visit: &mut dyn FnMut(u32, usize, f64) -> f64,
     ) {
-        if self.boxes.0.is_empty() {
+        let Some(scene) = &self.rtc else {
             return;
-        }
+        };
         flush_denormals();
         let n = dirs.len().min(PACKET).min(tmax.len());
         let mut rh = RTCRayHit16::default();
-        let mut valid = super::packet::Valid([0i32; 16]);
+        let mut valid = rtc::Valid([0i32; 16]);
         let o = o - self.center;
         let (mut lens, mut shifts) = ([1.0; PACKET], [0.0; PACKET]);
         for i in 0..n {
@@ -224,7 +206,7 @@ impl BoxCuller for EmbreeCuller {
             valid.0[i] = -1;
         }
         let mut ctx = CullContext {
-            rtc: RTCIntersectContext::default(),
+            rtc: rtc::new_context(),
             visit,
             tmin: &tmin[..n],
             tmax: &mut tmax[..n],
@@ -232,12 +214,10 @@ impl BoxCuller for EmbreeCuller {
             shift: shifts,
             slack: self.slack,
         };
-        // SAFETY: initialises the plain struct in place.
-        unsafe { rtcInitIntersectContext(&mut ctx.rtc) };
         ctx.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         let raw = (&mut ctx as *mut CullContext).cast::<RTCIntersectContext>();
         // SAFETY: a committed scene, a 64-byte aligned valid mask of 16, the context above
         // (which the callbacks read as a CullContext) outliving the call.
-        unsafe { rtcIntersect16(valid.0.as_ptr(), self.raw, raw, &mut rh) };
+        unsafe { scene.intersect16(&valid, raw, &mut rh) };
     }
 }

@@ -107,9 +107,7 @@ impl<const N: usize> Lanes<N> {
 fn initial_context(coherent: bool) -> RTCIntersectContext {
     static MADE: OnceLock<[RTCIntersectContext; 2]> = OnceLock::new();
     let [incoherent, coherent_one] = *MADE.get_or_init(|| {
-        let mut rtc = RTCIntersectContext::default();
-        // SAFETY: initialises the plain struct in place.
-        unsafe { rtcInitIntersectContext(&mut rtc) };
+        let rtc = super::rtc::new_context();
         let mut c = rtc;
         c.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         [rtc, c]
@@ -152,10 +150,7 @@ impl<'a> ExactContext<'a> {
 
 /// Field k of lane i of an N-wide SoA ray (`RTCRayN` / `RTCRayHitN`: 12 ray fields, then the
 /// hit's Ng_x, Ng_y, Ng_z, u, v, primID, geomID, instID, each N floats wide).
-const ORG: usize = 0;
-const TNEAR: usize = 3;
-const DIR: usize = 4;
-const TFAR: usize = 8;
+use super::rtc::field::{DIR, ORG, TFAR, TNEAR};
 const NG: usize = 12;
 const U: usize = 15;
 const PRIM_ID: usize = 17;

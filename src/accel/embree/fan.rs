@@ -53,7 +53,7 @@ impl EmbreeAccel {
 /// The kernel for one N-wide packet of a fan's lanes `first..first + N`, in this thread's
 /// packet `rh` (`Reused`: it writes the fields a query writes).
 macro_rules! fan_packet {
-    ($name:ident, $n:literal, $RayHitN:ident, $rtc_isect:ident) => {
+    ($name:ident, $n:literal, $RayHitN:ident, $isect_q:ident) => {
         impl EmbreeAccel {
             #[target_feature(enable = "avx2")]
             unsafe fn $name(&self, fan: &Fan, out: &mut FanHits, first: usize) {
@@ -132,7 +132,7 @@ macro_rules! fan_packet {
                     let mut ctx = self.context(true, &rays[..n], &lanes);
                     // SAFETY: an N-wide packet with its valid mask (64-byte aligned), the scene and
                     // the context its user geometry expects.
-                    unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), rh) };
+                    unsafe { self.scene.rtc.$isect_q(&valid, ctx.raw(), rh) };
                     if let Some(runs) = self.scene.exact_runs {
                         // Every hit exact, so as `to_hit` reads it (the callbacks record only
                         // a t in the rays' lookback (0, ∞)), but with no lookup and no branch on
@@ -173,8 +173,8 @@ macro_rules! fan_packet {
     };
 }
 
-fan_packet!(fan16, 16, RTCRayHit16, rtcIntersect16);
-fan_packet!(fan8, 8, RTCRayHit8, rtcIntersect8);
+fan_packet!(fan16, 16, RTCRayHit16, intersect16);
+fan_packet!(fan8, 8, RTCRayHit8, intersect8);
 
 #[cfg(test)]
 mod tests {

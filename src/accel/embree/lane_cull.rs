@@ -10,8 +10,7 @@ use glam::DVec3;
 
 /// Field offsets (in lanes) of Embree's N-wide SoA ray: origin x, y, z, then tnear, then
 /// direction x, y, z.
-const ORG: usize = 0;
-const DIR: usize = 4;
+use super::rtc::field::{DIR, ORG};
 
 /// Relative padding of the box: Embree's f32 ray is the caller's f64 ray rounded (2⁻²⁴ of its
 /// coordinates), and the test's own f32 products round as much again; 1e-5 is a hundredfold

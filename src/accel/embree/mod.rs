@@ -12,7 +12,6 @@
 
 mod bare;
 mod culler;
-mod device;
 mod exact;
 #[cfg(target_arch = "x86_64")]
 mod f64x4;
@@ -21,13 +20,14 @@ mod fan;
 mod lane_cull;
 mod lane_hits;
 mod packet;
+mod rtc;
 mod scene;
 
 pub use bare::BareRay;
 
 use super::{Accelerator, Backend, BoxCuller, CullerFactory, Fan, FanHits, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, Real};
-use device::Device;
+use rtc::Device;
 use std::sync::{Arc, OnceLock};
 
 pub struct EmbreeBackend {

@@ -57,7 +57,7 @@ macro_rules! reused {
 }
 
 macro_rules! packet_fns {
-    ($n:literal, $isect:ident, $occl:ident, $bare:ident, $RayHitN:ident, $RayN:ident, $HitN:ident, $rtc_isect:ident, $rtc_occl:ident) => {
+    ($n:literal, $isect:ident, $occl:ident, $bare:ident, $RayHitN:ident, $RayN:ident, $HitN:ident, $isect_q:ident, $occl_q:ident) => {
         impl EmbreeAccel {
             /// Bare Embree (the benchmark's baseline): prepared rays in one packet, nothing
             /// else; returns how many hit.
@@ -68,7 +68,7 @@ macro_rules! packet_fns {
                         fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
                         rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                     }
-                    unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx, rh) };
+                    unsafe { self.scene.rtc.$isect_q(&valid, ctx, rh) };
                     (0..rays.len())
                         .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
                         .count()
@@ -85,7 +85,7 @@ macro_rules! packet_fns {
                         rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                     }
                     let mut ctx = self.context(true, rays, &lanes);
-                    unsafe { $rtc_isect(valid.0.as_ptr(), self.scene.raw, ctx.raw(), rh) };
+                    unsafe { self.scene.rtc.$isect_q(&valid, ctx.raw(), rh) };
                     if let Some(runs) = self.scene.exact_runs {
                         // As the fans read hits back (`ExactRuns`): every hit exact, within the
                         // ray's (tmin, tmax), its primitive with no lookup.
@@ -130,7 +130,7 @@ macro_rules! packet_fns {
                         fill_lane(ray, i, &e, &mut valid.0);
                     }
                     let mut ctx = self.context(true, rays, &lanes);
-                    unsafe { $rtc_occl(valid.0.as_ptr(), self.scene.raw, ctx.raw(), ray) };
+                    unsafe { self.scene.rtc.$occl_q(&valid, ctx.raw(), ray) };
                     for i in 0..rays.len() {
                         out[i] = valid.0[i] != 0 && ray.tfar[i] == f32::NEG_INFINITY;
                     }
@@ -177,8 +177,7 @@ macro_rules! packet_fns {
 
 /// The valid mask of a packet: Embree reads it with aligned vector loads, so it needs the
 /// packet's alignment (64 bytes covers 8- and 16-wide).
-#[repr(C, align(64))]
-pub(super) struct Valid<const N: usize>(pub [i32; N]);
+pub(super) use super::rtc::Valid;
 
 pub(super) trait Lane {
     fn set(&mut self, i: usize, e: &EmbreeRay);
@@ -201,20 +200,10 @@ packet_fns!(
     RTCRayHit16,
     RTCRay16,
     RTCHit16,
-    rtcIntersect16,
-    rtcOccluded16
+    intersect16,
+    occluded16
 );
-packet_fns!(
-    8,
-    intersect8,
-    occluded8,
-    bare8,
-    RTCRayHit8,
-    RTCRay8,
-    RTCHit8,
-    rtcIntersect8,
-    rtcOccluded8
-);
+packet_fns!(8, intersect8, occluded8, bare8, RTCRayHit8, RTCRay8, RTCHit8, intersect8, occluded8);
 
 pub(super) fn single(e: &EmbreeRay) -> RTCRay {
     RTCRay {
@@ -259,7 +248,7 @@ impl EmbreeAccel {
         let rays = std::slice::from_ref(r);
         let lanes = Lanes::<1>::new(rays);
         let mut ctx = self.context(false, rays, &lanes);
-        unsafe { rtcIntersect1(self.scene.raw, ctx.raw(), &mut rh) };
+        unsafe { self.scene.rtc.intersect1(ctx.raw(), &mut rh) };
         if rh.hit.geomID == RTC_INVALID_GEOMETRY_ID {
             return None;
         }
@@ -275,7 +264,7 @@ impl EmbreeAccel {
         let rays = std::slice::from_ref(r);
         let lanes = Lanes::<1>::new(rays);
         let mut ctx = self.context(false, rays, &lanes);
-        unsafe { rtcOccluded1(self.scene.raw, ctx.raw(), &mut ray) };
+        unsafe { self.scene.rtc.occluded1(ctx.raw(), &mut ray) };
         ray.tfar == f32::NEG_INFINITY
     }
 }

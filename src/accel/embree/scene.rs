@@ -2,21 +2,12 @@
 //! sees large coordinates): Embree's triangles for meshes, while spheres, rods and boxes are
 //! user geometry running the exact f64 tests (exact.rs).
 
-use super::device::Device;
 use super::exact::{self, Round, Shape, Shapes};
+use super::rtc::{CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
 use crate::geometry::{Aabb, Geometry as SceneGeometry, Primitive};
 use embree_sys::*;
 use glam::DVec3;
 use std::sync::Arc;
-
-/// An Embree geometry handle, released on drop (the scene keeps its own reference).
-pub(super) struct GeometryHandle(pub(super) RTCGeometry);
-
-impl Drop for GeometryHandle {
-    fn drop(&mut self) {
-        unsafe { rtcReleaseGeometry(self.0) };
-    }
-}
 
 /// Which scene primitive an Embree (geomID, primID) is: `prims[primID]`.
 pub struct PrimMap {
@@ -64,8 +55,10 @@ impl ExactRuns {
     }
 }
 
+/// A group's geometry as an Embree scene, and what its hits mean.
 pub struct Scene {
-    pub(super) raw: RTCScene,
+    /// Released before the shapes below, which it points into (fields drop in order).
+    pub(super) rtc: CommittedScene,
     /// Indexed by geomID.
     pub maps: Vec<PrimMap>,
     /// The maps as runs, where they are runs of exact geometries.
@@ -73,31 +66,8 @@ pub struct Scene {
     /// Embree coordinates are rest-frame coordinates minus this.
     pub center: DVec3,
     /// What Embree's user geometry points into; dropped after the scene is released.
-    rounds: Option<Box<Shapes<Round>>>,
-    cuboids: Option<Box<Shapes<Aabb>>>,
-    _device: Arc<Device>,
-}
-
-unsafe impl Send for Scene {}
-unsafe impl Sync for Scene {}
-
-impl Drop for Scene {
-    fn drop(&mut self) {
-        unsafe { rtcReleaseScene(self.raw) };
-    }
-}
-
-/// A new Embree geometry of this kind.
-pub(super) fn new_geometry(
-    device: &Device,
-    kind: RTCGeometryType,
-) -> crate::Result<GeometryHandle> {
-    let g = unsafe { rtcNewGeometry(device.raw, kind) };
-    if g.is_null() {
-        device.check("creating a geometry")?;
-        return Err(crate::Error::backend("Embree could not create a geometry"));
-    }
-    Ok(GeometryHandle(g))
+    _rounds: Option<Box<Shapes<Round>>>,
+    _cuboids: Option<Box<Shapes<Aabb>>>,
 }
 
 fn f3(p: DVec3) -> [f32; 3] {
@@ -112,24 +82,6 @@ impl Scene {
         } else {
             DVec3::ZERO
         };
-        let raw = unsafe { rtcNewScene(device.raw) };
-        if raw.is_null() {
-            device.check("creating a scene")?;
-            return Err(crate::Error::backend("Embree could not create a scene"));
-        }
-        let mut scene = Scene {
-            raw,
-            maps: Vec::new(),
-            exact_runs: None,
-            center,
-            rounds: None,
-            cuboids: None,
-            _device: device.clone(),
-        };
-        unsafe {
-            rtcSetSceneBuildQuality(raw, RTC_BUILD_QUALITY_HIGH);
-            rtcSetSceneFlags(raw, RTC_SCENE_FLAG_ROBUST);
-        }
         let (mut tris, mut tri_map): (Vec<[[f32; 3]; 3]>, Vec<u32>) = (Vec::new(), Vec::new());
         let (mut cuboids, mut cuboid_map): (Vec<Aabb>, Vec<u32>) = (Vec::new(), Vec::new());
         let (mut rounds, mut round_map): (Vec<Round>, Vec<u32>) = (Vec::new(), Vec::new());
@@ -162,10 +114,15 @@ impl Scene {
                 }
             }
         }
+        // What the user geometries point into, made before the scene so that it is released
+        // first should the build fail (locals drop in reverse order).
+        let rounds = (!rounds.is_empty()).then(|| Box::new(Shapes(rounds)));
+        let cuboids = (!cuboids.is_empty()).then(|| Box::new(Shapes(cuboids)));
+        let mut builder = SceneBuilder::new(&device)?;
+        let mut maps = Vec::new();
         if !tris.is_empty() {
-            let g = new_geometry(&device, RTC_GEOMETRY_TYPE_TRIANGLE)?;
-            let verts = scene.buffer::<[f32; 3]>(
-                &g,
+            let mut g = Geometry::new(&device, RTC_GEOMETRY_TYPE_TRIANGLE)?;
+            let verts = g.new_buffer::<[f32; 3]>(
                 RTC_BUFFER_TYPE_VERTEX,
                 RTC_FORMAT_FLOAT3,
                 tris.len() * 3,
@@ -173,94 +130,30 @@ impl Scene {
             for (k, t) in tris.iter().enumerate() {
                 verts[k * 3..k * 3 + 3].copy_from_slice(t);
             }
-            let idx = scene.buffer::<[u32; 3]>(
-                &g,
-                RTC_BUFFER_TYPE_INDEX,
-                RTC_FORMAT_UINT3,
-                tris.len(),
-            )?;
+            let idx =
+                g.new_buffer::<[u32; 3]>(RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, tris.len())?;
             for (k, slot) in idx.iter_mut().enumerate() {
                 *slot = [3 * k as u32, 3 * k as u32 + 1, 3 * k as u32 + 2];
             }
-            scene.attach(&device, g, tri_map, false)?;
+            attach(&mut builder, &mut maps, g, tri_map, false)?;
         }
-        scene.rounds = scene.user_geometry(&device, rounds, round_map)?;
-        scene.cuboids = scene.user_geometry(&device, cuboids, cuboid_map)?;
-        unsafe { rtcCommitScene(raw) };
-        device.check("committing a scene")?;
-        scene.exact_runs = ExactRuns::of(&scene.maps);
-        Ok(scene)
-    }
-
-    /// Attach `shapes` (scene primitives `map`) as one user geometry whose hits are exact; the
-    /// returned box is what Embree points into.
-    fn user_geometry<S: Shape>(
-        &mut self,
-        device: &Device,
-        shapes: Vec<S>,
-        map: Vec<u32>,
-    ) -> crate::Result<Option<Box<Shapes<S>>>> {
-        if shapes.is_empty() {
-            return Ok(None);
+        if let Some(shapes) = &rounds {
+            let g = user_geometry(&device, shapes)?;
+            attach(&mut builder, &mut maps, g, round_map, true)?;
         }
-        let g = new_geometry(device, RTC_GEOMETRY_TYPE_USER)?;
-        let data = Box::new(Shapes(shapes));
-        let ptr = &*data as *const Shapes<S> as *mut std::ffi::c_void;
-        // SAFETY: `data` outlives the Embree scene (the scene drops it after releasing the
-        // scene), and the callbacks read it as `Shapes<S>`.
-        unsafe {
-            rtcSetGeometryUserPrimitiveCount(g.0, data.0.len() as u32);
-            rtcSetGeometryUserData(g.0, ptr);
-            rtcSetGeometryBoundsFunction(g.0, Some(exact::bounds::<S>), ptr);
-            rtcSetGeometryIntersectFunction(g.0, Some(exact::intersect::<S>));
-            rtcSetGeometryOccludedFunction(g.0, Some(exact::occluded::<S>));
+        if let Some(shapes) = &cuboids {
+            let g = user_geometry(&device, shapes)?;
+            attach(&mut builder, &mut maps, g, cuboid_map, true)?;
         }
-        self.attach(device, g, map, true)?;
-        Ok(Some(data))
-    }
-
-    /// A new buffer of `count` items of T on the geometry, as a slice to fill.
-    #[allow(clippy::mut_from_ref)]
-    fn buffer<T: Copy>(
-        &self,
-        g: &GeometryHandle,
-        kind: RTCBufferType,
-        format: RTCFormat,
-        count: usize,
-    ) -> crate::Result<&mut [T]> {
-        let stride = std::mem::size_of::<T>();
-        let ptr = unsafe { rtcSetNewGeometryBuffer(g.0, kind, 0, format, stride, count) };
-        self._device.check("allocating a buffer")?;
-        if ptr.is_null() {
-            return Err(crate::Error::backend(
-                "Embree could not allocate a geometry buffer",
-            ));
-        }
-        let n = count;
-        // SAFETY: Embree allocated count * stride bytes, aligned for f32/u32, owned by the
-        // geometry, which outlives this slice (it is filled before the geometry is committed).
-        Ok(unsafe { std::slice::from_raw_parts_mut(ptr as *mut T, n) })
-    }
-
-    fn attach(
-        &mut self,
-        device: &Device,
-        g: GeometryHandle,
-        prims: Vec<u32>,
-        exact: bool,
-    ) -> crate::Result<()> {
-        unsafe { rtcCommitGeometry(g.0) };
-        device.check("committing a geometry")?;
-        let id = unsafe { rtcAttachGeometry(self.raw, g.0) } as usize;
-        device.check("attaching a geometry")?;
-        if self.maps.len() <= id {
-            self.maps.resize_with(id + 1, || PrimMap {
-                prims: Vec::new(),
-                exact: false,
-            });
-        }
-        self.maps[id] = PrimMap { prims, exact };
-        Ok(())
+        let exact_runs = ExactRuns::of(&maps);
+        Ok(Scene {
+            rtc: builder.commit()?,
+            maps,
+            exact_runs,
+            center,
+            _rounds: rounds,
+            _cuboids: cuboids,
+        })
     }
 
     /// The scene primitive an Embree hit names, and whether its t is exact already.
@@ -268,6 +161,40 @@ impl Scene {
         let m = self.maps.get(geom as usize)?;
         Some((*m.prims.get(prim as usize)?, m.exact))
     }
+}
+
+/// A user geometry over `shapes`, whose hits are exact (exact.rs).
+fn user_geometry<S: Shape>(device: &Arc<Device>, shapes: &Shapes<S>) -> crate::Result<Geometry> {
+    let mut g = Geometry::new(device, RTC_GEOMETRY_TYPE_USER)?;
+    let ptr = shapes as *const Shapes<S> as *mut std::ffi::c_void;
+    let functions = UserFunctions {
+        bounds: exact::bounds::<S>,
+        intersect: exact::intersect::<S>,
+        occluded: exact::occluded::<S>,
+    };
+    // SAFETY: `shapes` is boxed in the `Scene` the geometry's scene goes into, and dropped
+    // after that scene is released; the callbacks read it as `Shapes<S>`.
+    unsafe { g.set_user(shapes.0.len() as u32, ptr, functions) };
+    Ok(g)
+}
+
+/// Attach `g`, whose primitives are the scene's `prims`, recording them by geomID.
+fn attach(
+    builder: &mut SceneBuilder,
+    maps: &mut Vec<PrimMap>,
+    g: Geometry,
+    prims: Vec<u32>,
+    exact: bool,
+) -> crate::Result<()> {
+    let id = builder.attach(g)? as usize;
+    if maps.len() <= id {
+        maps.resize_with(id + 1, || PrimMap {
+            prims: Vec::new(),
+            exact: false,
+        });
+    }
+    maps[id] = PrimMap { prims, exact };
+    Ok(())
 }
 
 #[cfg(test)]

@@ -1,0 +1,359 @@
+//! The thin layer over `embree-sys`: every `rtc*` call of the backend is made here, and every
+//! Embree handle is owned by a type that releases it on drop.
+//!
+//! - [`Device`]: the Embree device, with an error callback whose messages are checked after
+//!   building and committing (never per ray).
+//! - [`Geometry`]: a geometry being made (triangles or user geometry).
+//! - [`SceneBuilder`]: a scene being made, which geometries are attached to; committing it
+//!   gives a [`CommittedScene`], the only kind that is shared between threads and traced.
+//! - [`field`]: where Embree's SoA rays keep each field, for the user-geometry callbacks.
+
+use crate::{Error, Result};
+use embree_sys::*;
+use std::ffi::{c_char, c_void, CStr, CString};
+use std::sync::{Arc, Mutex};
+
+/// Fields of Embree's SoA ray (`RTCRayN`), each `N` f32 lanes wide, by index: lane i of field
+/// k is at `k · N + i` (as `RTCRay16` lays them out; checked below).
+pub mod field {
+    pub const ORG: usize = 0;
+    pub const TNEAR: usize = 3;
+    pub const DIR: usize = 4;
+    pub const TFAR: usize = 8;
+}
+
+const _: () = {
+    use std::mem::offset_of;
+    assert!(offset_of!(RTCRay16, org_x) == field::ORG * 64);
+    assert!(offset_of!(RTCRay16, tnear) == field::TNEAR * 64);
+    assert!(offset_of!(RTCRay16, dir_x) == field::DIR * 64);
+    assert!(offset_of!(RTCRay16, tfar) == field::TFAR * 64);
+    assert!(offset_of!(RTCRay8, tfar) == field::TFAR * 32);
+};
+
+pub struct Device {
+    raw: RTCDevice,
+    errors: *mut Mutex<Vec<String>>,
+    /// Packet width for primary rays: 16 where the CPU traces 16-wide natively, else 8.
+    pub packet_width: usize,
+}
+
+// SAFETY: Embree devices may be used from any thread (Embree's API is thread-safe for device
+// calls); the error list the callback writes is behind a mutex and freed only on drop.
+unsafe impl Send for Device {}
+unsafe impl Sync for Device {}
+
+unsafe extern "C" fn on_error(user: *mut c_void, code: RTCError, msg: *const c_char) {
+    let text = if msg.is_null() {
+        String::new()
+    } else {
+        // SAFETY: Embree passes a NUL-terminated message.
+        unsafe { CStr::from_ptr(msg) }
+            .to_string_lossy()
+            .into_owned()
+    };
+    // SAFETY: `user` is the device's error list, registered in `Device::new` and unregistered
+    // before it is freed.
+    let list = unsafe { &*(user as *const Mutex<Vec<String>>) };
+    if let Ok(mut l) = list.lock() {
+        l.push(format!("{code:?}: {text}"));
+    }
+}
+
+impl Device {
+    /// A device; `threads` limits Embree's own build threads (0: all cores).
+    pub fn new(threads: usize) -> Result<Device> {
+        let config = CString::new(format!("threads={threads},verbose=0")).expect("no NUL");
+        // SAFETY: a NUL-terminated configuration string.
+        let raw = unsafe { rtcNewDevice(config.as_ptr()) };
+        if raw.is_null() {
+            // SAFETY: asking for the error of no device is allowed.
+            let code = unsafe { rtcGetDeviceError(std::ptr::null_mut()) };
+            return Err(Error::backend(format!(
+                "Embree could not create a device ({code:?})"
+            )));
+        }
+        let errors = Box::into_raw(Box::new(Mutex::new(Vec::new())));
+        // SAFETY: a live device; the list outlives the registration (see Drop).
+        unsafe { rtcSetDeviceErrorFunction(raw, Some(on_error), errors as *mut c_void) };
+        // SAFETY: a live device.
+        let native16 =
+            unsafe { rtcGetDeviceProperty(raw, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) } != 0;
+        Ok(Device {
+            raw,
+            errors,
+            packet_width: if native16 { 16 } else { 8 },
+        })
+    }
+
+    /// Fail with the collected messages, if Embree reported any since the last check.
+    pub fn check(&self, what: &str) -> Result<()> {
+        // SAFETY: the list lives as long as the device.
+        let mut list = unsafe { &*self.errors }
+            .lock()
+            .map_err(|_| Error::backend("Embree error list poisoned"))?;
+        // SAFETY: a live device.
+        let code = unsafe { rtcGetDeviceError(self.raw) };
+        if code != RTCError::RTC_ERROR_NONE && list.is_empty() {
+            list.push(format!("{code:?}"));
+        }
+        if list.is_empty() {
+            return Ok(());
+        }
+        let msg = list.join("; ");
+        list.clear();
+        Err(Error::backend(format!("Embree failed while {what}: {msg}")))
+    }
+}
+
+impl Drop for Device {
+    fn drop(&mut self) {
+        // SAFETY: unregister the callback before freeing what it writes to; every scene and
+        // geometry holds an Arc of the device, so none outlives it.
+        unsafe {
+            rtcSetDeviceErrorFunction(self.raw, None, std::ptr::null_mut());
+            rtcReleaseDevice(self.raw);
+            drop(Box::from_raw(self.errors));
+        }
+    }
+}
+
+/// An Embree geometry being made; released on drop (a scene it is attached to keeps its own
+/// reference).
+pub struct Geometry {
+    raw: RTCGeometry,
+    device: Arc<Device>,
+}
+
+impl Drop for Geometry {
+    fn drop(&mut self) {
+        // SAFETY: our reference to a live geometry.
+        unsafe { rtcReleaseGeometry(self.raw) };
+    }
+}
+
+/// The callbacks of a user geometry.
+pub struct UserFunctions {
+    pub bounds: unsafe extern "C" fn(*const RTCBoundsFunctionArguments),
+    pub intersect: unsafe extern "C" fn(*const RTCIntersectFunctionNArguments),
+    pub occluded: unsafe extern "C" fn(*const RTCOccludedFunctionNArguments),
+}
+
+impl Geometry {
+    pub fn new(device: &Arc<Device>, kind: RTCGeometryType) -> Result<Geometry> {
+        // SAFETY: a live device.
+        let raw = unsafe { rtcNewGeometry(device.raw, kind) };
+        if raw.is_null() {
+            device.check("creating a geometry")?;
+            return Err(Error::backend("Embree could not create a geometry"));
+        }
+        Ok(Geometry {
+            raw,
+            device: device.clone(),
+        })
+    }
+
+    /// Make this (user) geometry `count` primitives whose callbacks read `data`.
+    ///
+    /// # Safety
+    /// `data` must stay valid, unmoved, for as long as any scene this geometry is attached to,
+    /// and be what `functions` read it as.
+    pub unsafe fn set_user(&mut self, count: u32, data: *mut c_void, functions: UserFunctions) {
+        // SAFETY: a live user geometry; the caller vouches for `data`.
+        unsafe {
+            rtcSetGeometryUserPrimitiveCount(self.raw, count);
+            rtcSetGeometryUserData(self.raw, data);
+            rtcSetGeometryBoundsFunction(self.raw, Some(functions.bounds), data);
+            rtcSetGeometryIntersectFunction(self.raw, Some(functions.intersect));
+            rtcSetGeometryOccludedFunction(self.raw, Some(functions.occluded));
+        }
+    }
+
+    /// A new buffer of `count` items of T (of Embree format `format`), to fill before the
+    /// geometry is attached.
+    pub fn new_buffer<T: Copy>(
+        &mut self,
+        kind: RTCBufferType,
+        format: RTCFormat,
+        count: usize,
+    ) -> Result<&mut [T]> {
+        let stride = std::mem::size_of::<T>();
+        // SAFETY: a live geometry, slot 0.
+        let ptr = unsafe { rtcSetNewGeometryBuffer(self.raw, kind, 0, format, stride, count) };
+        self.device.check("allocating a buffer")?;
+        if ptr.is_null() {
+            return Err(Error::backend(
+                "Embree could not allocate a geometry buffer",
+            ));
+        }
+        // SAFETY: Embree allocated count · stride bytes, aligned for f32/u32 and owned by the
+        // geometry, which the returned slice borrows.
+        Ok(unsafe { std::slice::from_raw_parts_mut(ptr as *mut T, count) })
+    }
+}
+
+/// A scene being made; released on drop unless committed.
+pub struct SceneBuilder {
+    raw: RTCScene,
+    device: Arc<Device>,
+}
+
+impl Drop for SceneBuilder {
+    fn drop(&mut self) {
+        if !self.raw.is_null() {
+            // SAFETY: our reference to a live scene.
+            unsafe { rtcReleaseScene(self.raw) };
+        }
+    }
+}
+
+impl SceneBuilder {
+    /// A scene built for quality and robust traversal (rays grazing edges are not lost).
+    pub fn new(device: &Arc<Device>) -> Result<SceneBuilder> {
+        // SAFETY: a live device.
+        let raw = unsafe { rtcNewScene(device.raw) };
+        if raw.is_null() {
+            device.check("creating a scene")?;
+            return Err(Error::backend("Embree could not create a scene"));
+        }
+        // SAFETY: a live scene, not yet committed.
+        unsafe {
+            rtcSetSceneBuildQuality(raw, RTC_BUILD_QUALITY_HIGH);
+            rtcSetSceneFlags(raw, RTC_SCENE_FLAG_ROBUST);
+        }
+        Ok(SceneBuilder {
+            raw,
+            device: device.clone(),
+        })
+    }
+
+    /// Commit `g` and attach it; its geomID.
+    pub fn attach(&mut self, g: Geometry) -> Result<u32> {
+        // SAFETY: a live geometry and scene.
+        unsafe { rtcCommitGeometry(g.raw) };
+        self.device.check("committing a geometry")?;
+        // SAFETY: as above; the scene takes its own reference, ours goes with `g`.
+        let id = unsafe { rtcAttachGeometry(self.raw, g.raw) };
+        self.device.check("attaching a geometry")?;
+        Ok(id)
+    }
+
+    /// Build the scene's BVH; from now on it is only read.
+    pub fn commit(mut self) -> Result<CommittedScene> {
+        let raw = std::mem::replace(&mut self.raw, std::ptr::null_mut());
+        let scene = CommittedScene {
+            raw,
+            _device: self.device.clone(),
+        };
+        // SAFETY: a live scene.
+        unsafe { rtcCommitScene(raw) };
+        self.device.check("committing a scene")?;
+        Ok(scene)
+    }
+}
+
+/// A committed scene: only traced, from any number of threads.
+pub struct CommittedScene {
+    raw: RTCScene,
+    _device: Arc<Device>,
+}
+
+// SAFETY: a committed Embree scene may be traced from several threads at once (Embree's
+// documented contract); nothing here modifies it after the commit.
+unsafe impl Send for CommittedScene {}
+unsafe impl Sync for CommittedScene {}
+
+impl Drop for CommittedScene {
+    fn drop(&mut self) {
+        // SAFETY: our reference to a live scene.
+        unsafe { rtcReleaseScene(self.raw) };
+    }
+}
+
+/// A ray packet's valid mask, aligned as Embree requires of packets of up to 16.
+#[repr(C, align(64))]
+pub struct Valid<const N: usize>(pub [i32; N]);
+
+macro_rules! packet_queries {
+    ($isect:ident, $occl:ident, $n:literal, $rayhit:ty, $ray:ty, $rtc_isect:ident, $rtc_occl:ident) => {
+        /// Closest hits of the packet's valid lanes.
+        ///
+        /// # Safety
+        /// `context` is an intersect context whose extension, if any, is what this scene's
+        /// user geometry callbacks read, valid for the call.
+        #[inline(always)]
+        pub unsafe fn $isect(
+            &self,
+            valid: &Valid<$n>,
+            context: *mut RTCIntersectContext,
+            rays: &mut $rayhit,
+        ) {
+            // SAFETY: a committed scene, an aligned mask; the caller vouches for the context.
+            unsafe { $rtc_isect(valid.0.as_ptr(), self.raw, context, rays) };
+        }
+
+        /// Whether anything lies on each of the packet's valid lanes (tfar set to −∞ where so).
+        ///
+        /// # Safety
+        /// As for the closest hits.
+        #[inline(always)]
+        pub unsafe fn $occl(
+            &self,
+            valid: &Valid<$n>,
+            context: *mut RTCIntersectContext,
+            rays: &mut $ray,
+        ) {
+            // SAFETY: as above.
+            unsafe { $rtc_occl(valid.0.as_ptr(), self.raw, context, rays) };
+        }
+    };
+}
+
+impl CommittedScene {
+    packet_queries!(
+        intersect16,
+        occluded16,
+        16,
+        RTCRayHit16,
+        RTCRay16,
+        rtcIntersect16,
+        rtcOccluded16
+    );
+    packet_queries!(
+        intersect8,
+        occluded8,
+        8,
+        RTCRayHit8,
+        RTCRay8,
+        rtcIntersect8,
+        rtcOccluded8
+    );
+
+    /// The closest hit of one ray.
+    ///
+    /// # Safety
+    /// As for the packets.
+    #[inline(always)]
+    pub unsafe fn intersect1(&self, context: *mut RTCIntersectContext, ray: &mut RTCRayHit) {
+        // SAFETY: a committed scene; the caller vouches for the context.
+        unsafe { rtcIntersect1(self.raw, context, ray) };
+    }
+
+    /// Whether anything lies on one ray.
+    ///
+    /// # Safety
+    /// As for the packets.
+    #[inline(always)]
+    pub unsafe fn occluded1(&self, context: *mut RTCIntersectContext, ray: &mut RTCRay) {
+        // SAFETY: as above.
+        unsafe { rtcOccluded1(self.raw, context, ray) };
+    }
+}
+
+/// An intersect context as `rtcInitIntersectContext` makes it.
+pub fn new_context() -> RTCIntersectContext {
+    let mut rtc = RTCIntersectContext::default();
+    // SAFETY: initialises the plain struct in place.
+    unsafe { rtcInitIntersectContext(&mut rtc) };
+    rtc
+}

@@ -1,0 +1,116 @@
+//! House rules a change could quietly break: Embree is called through its thin layer only, the
+//! code cites nothing outside the repository, and every section of docs/physics.md it cites
+//! exists.
+
+use std::path::{Path, PathBuf};
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+fn sources(dirs: &[&str]) -> Vec<(PathBuf, String)> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    for d in dirs {
+        rust_files(&root.join(d), &mut files);
+    }
+    files
+        .into_iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(&p).unwrap();
+            (p, text)
+        })
+        .collect()
+}
+
+/// The code of a line, without its comment.
+fn code(line: &str) -> &str {
+    line.split("//").next().unwrap_or("")
+}
+
+#[test]
+fn embree_is_called_through_its_layer_only() {
+    let mut calls = 0;
+    for (path, text) in sources(&["src"]) {
+        let layer = path.ends_with("accel/embree/rtc.rs");
+        for (n, line) in text.lines().enumerate() {
+            let c = code(line);
+            let found = c.match_indices("rtc").any(|(i, _)| {
+                let rest = &c[i + 3..];
+                let name: String = rest.chars().take_while(|ch| ch.is_alphanumeric()).collect();
+                name.starts_with(|ch: char| ch.is_ascii_uppercase())
+                    && rest[name.len()..].starts_with('(')
+                    && !c[..i].ends_with(|ch: char| ch.is_alphanumeric() || ch == '_')
+            });
+            if found {
+                assert!(
+                    layer,
+                    "{}:{}: an Embree call outside accel/embree/rtc.rs: {line}",
+                    path.display(),
+                    n + 1
+                );
+                calls += 1;
+            }
+        }
+    }
+    assert!(calls > 10, "the layer makes Embree's calls ({calls} found)");
+}
+
+#[test]
+fn nothing_cites_files_outside_the_repository() {
+    for (path, text) in sources(&["src", "tests"]) {
+        if path.ends_with("tests/house.rs") {
+            continue;
+        }
+        for (n, line) in text.lines().enumerate() {
+            for bad in ["../shared", "PHYSICS.md", "DESIGN.md"] {
+                assert!(
+                    !line.contains(bad),
+                    "{}:{}: cites `{bad}`, which is not in the repository",
+                    path.display(),
+                    n + 1
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn every_cited_section_of_the_physics_exists() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let physics = std::fs::read_to_string(root.join("docs/physics.md")).unwrap();
+    let headings: Vec<String> = physics
+        .lines()
+        .filter(|l| l.starts_with('#'))
+        .filter_map(|l| l.trim_start_matches('#').split_whitespace().next())
+        .map(|n| n.trim_end_matches('.').to_string())
+        .collect();
+    let mut cited = 0;
+    for (path, text) in sources(&["src", "tests"]) {
+        if path.ends_with("tests/house.rs") {
+            continue;
+        }
+        for (at, _) in text.match_indices("docs/physics.md §") {
+            let rest = &text[at + "docs/physics.md §".len()..];
+            let number: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_digit() || *c == '.')
+                .collect();
+            let number = number.trim_end_matches('.');
+            assert!(
+                headings.iter().any(|h| h == number),
+                "{} cites docs/physics.md §{number}, which has no such section",
+                path.display()
+            );
+            cited += 1;
+        }
+    }
+    assert!(cited > 10, "the code cites the physics ({cited} citations)");
+}
