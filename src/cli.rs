@@ -205,7 +205,7 @@ fn run_bench(args: &BenchArgs) -> crate::Result<()> {
                 args.backends.clone()
             };
             for n in &names {
-                let backend = n.split_whitespace().next().unwrap_or_default();
+                let (backend, _, _) = bench::parse_setting(n)?;
                 accel::backend_by_name(backend).map_err(|e| e.on_flag("--backend"))?;
             }
             let refs: Vec<&str> = names.iter().map(String::as_str).collect();

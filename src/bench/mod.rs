@@ -143,8 +143,18 @@ impl Row {
     }
 }
 
-/// A setting is a backend name, optionally with one skip switched off.
-fn parse_setting(setting: &str) -> (&str, WorldOptions, Passes) {
+/// What a setting may switch off or leave out, beside its backend's name: each word is one.
+pub const SETTING_WORDS: [(&str, &str); 5] = [
+    ("no-cull", "bounds and screen culling"),
+    ("no-tree", "the trees over many groups"),
+    ("no-merge", "merging groups of one velocity"),
+    ("no-fused", "fans of primary rays"),
+    ("colour-only", "the EXR passes (a PNG's render)"),
+];
+
+/// A setting: a backend name, then any of [`SETTING_WORDS`]; an unknown word is an error, so a
+/// misspelt setting is never measured as another under its name.
+pub fn parse_setting(setting: &str) -> crate::Result<(&str, WorldOptions, Passes)> {
     let mut o = WorldOptions::default();
     let mut passes = Passes::All;
     let mut parts = setting.split_whitespace();
@@ -156,10 +166,22 @@ fn parse_setting(setting: &str) -> (&str, WorldOptions, Passes) {
             "no-merge" => o.merge_equal_velocities = false,
             "no-fused" => o.fused_primary = false,
             "colour-only" => passes = Passes::Colour,
-            _ => {}
+            other => {
+                let known: Vec<String> = SETTING_WORDS
+                    .iter()
+                    .map(|(w, what)| format!("{w} ({what})"))
+                    .collect();
+                return Err(crate::Error::flag(
+                    "--backend",
+                    format!(
+                        "unknown word `{other}` in the setting `{setting}`; after the backend's name a setting may say: {}",
+                        known.join(", ")
+                    ),
+                ));
+            }
         }
     }
-    (backend, o, passes)
+    Ok((backend, o, passes))
 }
 
 fn with_spp(scene: &Scene, spp: u32) -> Scene {
@@ -190,7 +212,7 @@ fn fastest(repeat: usize, mut f: impl FnMut()) -> f64 {
 }
 
 fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result<(Row, Frame)> {
-    let (backend_name, options, passes) = parse_setting(setting);
+    let (backend_name, options, passes) = parse_setting(setting)?;
     let backend = backend_by_name(backend_name)?;
     let scene = with_spp(&case.scene, spp);
     memory::reset_peak();
@@ -262,7 +284,7 @@ fn beside(
 ) -> crate::Result<Beside> {
     let alone = Case::new(&case.name, one.clone(), &[setting]).without_hi_reference();
     let (one_row, _) = measure(&alone, setting, 1, repeat)?;
-    let (backend_name, options, passes) = parse_setting(setting);
+    let (backend_name, options, passes) = parse_setting(setting)?;
     let backend = backend_by_name(backend_name)?;
     let (many, one) = (with_spp(&case.scene, 1), with_spp(one, 1));
     let many_world = World::build_with(&many, backend.as_ref(), options)?;
@@ -370,7 +392,7 @@ pub fn run(
             None
         };
         for setting in &case.settings {
-            if backend_by_name(parse_setting(setting).0).is_err() {
+            if backend_by_name(parse_setting(setting)?.0).is_err() {
                 continue;
             }
             let plain = matches!(setting.as_str(), "embree" | "bvh" | "embree colour-only");

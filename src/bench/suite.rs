@@ -256,3 +256,29 @@ pub fn cases(quick: bool) -> Vec<LazyCase> {
     }));
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::LATTICE_SETTINGS;
+    use crate::bench::parse_setting;
+
+    /// The suite's settings parse, and a setting with a word the bench does not know is an
+    /// error (it had been measured as plain `embree` under its own label).
+    #[test]
+    fn settings_are_checked() {
+        for s in LATTICE_SETTINGS.iter().chain(&[
+            "bvh",
+            "embree no-tree",
+            "embree no-merge",
+            "embree colour-only",
+        ]) {
+            assert!(parse_setting(s).is_ok(), "{s}");
+        }
+        let (_, o, _) = parse_setting("embree no-cull no-fused").unwrap();
+        assert!(!o.bounds_cull && !o.fused_primary && o.group_tree);
+        let e = parse_setting("embree no-such-switch")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no-such-switch") && e.contains("no-cull"), "{e}");
+    }
+}
