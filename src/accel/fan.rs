@@ -1,7 +1,7 @@
 //! A packet of primary rays handed to a backend as what makes them rather than as rays: the
 //! pinhole camera, the boost into the group's rest frame, the imaging event there and the
 //! lanes' image points. A backend with a path of its own (Embree's: camera, boost and packet
-//! four lanes per AVX2 vector, `embree/fan.rs`) makes, boosts and traces them at once; its rays
+//! four lanes per AVX2 vector, `embree/fan_kernel.rs`) makes, boosts and traces them at once; its rays
 //! are the renderer's to the bit, because both run the same arithmetic (`Pinhole::look`,
 //! `Boost::null_dir_lanes`), so images do not depend on which path served them.
 

@@ -13,15 +13,15 @@ use super::apparent_tree::ApparentTree;
 use super::group_tree::SlicedGroupTree;
 use super::light_tree::LightTree;
 
-mod fans;
 mod moving_bounds;
+mod primary_hits;
 use crate::accel::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, Part, PACKET};
 use crate::scene::Scene;
 use crate::spacetime::{Boost, NullRay, Velocity};
-pub use fans::PrimaryHits;
 use glam::DVec3;
 use moving_bounds::MovingBounds;
+pub use primary_hits::PrimaryHits;
 use std::sync::{Arc, OnceLock};
 
 /// From this many groups on, rays find their groups through the group tree.
@@ -71,7 +71,7 @@ impl Default for WorldOptions {
     }
 }
 
-pub struct GroupRt {
+pub struct WorldGroup {
     /// The imaging event's position in this group's rest frame.
     pub event_rest: DVec3,
     pub velocity: Velocity,
@@ -87,7 +87,7 @@ pub struct GroupRt {
     moving: MovingBounds,
 }
 
-impl GroupRt {
+impl WorldGroup {
     /// The closest hit of each ray in this group (None for inactive rays): through the
     /// accelerator, or the primitives one by one for a group without one.
     fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
@@ -150,7 +150,7 @@ pub struct SurfaceHit {
 }
 
 pub struct World {
-    pub groups: Vec<GroupRt>,
+    pub groups: Vec<WorldGroup>,
     /// The imaging event (world frame), where every primary ray starts.
     event: crate::spacetime::Event,
     pub options: WorldOptions,
@@ -269,7 +269,7 @@ impl World {
                 })?)
             };
             let boost = Boost::to_rest(&velocity);
-            groups.push(GroupRt {
+            groups.push(WorldGroup {
                 event_rest: boost.event(event).x,
                 velocity,
                 boost,
@@ -309,7 +309,7 @@ impl World {
     /// rays, and a light tree per light at rest for shadow rays.
     fn group_trees(
         scene: &Scene,
-        groups: &[GroupRt],
+        groups: &[WorldGroup],
         backend: &dyn Backend,
     ) -> crate::Result<(Kinetic, ApparentTree, Vec<Option<LightTree>>)> {
         let event = scene.camera.imaging_event();
@@ -373,7 +373,7 @@ impl World {
     /// (tmin, tmax). The origin moves along the ray to where it enters the bounds, so the
     /// backend never sees large coordinates (docs/physics.md §7.1).
     #[inline(always)]
-    fn rest_ray(&self, g: &GroupRt, ray: &NullRay, tmin: f64, tmax: f64) -> Option<RestRay> {
+    fn rest_ray(&self, g: &WorldGroup, ray: &NullRay, tmin: f64, tmax: f64) -> Option<RestRay> {
         // Every primary ray starts at the imaging event: its rest-frame origin is per group.
         let origin = if ray.origin == self.event {
             g.event_rest
@@ -607,7 +607,7 @@ impl World {
     /// (`closest_hits`, `occluded_many`) go without it, as before: unmeasured there (no scene
     /// of the suite has two to seven groups).
     #[inline(always)]
-    fn may_meet(&self, g: &GroupRt, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
+    fn may_meet(&self, g: &WorldGroup, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
         !self.clip_rays || g.moving.may_meet(ray, tmin, tmax)
     }
 

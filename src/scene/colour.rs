@@ -2,14 +2,14 @@
 //! (`{ blackbody = T }`, `{ line = NM, fwhm = NM }`, `{ wavelengths = [...], values = [...] }`).
 
 use super::doc::Val;
-use super::reader::{Table, R};
+use super::reader::{SceneResult, Table};
 use crate::spectrum::{camera, Colour, Role, Spectrum};
 
 const FORMS: &str = "a number (grey), [r, g, b], { blackbody = T }, { line = NM, fwhm = NM } or { wavelengths = [...], values = [...] }";
 
 impl Table<'_> {
     /// A colour for `role`. Reflectances take RGB and tables only.
-    pub fn colour(&self, key: &str, role: Role) -> R<Option<Colour>> {
+    pub fn colour(&self, key: &str, role: Role) -> SceneResult<Option<Colour>> {
         let Some(n) = self.get(key) else {
             return Ok(None);
         };
@@ -97,7 +97,7 @@ impl Table<'_> {
         Ok(Some(colour))
     }
 
-    pub fn bool_or(&self, key: &str, default: bool) -> R<bool> {
+    pub fn bool_or(&self, key: &str, default: bool) -> SceneResult<bool> {
         match self.get(key) {
             None => Ok(default),
             Some(n) => match n.val {
@@ -113,7 +113,7 @@ impl Table<'_> {
 }
 
 /// `{ wavelengths = [...], values = [...] }`: nm strictly increasing, values ≥ 0.
-fn tabulated(t: &Table) -> R<Spectrum> {
+fn tabulated(t: &Table) -> SceneResult<Spectrum> {
     let wn = t.get("wavelengths").ok_or_else(|| {
         t.error(
             "wavelengths",

@@ -3,7 +3,7 @@
 use super::doc::Doc;
 use super::model::*;
 use super::procedural::{BarArray, Lattice};
-use super::reader::{Table, R};
+use super::reader::{SceneResult, Table};
 use super::SceneError;
 use crate::geometry::{Geometry, Primitive};
 use crate::spacetime::Velocity;
@@ -62,7 +62,7 @@ fn superseded(table: &[&str], key: &str) -> &'static [&'static str] {
     }
 }
 
-fn build(doc: &Doc) -> R<Scene> {
+fn build(doc: &Doc) -> SceneResult<Scene> {
     let root = Table::root(doc)?;
     let camera = match root.table("camera")? {
         Some(t) => camera(&t)?,
@@ -169,7 +169,7 @@ fn build(doc: &Doc) -> R<Scene> {
 
 /// A velocity: `velocity = [bx, by, bz]`, or `<dir_key> = [...]` with one of `beta`,
 /// `rapidity`, `one_minus_beta`. None when none of these keys is present.
-fn velocity(t: &Table, dir_key: &str) -> R<Option<Velocity>> {
+fn velocity(t: &Table, dir_key: &str) -> SceneResult<Option<Velocity>> {
     let forms: Vec<&str> = ["beta", "rapidity", "one_minus_beta"]
         .into_iter()
         .filter(|k| t.has(k))
@@ -222,7 +222,7 @@ fn velocity(t: &Table, dir_key: &str) -> R<Option<Velocity>> {
     v.map(Some).map_err(|e| t.error_at(n, form, e.to_string()))
 }
 
-fn camera(t: &Table) -> R<Camera> {
+fn camera(t: &Table) -> SceneResult<Camera> {
     let position = t.req_vec3("position")?;
     let forward = match (t.vec3("look_at")?, t.vec3("direction")?) {
         (Some(_), Some(_)) => {
@@ -321,7 +321,7 @@ fn camera(t: &Table) -> R<Camera> {
     })
 }
 
-fn image(t: &Table) -> R<ImageSettings> {
+fn image(t: &Table) -> SceneResult<ImageSettings> {
     let width = t.uint("width", Some(512), 1, 1 << 20)? as u32;
     let height = t.uint("height", Some(512), 1, 1 << 20)? as u32;
     let crop = t
@@ -357,7 +357,7 @@ fn image(t: &Table) -> R<ImageSettings> {
     Ok(s)
 }
 
-fn render_settings(t: &Table) -> R<RenderSettings> {
+fn render_settings(t: &Table) -> SceneResult<RenderSettings> {
     let s = RenderSettings {
         max_depth: t.uint("max_depth", Some(5), 0, 64)? as u32,
         ambient: t
@@ -370,7 +370,7 @@ fn render_settings(t: &Table) -> R<RenderSettings> {
     Ok(s)
 }
 
-fn material(t: &Table) -> R<Material> {
+fn material(t: &Table) -> SceneResult<Material> {
     let d = Material::default_white();
     let unit = |v: f64| (0.0..=1.0).contains(&v);
     let m = Material {
@@ -398,7 +398,7 @@ fn material(t: &Table) -> R<Material> {
     Ok(m)
 }
 
-fn light(t: &Table, groups: &[Group]) -> R<Light> {
+fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
     let position = t.req_vec3("position")?;
     let intensity = t.f64_where("intensity", Some(1.0), |v| v >= 0.0, "0 or more")?;
     let color = t
@@ -481,7 +481,12 @@ const OBJECT_KEYS: &[&str] = &[
     "axis",
 ];
 
-fn material_ref(t: &Table, key: &str, ids: &HashMap<String, u32>, default: u32) -> R<u32> {
+fn material_ref(
+    t: &Table,
+    key: &str,
+    ids: &HashMap<String, u32>,
+    default: u32,
+) -> SceneResult<u32> {
     match t.string(key)? {
         None => Ok(default),
         Some(name) => ids.get(name).copied().ok_or_else(|| {
@@ -504,7 +509,7 @@ fn material_ref(t: &Table, key: &str, ids: &HashMap<String, u32>, default: u32) 
     }
 }
 
-fn budget(t: &Table, key: &str, total: &mut u64, add: u64) -> R<()> {
+fn budget(t: &Table, key: &str, total: &mut u64, add: u64) -> SceneResult<()> {
     *total = total.saturating_add(add);
     if *total > MAX_PRIMITIVES {
         return Err(t.error(
@@ -524,7 +529,7 @@ fn add_object(
     mats: &HashMap<String, u32>,
     geo: &mut Geometry,
     total: &mut u64,
-) -> R<String> {
+) -> SceneResult<String> {
     let kind = t.req_string("type")?;
     let mat = material_ref(t, "material", mats, 0)?;
     match kind {
@@ -559,7 +564,7 @@ fn add_object(
                         t.numbers_of(e, "vertices", Some(3))
                             .map(|v| DVec3::new(v[0], v[1], v[2]))
                     })
-                    .collect::<R<Vec<_>>>()?,
+                    .collect::<SceneResult<Vec<_>>>()?,
                 _ => return Err(t.error_at(vn, "vertices", "expected an array of [x, y, z]")),
             };
             let inn = t
@@ -588,7 +593,7 @@ fn add_object(
                             v: idx.map(|i| verts[i]),
                         })
                     })
-                    .collect::<R<Vec<_>>>()?,
+                    .collect::<SceneResult<Vec<_>>>()?,
                 _ => return Err(t.error_at(inn, "indices", "expected an array of [i, j, k]")),
             };
             if tris.is_empty() {

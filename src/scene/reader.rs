@@ -14,10 +14,10 @@ pub struct Table<'a> {
     used: RefCell<Vec<bool>>,
 }
 
-pub type R<T> = Result<T, SceneError>;
+pub type SceneResult<T> = Result<T, SceneError>;
 
 impl<'a> Table<'a> {
-    pub fn new(doc: &'a Doc, node: &'a Node, path: String) -> R<Table<'a>> {
+    pub fn new(doc: &'a Doc, node: &'a Node, path: String) -> SceneResult<Table<'a>> {
         let Some(entries) = node.entries() else {
             return Err(SceneError::new(
                 doc.locate(&node.origin),
@@ -33,7 +33,7 @@ impl<'a> Table<'a> {
         })
     }
 
-    pub fn root(doc: &'a Doc) -> R<Table<'a>> {
+    pub fn root(doc: &'a Doc) -> SceneResult<Table<'a>> {
         Table::new(doc, &doc.root, String::new())
     }
 
@@ -70,11 +70,11 @@ impl<'a> Table<'a> {
         SceneError::new(self.doc.locate(&node.origin), self.key_path(key), msg)
     }
 
-    pub fn f64(&self, key: &str) -> R<Option<f64>> {
+    pub fn f64(&self, key: &str) -> SceneResult<Option<f64>> {
         self.get(key).map(|n| self.num(n, key)).transpose()
     }
 
-    fn num(&self, n: &Node, key: &str) -> R<f64> {
+    fn num(&self, n: &Node, key: &str) -> SceneResult<f64> {
         let v = match n.val {
             Val::Float(f) => f,
             Val::Int(i) => i as f64,
@@ -88,7 +88,7 @@ impl<'a> Table<'a> {
         Ok(v)
     }
 
-    pub fn f64_or(&self, key: &str, default: f64) -> R<f64> {
+    pub fn f64_or(&self, key: &str, default: f64) -> SceneResult<f64> {
         Ok(self.f64(key)?.unwrap_or(default))
     }
 
@@ -99,7 +99,7 @@ impl<'a> Table<'a> {
         default: Option<f64>,
         ok: fn(f64) -> bool,
         expect: &str,
-    ) -> R<f64> {
+    ) -> SceneResult<f64> {
         match self.get(key) {
             Some(n) => {
                 let v = self.num(n, key)?;
@@ -115,7 +115,7 @@ impl<'a> Table<'a> {
         }
     }
 
-    pub fn uint(&self, key: &str, default: Option<u64>, min: u64, max: u64) -> R<u64> {
+    pub fn uint(&self, key: &str, default: Option<u64>, min: u64, max: u64) -> SceneResult<u64> {
         match self.get(key) {
             Some(n) => self.uint_of(n, key, min, max),
             None => default.ok_or_else(|| {
@@ -127,7 +127,7 @@ impl<'a> Table<'a> {
         }
     }
 
-    fn uint_of(&self, n: &Node, key: &str, min: u64, max: u64) -> R<u64> {
+    fn uint_of(&self, n: &Node, key: &str, min: u64, max: u64) -> SceneResult<u64> {
         match n.val {
             Val::Int(i) if i >= min as i64 && (i as u64) <= max => Ok(i as u64),
             Val::Int(i) => Err(self.error_at(
@@ -143,7 +143,7 @@ impl<'a> Table<'a> {
         }
     }
 
-    pub fn string(&self, key: &str) -> R<Option<&'a str>> {
+    pub fn string(&self, key: &str) -> SceneResult<Option<&'a str>> {
         match self.get(key) {
             Some(Node {
                 val: Val::Str(s), ..
@@ -153,20 +153,20 @@ impl<'a> Table<'a> {
         }
     }
 
-    pub fn req_string(&self, key: &str) -> R<&'a str> {
+    pub fn req_string(&self, key: &str) -> SceneResult<&'a str> {
         self.string(key)?
             .ok_or_else(|| self.error(key, "missing: give a string"))
     }
 
     /// An array of numbers of exactly `len` elements.
-    pub fn numbers(&self, key: &str, len: usize) -> R<Option<Vec<f64>>> {
+    pub fn numbers(&self, key: &str, len: usize) -> SceneResult<Option<Vec<f64>>> {
         let Some(n) = self.get(key) else {
             return Ok(None);
         };
         self.numbers_of(n, key, Some(len)).map(Some)
     }
 
-    pub fn numbers_of(&self, n: &Node, key: &str, len: Option<usize>) -> R<Vec<f64>> {
+    pub fn numbers_of(&self, n: &Node, key: &str, len: Option<usize>) -> SceneResult<Vec<f64>> {
         let Val::Array(items) = &n.val else {
             let want = len
                 .map(|l| format!("an array of {l} numbers"))
@@ -185,17 +185,17 @@ impl<'a> Table<'a> {
         items.iter().map(|e| self.num(e, key)).collect()
     }
 
-    pub fn vec3(&self, key: &str) -> R<Option<DVec3>> {
+    pub fn vec3(&self, key: &str) -> SceneResult<Option<DVec3>> {
         Ok(self.numbers(key, 3)?.map(|v| DVec3::new(v[0], v[1], v[2])))
     }
 
-    pub fn req_vec3(&self, key: &str) -> R<DVec3> {
+    pub fn req_vec3(&self, key: &str) -> SceneResult<DVec3> {
         self.vec3(key)?
             .ok_or_else(|| self.error(key, "missing: give [x, y, z]"))
     }
 
     /// A colour: `[r, g, b]` or one number for grey; every channel ≥ 0.
-    pub fn color(&self, key: &str) -> R<Option<DVec3>> {
+    pub fn color(&self, key: &str) -> SceneResult<Option<DVec3>> {
         let Some(n) = self.get(key) else {
             return Ok(None);
         };
@@ -218,7 +218,7 @@ impl<'a> Table<'a> {
         key: &str,
         len: usize,
         default: Option<f64>,
-    ) -> R<Vec<f64>> {
+    ) -> SceneResult<Vec<f64>> {
         let v = match self.get(key) {
             None => match default {
                 Some(d) => vec![d; len],
@@ -237,7 +237,13 @@ impl<'a> Table<'a> {
     }
 
     /// Whole numbers, exactly `len` of them, each in [min, max].
-    pub fn uints(&self, key: &str, len: usize, min: u64, max: u64) -> R<Option<Vec<u64>>> {
+    pub fn uints(
+        &self,
+        key: &str,
+        len: usize,
+        min: u64,
+        max: u64,
+    ) -> SceneResult<Option<Vec<u64>>> {
         let Some(n) = self.get(key) else {
             return Ok(None);
         };
@@ -261,19 +267,19 @@ impl<'a> Table<'a> {
         items
             .iter()
             .map(|e| self.uint_of(e, key, min, max))
-            .collect::<R<Vec<_>>>()
+            .collect::<SceneResult<Vec<_>>>()
             .map(Some)
     }
 
     /// A sub-table.
-    pub fn table(&self, key: &str) -> R<Option<Table<'a>>> {
+    pub fn table(&self, key: &str) -> SceneResult<Option<Table<'a>>> {
         self.get(key)
             .map(|n| Table::new(self.doc, n, self.key_path(key)))
             .transpose()
     }
 
     /// An array of tables (`[[key]]`); each entry's path uses its `name` when it has one.
-    pub fn tables(&self, key: &str) -> R<Vec<Table<'a>>> {
+    pub fn tables(&self, key: &str) -> SceneResult<Vec<Table<'a>>> {
         let Some(n) = self.get(key) else {
             return Ok(Vec::new());
         };
@@ -306,7 +312,7 @@ impl<'a> Table<'a> {
     }
 
     /// Every key must have been read: report the first that was not, with a suggestion.
-    pub fn finish(&self, known: &[&str]) -> R<()> {
+    pub fn finish(&self, known: &[&str]) -> SceneResult<()> {
         let used = self.used.borrow();
         for (i, (k, n)) in self.entries().iter().enumerate() {
             if !used[i] {

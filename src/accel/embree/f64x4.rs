@@ -1,5 +1,5 @@
 //! Four f64 in one AVX vector, as a `Real`, for the several-ray primitive tests (`lane_hits`)
-//! and the fans of primary rays (`fan.rs`).
+//! and the fans of primary rays (`fan_kernel.rs`).
 //!
 //! Written with the intrinsics rather than left to the compiler's vectoriser, which kept the
 //! rod test scalar (it paired one ray's two square roots instead of four rays' one). An `F4` is

@@ -16,7 +16,7 @@ mod exact;
 #[cfg(target_arch = "x86_64")]
 mod f64x4;
 #[cfg(target_arch = "x86_64")]
-mod fan;
+mod fan_kernel;
 mod lane_cull;
 mod lane_hits;
 mod packet;
@@ -82,7 +82,7 @@ impl Backend for EmbreeBackend {
     fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>> {
         let device = self.device()?;
         let width = self.packet_width.unwrap_or(device.packet_width);
-        let scene = scene::Scene::build(device, &geometry)?;
+        let scene = scene::EmbreeScene::build(device, &geometry)?;
         let diag = geometry.bounds().diagonal();
         Ok(Box::new(EmbreeAccel {
             scene,
@@ -96,7 +96,7 @@ impl Backend for EmbreeBackend {
 }
 
 pub struct EmbreeAccel {
-    scene: scene::Scene,
+    scene: scene::EmbreeScene,
     geometry: Arc<Geometry>,
     width: usize,
     pullback: f64,
@@ -113,7 +113,7 @@ struct EmbreeRay {
 }
 
 /// Directions this long, within a factor of the unit, Embree traces as they are (`scale`).
-const AS_THEY_ARE: f64 = 16.0;
+const MAX_UNNORMALISED: f64 = 16.0;
 
 /// What Embree traces a direction of length `len` (`Ray::len`) divided by: 1 where `len`
 /// lies within [1/16, 16], so the direction goes in as it is, with no division (a boost's
@@ -125,8 +125,8 @@ const AS_THEY_ARE: f64 = 16.0;
 #[inline(always)]
 fn scale<R: Real>(len: R) -> R {
     let near = R::both(
-        len.ge(R::splat(1.0 / AS_THEY_ARE)),
-        len.le(R::splat(AS_THEY_ARE)),
+        len.ge(R::splat(1.0 / MAX_UNNORMALISED)),
+        len.le(R::splat(MAX_UNNORMALISED)),
     );
     R::select(near, R::splat(1.0), len)
 }

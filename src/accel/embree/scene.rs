@@ -19,7 +19,7 @@ pub struct PrimMap {
 /// The scene primitives of an Embree scene whose every geometry is user geometry with exact
 /// hits and holds a run of the scene's primitives (`PrimMap::prims[i] = first + i`): the
 /// firsts, by geomID. A hit's primitive is then `first + primID` and its t the context's, read
-/// back with no lookup and no branch on whether a lane hit (the fans in `fan.rs` and the
+/// back with no lookup and no branch on whether a lane hit (the fans in `fan_kernel.rs` and the
 /// packets in `packet.rs`; the paper's lattice, the bar array and every scene of spheres and
 /// rods are such).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,7 +56,7 @@ impl ExactRuns {
 }
 
 /// A group's geometry as an Embree scene, and what its hits mean.
-pub struct Scene {
+pub struct EmbreeScene {
     /// Released before the shapes below, which it points into (fields drop in order).
     pub(super) rtc: CommittedScene,
     /// Indexed by geomID.
@@ -74,8 +74,8 @@ fn f3(p: DVec3) -> [f32; 3] {
     [p.x as f32, p.y as f32, p.z as f32]
 }
 
-impl Scene {
-    pub fn build(device: Arc<Device>, geo: &SceneGeometry) -> crate::Result<Scene> {
+impl EmbreeScene {
+    pub fn build(device: Arc<Device>, geo: &SceneGeometry) -> crate::Result<EmbreeScene> {
         let center = geo.bounds().centroid();
         let center = if center.is_finite() {
             center
@@ -146,7 +146,7 @@ impl Scene {
             attach(&mut builder, &mut maps, g, cuboid_map, true)?;
         }
         let exact_runs = ExactRuns::of(&maps);
-        Ok(Scene {
+        Ok(EmbreeScene {
             rtc: builder.commit()?,
             maps,
             exact_runs,
@@ -172,7 +172,7 @@ fn user_geometry<S: Shape>(device: &Arc<Device>, shapes: &Shapes<S>) -> crate::R
         intersect: exact::intersect::<S>,
         occluded: exact::occluded::<S>,
     };
-    // SAFETY: `shapes` is boxed in the `Scene` the geometry's scene goes into, and dropped
+    // SAFETY: `shapes` is boxed in the `EmbreeScene` the geometry's scene goes into, and dropped
     // after that scene is released; the callbacks read it as `Shapes<S>`.
     unsafe { g.set_user(shapes.0.len() as u32, ptr, functions) };
     Ok(g)

@@ -3,7 +3,7 @@
 //! made, boosted and traced by the backend from the camera and the lanes' image points, with the
 //! same rays and hits to the bit as `CameraRays::ray` and `closest_hits` (tests/fused_primary.rs).
 
-use super::{GroupRt, SurfaceHit, World};
+use super::{SurfaceHit, World, WorldGroup};
 use crate::accel::{Accelerator, Fan, FanHits, NO_HIT};
 use crate::geometry::PACKET;
 use crate::render::CameraRays;
@@ -14,7 +14,7 @@ impl World {
     /// The one group and its accelerator when primary rays through `cam` go to the backend as
     /// fans: a pinhole camera, a single group seen from close by (no clip, no group trees) and
     /// a backend with a path of its own for them.
-    fn fan_group(&self, cam: &CameraRays) -> Option<(&GroupRt, &dyn Accelerator, Pinhole)> {
+    fn fan_group(&self, cam: &CameraRays) -> Option<(&WorldGroup, &dyn Accelerator, Pinhole)> {
         let [g] = self.groups.as_slice() else {
             return None;
         };

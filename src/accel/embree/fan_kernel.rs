@@ -15,7 +15,7 @@
 use super::exact::Lanes;
 use super::f64x4::F4;
 use super::packet::{flush_denormals, Reused, Valid};
-use super::{lane_geometry, scale, EmbreeAccel, AS_THEY_ARE};
+use super::{lane_geometry, scale, EmbreeAccel, MAX_UNNORMALISED};
 use crate::accel::{Fan, FanHits, Ray, NO_HIT};
 use crate::geometry::Real;
 use crate::geometry::PACKET;
@@ -63,7 +63,7 @@ macro_rules! fan_packet {
                     let n = fan.n.saturating_sub(first).min(N);
                     // Every lane's s lies within [1/stretch, stretch] but for rounding, which
                     // the margin below 16 covers: then `scale` is 1 in every lane.
-                    let raw = fan.to_rest.max_stretch() <= AS_THEY_ARE - 1.0;
+                    let raw = fan.to_rest.max_stretch() <= MAX_UNNORMALISED - 1.0;
                     let splat = F4::splat;
                     let o = fan.origin - self.scene.center;
                     let (o, pullback) =
@@ -179,18 +179,18 @@ fan_packet!(fan8, 8, RTCRayHit8, intersect8);
 #[cfg(test)]
 mod tests {
     use super::super::scale;
-    use super::AS_THEY_ARE;
+    use super::MAX_UNNORMALISED;
     use crate::rng::Rng;
     use crate::spacetime::{Boost, Velocity};
 
     /// The fans trace every lane's direction as it is where the boost stretches by at most
-    /// `AS_THEY_ARE − 1`, which is right only if `scale` then says 1 for every ray the boost
+    /// `MAX_UNNORMALISED − 1`, which is right only if `scale` then says 1 for every ray the boost
     /// makes (so that a fan's Embree rays are `embree_ray`'s to the bit); beyond, `scale` must
     /// say so for some directions, or the margin would be wasted.
     #[test]
     fn within_the_stretch_every_direction_goes_in_as_it_is() {
         let mut rng = Rng(0x5eed_f00d_1234_5678);
-        let limit = AS_THEY_ARE - 1.0;
+        let limit = MAX_UNNORMALISED - 1.0;
         // e^φ = limit at β = (limit² − 1) / (limit² + 1).
         let edge = (limit * limit - 1.0) / (limit * limit + 1.0);
         for case in 0..2_000 {
