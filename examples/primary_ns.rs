@@ -43,6 +43,9 @@ fn main() {
             fused_primary: mode != "layer-unfused",
             ..WorldOptions::default()
         };
+        if mode == "bare" {
+            return bare(&scene, &embree, options, seconds, size, &beta);
+        }
         let world = World::build_with(&scene, backend.as_ref(), options).unwrap();
         let mut pass: Box<dyn FnMut()> = match mode.as_str() {
             "layer" | "layer-unfused" | "bvh" => Box::new(|| {
@@ -51,21 +54,30 @@ fn main() {
             "render" => Box::new(|| {
                 render_world(&scene, &world);
             }),
-            _ => bare(&scene, &world),
+            other => fail(&format!("unknown mode `{other}`")),
         };
-        pass();
-        let (start, mut best) = (Instant::now(), f64::INFINITY);
-        while start.elapsed().as_secs_f64() < seconds {
-            let t = Instant::now();
-            pass();
-            best = best.min(t.elapsed().as_secs_f64());
-        }
-        let pixels = f64::from(size) * f64::from(size);
-        println!(
-            "{mode} beta={beta} {size}x{size}: {:.2} ns per pixel",
-            best * 1e9 / pixels
-        );
+        report(&mode, &beta, size, best_of(seconds, &mut pass));
     });
+}
+
+/// The fastest of as many passes as fit in `seconds`, after one untimed.
+fn best_of(seconds: f64, mut pass: impl FnMut()) -> f64 {
+    pass();
+    let (start, mut best) = (Instant::now(), f64::INFINITY);
+    while start.elapsed().as_secs_f64() < seconds {
+        let t = Instant::now();
+        pass();
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    best
+}
+
+fn report(mode: &str, beta: &str, size: u32, best: f64) {
+    let pixels = f64::from(size) * f64::from(size);
+    println!(
+        "{mode} beta={beta} {size}x{size}: {:.2} ns per pixel",
+        best * 1e9 / pixels
+    );
 }
 
 fn fail(message: &dyn std::fmt::Display) -> ! {
@@ -73,18 +85,31 @@ fn fail(message: &dyn std::fmt::Display) -> ! {
     std::process::exit(2)
 }
 
+/// Bare Embree on the rest-frame primary rays of the lattice's one group, through the same
+/// Embree scene as the world's (`bench::world_and_accel`).
 #[cfg(feature = "embree")]
-fn bare<'a>(scene: &'a rest_embree::scene::Scene, world: &'a World) -> Box<dyn FnMut() + 'a> {
-    let Some((accel, tiles)) = rest_embree::bench::bare_rays(scene, world) else {
+fn bare(
+    scene: &rest_embree::scene::Scene,
+    embree: &str,
+    options: WorldOptions,
+    seconds: f64,
+    size: u32,
+    beta: &str,
+) {
+    use rayon::prelude::*;
+    let (world, accel) =
+        rest_embree::bench::world_and_accel(scene, embree, options).unwrap_or_else(|e| fail(&e));
+    let Some(accel) = accel else {
         fail(&"bare Embree needs the lattice's one group on Embree")
     };
-    Box::new(move || {
-        use rayon::prelude::*;
+    let tiles = rest_embree::bench::bare_rays(scene, &world, &accel);
+    let pass = || {
         let _: usize = tiles.par_iter().map(|t| accel.trace_bare(t)).sum();
-    })
+    };
+    report("bare", beta, size, best_of(seconds, pass));
 }
 
 #[cfg(not(feature = "embree"))]
-fn bare<'a>(_: &'a rest_embree::scene::Scene, _: &'a World) -> Box<dyn FnMut() + 'a> {
+fn bare(_: &rest_embree::scene::Scene, _: &str, _: WorldOptions, _: f64, _: u32, _: &str) {
     fail(&"bare Embree needs a build with the `embree` feature")
 }

@@ -155,8 +155,4 @@ impl Accelerator for Bvh {
     fn geometry(&self) -> &Arc<Geometry> {
         &self.geometry
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }

@@ -81,8 +81,25 @@ pub trait Accelerator: Send + Sync {
     }
     /// The geometry this accelerator was built over.
     fn geometry(&self) -> &Arc<Geometry>;
-    /// For benchmarks that need the concrete backend.
-    fn as_any(&self) -> &dyn std::any::Any;
+}
+
+/// An accelerator shared (a world and a measurement of the same structure, say).
+impl<A: Accelerator + ?Sized> Accelerator for Arc<A> {
+    fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        (**self).intersect(rays, hits)
+    }
+    fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
+        (**self).occluded(rays, out)
+    }
+    fn serves_fans(&self) -> bool {
+        (**self).serves_fans()
+    }
+    fn intersect_fan(&self, fan: &Fan, out: &mut FanHits) -> bool {
+        (**self).intersect_fan(fan, out)
+    }
+    fn geometry(&self) -> &Arc<Geometry> {
+        (**self).geometry()
+    }
 }
 
 /// Builds accelerators; one per kind of backend.
@@ -169,6 +186,19 @@ pub fn default_backend_name() -> &'static str {
     backend_names()[0]
 }
 
+/// The Embree backend of that name: `embree` picks 16- or 8-wide packets from the CPU;
+/// `embree-16`, `embree-8` and `embree-single` fix the width, for comparisons.
+#[cfg(feature = "embree")]
+pub fn embree_backend(name: &str) -> Option<EmbreeBackend> {
+    match name {
+        "embree" => Some(EmbreeBackend::new()),
+        "embree-16" => Some(EmbreeBackend::with_packet_width(16)),
+        "embree-8" => Some(EmbreeBackend::with_packet_width(8)),
+        "embree-single" => Some(EmbreeBackend::with_packet_width(1)),
+        _ => None,
+    }
+}
+
 /// The backend of that name, or an error that lists the choices.
 pub fn backend_by_name(name: &str) -> crate::Result<Box<dyn Backend>> {
     match name {
@@ -176,14 +206,9 @@ pub fn backend_by_name(name: &str) -> crate::Result<Box<dyn Backend>> {
         // The f64 BVH's tree with f32 nodes, for comparisons.
         "bvh-f32" => Ok(Box::new(Bvh32Backend)),
         #[cfg(feature = "embree")]
-        "embree" => Ok(Box::new(EmbreeBackend::new())),
-        // Fixed packet widths, for comparisons (`embree` picks 16 or 8 from the CPU).
-        #[cfg(feature = "embree")]
-        "embree-16" => Ok(Box::new(EmbreeBackend::with_packet_width(16))),
-        #[cfg(feature = "embree")]
-        "embree-8" => Ok(Box::new(EmbreeBackend::with_packet_width(8))),
-        #[cfg(feature = "embree")]
-        "embree-single" => Ok(Box::new(EmbreeBackend::with_packet_width(1))),
+        "embree" | "embree-16" | "embree-8" | "embree-single" => {
+            Ok(Box::new(embree_backend(name).expect("an Embree name")))
+        }
         #[cfg(not(feature = "embree"))]
         "embree" | "embree-16" | "embree-8" | "embree-single" => Err(crate::Error::backend(
             "backend 'embree' is not in this build: rebuild with `--features embree` (needs libembree-dev and libclang-dev)",

@@ -308,30 +308,69 @@ fn beside(
     })
 }
 
-/// The bare-Embree baseline's input: the Embree accelerator of the world's one group and the
-/// scene's primary rays (pixel centres, tile by tile) in that group's rest frame, as bare f32
-/// rays; None unless the world is one group on Embree.
+/// A world of `scene` on the Embree backend `name` (`embree`, `embree-16`, …) with `options`,
+/// and the Embree accelerator of its one group, shared with the world (None unless the world is
+/// one group traced through an accelerator): bare Embree measured beside the layer on the same
+/// structure.
 #[cfg(feature = "embree")]
-pub fn bare_rays<'w>(
+pub fn world_and_accel(
     scene: &Scene,
-    world: &'w World,
-) -> Option<(
-    &'w crate::accel::EmbreeAccel,
-    Vec<Vec<crate::accel::BareRay>>,
-)> {
-    let [g] = world.groups.as_slice() else {
-        return None;
+    name: &str,
+    options: WorldOptions,
+) -> crate::Result<(World, Option<std::sync::Arc<crate::accel::EmbreeAccel>>)> {
+    use crate::accel::{Accelerator, Backend, CullerFactory, EmbreeAccel, EmbreeBackend};
+    use crate::geometry::Geometry;
+    use std::sync::Arc;
+    /// Builds as `inner` does and keeps a handle on what it built.
+    struct Keeping {
+        inner: EmbreeBackend,
+        built: std::sync::Mutex<Vec<Arc<EmbreeAccel>>>,
+    }
+    impl Backend for Keeping {
+        fn name(&self) -> &'static str {
+            self.inner.name()
+        }
+        fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>> {
+            let accel = Arc::new(self.inner.accelerator(geometry)?);
+            self.built.lock().expect("not poisoned").push(accel.clone());
+            Ok(Box::new(accel))
+        }
+        fn cullers(&self) -> CullerFactory {
+            self.inner.cullers()
+        }
+    }
+    let inner = crate::accel::embree_backend(name)
+        .ok_or_else(|| crate::Error::flag("--backend", format!("`{name}` is no Embree backend")))?;
+    let backend = Keeping {
+        inner,
+        built: Default::default(),
     };
-    let accel: &crate::accel::EmbreeAccel = g.accel.as_ref()?.as_any().downcast_ref()?;
-    let tiles = crate::render::primary_rays_by_tile(scene)
+    let world = World::build_with(scene, &backend, options)?;
+    let built = backend.built.into_inner().expect("not poisoned");
+    let accel = match (world.groups.as_slice(), built.as_slice()) {
+        ([_], [a]) => Some(a.clone()),
+        _ => None,
+    };
+    Ok((world, accel))
+}
+
+/// The scene's primary rays (pixel centres, tile by tile) in the rest frame of the world's one
+/// group, as bare f32 rays for `accel`.
+#[cfg(feature = "embree")]
+pub fn bare_rays(
+    scene: &Scene,
+    world: &World,
+    accel: &crate::accel::EmbreeAccel,
+) -> Vec<Vec<crate::accel::BareRay>> {
+    let g = &world.groups[0];
+    crate::render::primary_rays_by_tile(scene)
         .iter()
         .map(|rays| {
             rays.iter()
                 .map(|r| accel.bare_ray(g.boost.event(r.origin).x, g.boost.view_dir(r.dir).0))
                 .collect()
         })
-        .collect();
-    Some((accel, tiles))
+        .collect()
 }
 
 /// Blocks of each side where two measurements are set side by side (`bare_embree`, `beside`).
@@ -348,11 +387,11 @@ const PAIRED_BLOCKS: usize = 3;
 #[cfg(feature = "embree")]
 fn bare_embree(case: &Case, repeat: usize) -> crate::Result<Option<(u64, f64, f64)>> {
     use rayon::prelude::*;
-    let backend = backend_by_name("embree")?;
-    let world = World::build(&case.scene, backend.as_ref())?;
-    let Some((accel, tiles)) = bare_rays(&case.scene, &world) else {
+    let (world, accel) = world_and_accel(&case.scene, "embree", WorldOptions::default())?;
+    let Some(accel) = accel else {
         return Ok(None);
     };
+    let tiles = bare_rays(&case.scene, &world, &accel);
     let n: u64 = tiles.iter().map(|t| t.len() as u64).sum();
     let bare = || {
         let _hits: usize = tiles.par_iter().map(|t| accel.trace_bare(t)).sum();

@@ -52,6 +52,23 @@ impl EmbreeBackend {
         }
     }
 
+    /// The accelerator over `geometry`, as this backend's `build` makes it (concrete, for
+    /// callers that trace it more ways than the trait's).
+    pub fn accelerator(&self, geometry: Arc<Geometry>) -> crate::Result<EmbreeAccel> {
+        let device = self.device()?;
+        let width = self.packet_width.unwrap_or(device.packet_width);
+        let scene = scene::EmbreeScene::build(device, &geometry)?;
+        let diag = geometry.bounds().diagonal();
+        Ok(EmbreeAccel {
+            scene,
+            geometry,
+            width,
+            // How far a ray's origin is pulled back before the f32 cast, so geometry flush with
+            // the bounds (where the renderer put the origin) is not lost to f32 rounding.
+            pullback: 1e-4 * diag.max(1e-6),
+        })
+    }
+
     fn device(&self) -> crate::Result<Arc<Device>> {
         // Embree's build threads follow the render's (--threads sets rayon's global pool).
         self.device
@@ -80,18 +97,7 @@ impl Backend for EmbreeBackend {
     }
 
     fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>> {
-        let device = self.device()?;
-        let width = self.packet_width.unwrap_or(device.packet_width);
-        let scene = scene::EmbreeScene::build(device, &geometry)?;
-        let diag = geometry.bounds().diagonal();
-        Ok(Box::new(EmbreeAccel {
-            scene,
-            geometry,
-            width,
-            // How far a ray's origin is pulled back before the f32 cast, so geometry flush with
-            // the bounds (where the renderer put the origin) is not lost to f32 rounding.
-            pullback: 1e-4 * diag.max(1e-6),
-        }))
+        Ok(Box::new(self.accelerator(geometry)?))
     }
 }
 
@@ -259,9 +265,5 @@ impl Accelerator for EmbreeAccel {
 
     fn geometry(&self) -> &Arc<Geometry> {
         &self.geometry
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }
