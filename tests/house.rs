@@ -69,8 +69,14 @@ fn nothing_cites_files_outside_the_repository() {
         if path.ends_with("tests/house.rs") {
             continue;
         }
+        // The names are put together here so that this file does not cite them itself.
+        let outside = [
+            ["..", "/shared"].concat(),
+            ["PHYSICS", ".md"].concat(),
+            ["DESIGN", ".md"].concat(),
+        ];
         for (n, line) in text.lines().enumerate() {
-            for bad in ["../shared", "PHYSICS.md", "DESIGN.md"] {
+            for bad in &outside {
                 assert!(
                     !line.contains(bad),
                     "{}:{}: cites `{bad}`, which is not in the repository",
