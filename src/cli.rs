@@ -180,6 +180,24 @@ fn pick_cases(all: Vec<bench::LazyCase>, texts: &[String]) -> crate::Result<Vec<
 
 fn run_bench(args: &BenchArgs) -> crate::Result<()> {
     set_threads(args.threads)?;
+    // What can be refused is refused before anything is measured.
+    if args.scene.is_none() && !args.set.is_empty() {
+        return Err(Error::flag(
+            "--set",
+            "sets values of a scene file: give one (rest-embree bench SCENE.toml --set ...); the suite's cases set their own",
+        ));
+    }
+    if args.cases.iter().any(|c| c.trim().is_empty()) {
+        return Err(Error::flag(
+            "--case",
+            "is empty: give a case's name, or a part of one",
+        ));
+    }
+    let out_flag = format!("--out {}", args.out.display());
+    std::fs::create_dir_all(&args.out).map_err(|e| Error::flag(&out_flag, e))?;
+    let probe = args.out.join(format!(".probe-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| Error::flag(&out_flag, e))?;
+    let _ = std::fs::remove_file(&probe);
     let cases = match &args.scene {
         None => {
             let all = bench::cases(args.quick);
@@ -221,8 +239,6 @@ fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         "threads: {}\n\n{table}\n{summary}",
         rayon::current_num_threads()
     );
-    let out_flag = format!("--out {}", args.out.display());
-    std::fs::create_dir_all(&args.out).map_err(|e| Error::flag(&out_flag, e))?;
     let md = format!(
         "Measured with `rest-embree bench{}` on {} threads.\n\n{table}\n{summary}",
         if args.quick { " --quick" } else { "" },

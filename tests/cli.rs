@@ -474,6 +474,24 @@ fn bench_writes_its_table_csv_and_plot() {
         out.to_str().unwrap(),
     ]);
     assert!(!ok && err.contains("--case"), "{err}");
+    // Refused before anything is measured: an empty --case, --set without a scene, an --out
+    // that cannot be written (a file where the folder should be).
+    let blocker = d.file("not-a-folder", "");
+    let out = out.to_str().unwrap();
+    for (args, flag) in [
+        (vec!["--case", "", "--out", out], "--case"),
+        (vec!["--set", "camera.time=3", "--out", out], "--set"),
+        (vec!["--out", blocker.to_str().unwrap()], "--out"),
+    ] {
+        let mut all = vec!["bench", "--quick", "--case", "lattice beta=0.9, no lights"];
+        all.extend(args.iter().copied());
+        let (ok, err) = run(&all);
+        assert!(!ok && err.contains(flag), "{flag}: {err}");
+        assert!(
+            !err.contains("bench: lattice"),
+            "{flag}: refused before measuring: {err}"
+        );
+    }
 }
 
 #[test]
