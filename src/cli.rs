@@ -76,7 +76,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub samples: Option<i64>,
     /// World time of the imaging event (overrides camera.time).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = finite)]
     pub time: Option<f64>,
     /// Override any scene value with a TOML value, e.g. 'group.cube.velocity=[0.99,0,0]'.
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -111,6 +111,28 @@ impl RenderArgs {
         }
         v
     }
+}
+
+/// A finite number (clap takes `nan` and `inf` for f64).
+fn finite(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) => Err(format!("must be a finite number (got {v:?})")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// Parse the command line: help and version print and exit 0; every other argument error
+/// prints and exits 1, like every other user error.
+pub fn parse() -> Result<Cli, ExitCode> {
+    Cli::try_parse().map_err(|e| {
+        let _ = e.print();
+        if e.use_stderr() {
+            ExitCode::FAILURE
+        } else {
+            ExitCode::SUCCESS
+        }
+    })
 }
 
 pub fn run(cli: Cli) -> ExitCode {

@@ -1,5 +1,6 @@
-use clap::Parser;
-
 fn main() -> std::process::ExitCode {
-    rest_embree::cli::run(rest_embree::cli::Cli::parse())
+    match rest_embree::cli::parse() {
+        Ok(cli) => rest_embree::cli::run(cli),
+        Err(code) => code,
+    }
 }

@@ -663,3 +663,51 @@ fn spectra_and_switches_render() {
     // colour, the searchlight then its brightness but not its colour much.
     assert!((pixels[0] - pixels[1]).abs() > 0.01, "{pixels:?}");
 }
+
+/// The exit status of the command with these arguments, and its standard error.
+fn status(args: &[&str]) -> (Option<i32>, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args(args)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!err.contains("panicked"), "the command panicked: {err}");
+    (out.status.code(), err)
+}
+
+/// Every user error exits with 1 (argument errors too, where clap's own is 2), help with 0;
+/// numbers are echoed in their shortest form; a frame too large is blamed on the flag that
+/// made it so; a time that is not a finite number is the flag's error.
+#[test]
+fn messages_and_exit_status() {
+    let d = Dir::new("messages");
+    let scene = d.file("scene.toml", GOOD);
+    let out = d.0.join("out.png");
+    let (s, o) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    let (code, err) = status(&["render", "--nonsense"]);
+    assert_eq!(code, Some(1), "{err}");
+    let (code, _) = status(&["--help"]);
+    assert_eq!(code, Some(0));
+    let (code, err) = status(&["render", s, "-o", o, "--time", "nan"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("--time") && err.contains("finite"), "{err}");
+    let (code, err) = status(&["render", s, "-o", o, "--set", "camera.fov_y=1e308"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("(got 1e308)") && !err.contains("00000000"),
+        "{err}"
+    );
+    let (code, err) = status(&[
+        "render", s, "-o", o, "--width", "20000", "--height", "20000",
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--width 20000") && !err.contains("scene.toml"),
+        "{err}"
+    );
+    assert_eq!(
+        d.entries(),
+        vec!["scene.toml".to_string()],
+        "nothing written"
+    );
+}

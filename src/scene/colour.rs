@@ -51,7 +51,7 @@ impl Table<'_> {
                 return Err(t.error_at(
                     t.get("scale").expect("read"),
                     "scale",
-                    format!("must not be negative (got {s})"),
+                    format!("must not be negative (got {s:?})"),
                 ))
             }
             (Some(s), None) => s,
@@ -60,7 +60,7 @@ impl Table<'_> {
                     return Err(t.error_at(
                         t.get("luminance").expect("read"),
                         "luminance",
-                        format!("must not be negative (got {y})"),
+                        format!("must not be negative (got {y:?})"),
                     ));
                 }
                 if role == Role::Reflectance {
@@ -143,7 +143,7 @@ fn tabulated(t: &Table) -> SceneResult<Spectrum> {
         return Err(t.error_at(
             wn,
             "wavelengths",
-            format!("wavelengths must be above 0 nm (got {w})"),
+            format!("wavelengths must be above 0 nm (got {w:?})"),
         ));
     }
     if let Some(k) = (1..wavelengths.len()).find(|&k| wavelengths[k] <= wavelengths[k - 1]) {
@@ -161,7 +161,7 @@ fn tabulated(t: &Table) -> SceneResult<Spectrum> {
         return Err(t.error_at(
             vn,
             "values",
-            format!("values must not be negative (got {v})"),
+            format!("values must not be negative (got {v:?})"),
         ));
     }
     Ok(Spectrum::Tabulated {

@@ -269,7 +269,7 @@ fn camera(t: &Table) -> SceneResult<Camera> {
     )?;
     let view_height = t.f64("view_height")?;
     if let Some(h) = view_height.filter(|&h| h <= 0.0) {
-        return Err(t.error("view_height", format!("must be greater than 0 (got {h})")));
+        return Err(t.error("view_height", format!("must be greater than 0 (got {h:?})")));
     }
     let projection = match t.string("projection")?.unwrap_or("pinhole") {
         "pinhole" | "perspective" => Projection::Pinhole {
@@ -348,8 +348,13 @@ fn image(t: &Table) -> SceneResult<ImageSettings> {
     };
     let (fw, fh) = s.frame_size();
     if fw as u64 * fh as u64 > 1 << 28 {
-        return Err(t.error(
-            "width",
+        let (key, n) = ["width", "height", "crop"]
+            .into_iter()
+            .find_map(|k| t.get(k).map(|n| (k, n)))
+            .expect("a frame this large was set by one of these");
+        return Err(t.error_at(
+            n,
+            key,
             format!("a {fw}x{fh} frame is too large (at most 2^28 pixels; render it in crops)"),
         ));
     }

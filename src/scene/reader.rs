@@ -106,7 +106,7 @@ impl<'a> Table<'a> {
                 if ok(v) {
                     Ok(v)
                 } else {
-                    Err(self.error_at(n, key, format!("must be {expect} (got {v})")))
+                    Err(self.error_at(n, key, format!("must be {expect} (got {v:?})")))
                 }
             }
             None => {

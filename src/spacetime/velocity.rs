@@ -25,12 +25,12 @@ impl fmt::Display for VelocityError {
             VelocityError::NotFinite => write!(f, "the speed must be a finite number"),
             VelocityError::NotBelowLight(b) => write!(
                 f,
-                "speed {b} is not below 1 (the speed of light); for speeds near 1 give `rapidity` or `one_minus_beta` with a `direction`"
+                "speed {b:?} is not below 1 (the speed of light); for speeds near 1 give `rapidity` or `one_minus_beta` with a `direction`"
             ),
-            VelocityError::Negative(what, v) => write!(f, "{what} must not be negative (got {v}); reverse `direction` instead"),
+            VelocityError::Negative(what, v) => write!(f, "{what} must not be negative (got {v:?}); reverse `direction` instead"),
             VelocityError::ZeroDirection => write!(f, "`direction` must not be the zero vector"),
             VelocityError::OneMinusBetaRange(e) => {
-                write!(f, "one_minus_beta must lie in (0, 1] (got {e})")
+                write!(f, "one_minus_beta must lie in (0, 1] (got {e:?})")
             }
         }
     }
