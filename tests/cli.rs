@@ -705,9 +705,19 @@ fn messages_and_exit_status() {
         err.contains("--width 20000") && !err.contains("scene.toml"),
         "{err}"
     );
-    assert_eq!(
-        d.entries(),
-        vec!["scene.toml".to_string()],
-        "nothing written"
+    // A key rejected where it stands says why, and does not suggest itself.
+    let lone = d.file(
+        "lone.toml",
+        &with("velocity = [0.5, 0, 0]", "direction = [1, 0, 0]"),
     );
+    let (code, err) = status(&["render", lone.to_str().unwrap(), "-o", o]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("group.cube.direction") && err.contains("give the speed too"),
+        "{err}"
+    );
+    assert!(!err.contains("did you mean `direction`"), "{err}");
+    let mut entries = d.entries();
+    entries.sort();
+    assert_eq!(entries, ["lone.toml", "scene.toml"], "nothing written");
 }

@@ -188,8 +188,9 @@ fn velocity(t: &Table, dir_key: &str) -> SceneResult<Option<Velocity>> {
             .map_err(|e| t.error_at(n, "velocity", e.to_string()));
     }
     if forms.is_empty() {
-        if t.has(dir_key) && dir_key != "direction" {
-            return Err(t.error(
+        if let Some(n) = t.get(dir_key) {
+            return Err(t.error_at(
+                n,
                 dir_key,
                 "give the speed too: one of beta, rapidity, one_minus_beta",
             ));

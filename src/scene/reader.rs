@@ -316,6 +316,9 @@ impl<'a> Table<'a> {
         let used = self.used.borrow();
         for (i, (k, n)) in self.entries().iter().enumerate() {
             if !used[i] {
+                if known.contains(&k.as_str()) {
+                    return Err(self.error_at(n, k, "not used with the other keys given here"));
+                }
                 let hint = closest(k, known)
                     .map(|s| format!("; did you mean `{s}`?"))
                     .unwrap_or_else(|| format!("; known keys here: {}", known.join(", ")));
