@@ -47,6 +47,7 @@ pub fn assert_rel(a: f64, b: f64, rel: f64, what: &str) {
 pub fn cases() -> serde_json::Value {
     serde_json::from_str(include_str!("../data/cases.json")).expect("cases.json parses")
 }
+pub mod cli;
 pub mod conformance;
 
 use rest_embree::render::Frame;

@@ -1,0 +1,188 @@
+//! The real binary on colours and on careless input: bad spectra name their line and key, the
+//! switches change the picture, every user error exits 1 with a message that points.
+
+mod common;
+use common::cli::*;
+
+/// Bad spectra, and colours of the wrong kind, name the line and key; nothing is written.
+#[test]
+fn bad_spectra_name_line_and_key() {
+    let colour = "color = [0.8, 0.8, 0.8]";
+    let cases: &[(&str, &str, &str, &[&str])] = &[
+        (
+            "cold",
+            "position = [0, 0, 20]",
+            "position = [0, 0, 20]\ncolor = { blackbody = 0 }",
+            &["scene.toml:17", "light.0.color.blackbody", "above 0"],
+        ),
+        (
+            "negative-scale",
+            "position = [0, 0, 20]",
+            "position = [0, 0, 20]\ncolor = { blackbody = 3000, scale = -1 }",
+            &["scene.toml:17", "light.0.color.scale", "negative"],
+        ),
+        (
+            "fwhm",
+            "position = [0, 0, 20]",
+            "position = [0, 0, 20]\ncolor = { line = 500, fwhm = 0 }",
+            &["scene.toml:17", "light.0.color.fwhm", "above 0"],
+        ),
+        (
+            "unsorted",
+            colour,
+            "color = { wavelengths = [400, 700, 500], values = [0.1, 0.5, 0.9] }",
+            &[
+                "scene.toml:13",
+                "material.white.color.wavelengths",
+                "increase",
+            ],
+        ),
+        (
+            "mismatched",
+            colour,
+            "color = { wavelengths = [400, 700], values = [0.1, 0.5, 0.9] }",
+            &[
+                "scene.toml:13",
+                "material.white.color.values",
+                "3 values for 2",
+            ],
+        ),
+        (
+            "blackbody-reflectance",
+            colour,
+            "color = { blackbody = 5800 }",
+            &[
+                "scene.toml:13",
+                "material.white.color",
+                "reflectance cannot be a blackbody",
+            ],
+        ),
+        (
+            "line-reflectance",
+            colour,
+            "color = { line = 500, fwhm = 20 }",
+            &["scene.toml:13", "material.white.color", "emission line"],
+        ),
+        (
+            "nan",
+            colour,
+            "color = { wavelengths = [400, 700], values = [nan, 0.5] }",
+            &["scene.toml:13", "material.white.color.values", "finite"],
+        ),
+        (
+            "unknown",
+            "position = [0, 0, 20]",
+            "position = [0, 0, 20]\ncolor = { blackbody = 5000, kelvins = 3 }",
+            &["scene.toml:17", "light.0.color.kelvins", "unknown key"],
+        ),
+        (
+            "switch",
+            "[[material]]",
+            "[render]\ndoppler = \"yes\"\n[[material]]",
+            &["scene.toml:12", "render.doppler", "true or false"],
+        ),
+    ];
+    for (name, from, to, needles) in cases {
+        fails(name, &with(from, to), &[], needles);
+    }
+    // And through --set.
+    fails(
+        "set",
+        GOOD,
+        &["--set", "material.white.emission={ blackbody = -5 }"],
+        &["--set", "material.white.emission.blackbody", "above 0"],
+    );
+}
+
+/// Spectra given in the file or with --set render; the switches change the picture.
+#[test]
+fn spectra_and_switches_render() {
+    let d = Dir::new("spectra");
+    let scene = d.file(
+        "scene.toml",
+        &with(
+            "position = [0, 0, 20]",
+            "position = [0, 0, 20]\ncolor = { blackbody = 5800, luminance = 1 }",
+        ),
+    );
+    let mut pixels = Vec::new();
+    for (i, sets) in [
+        vec!["render.doppler=false", "render.searchlight=false"],
+        vec!["render.doppler=true", "render.searchlight=false"],
+        vec!["render.doppler=true", "render.searchlight=true"],
+        vec!["material.white.color={ wavelengths = [380, 780], values = [0.2, 0.9] }"],
+    ]
+    .iter()
+    .enumerate()
+    {
+        let out = d.0.join(format!("out{i}.exr"));
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        let (ok, err) = run(&args);
+        assert!(ok, "{sets:?}: {err}");
+        let (_, _, ch) = rest_embree::output::read_exr_channels(&out).unwrap();
+        let sum: f64 = ["R", "G", "B"]
+            .iter()
+            .map(|c| ch[*c].iter().map(|&v| f64::from(v)).sum::<f64>())
+            .sum();
+        assert!(sum.is_finite() && sum > 0.0, "{sets:?}: {sum}");
+        pixels.push(ch["B"].iter().sum::<f32>() / ch["R"].iter().sum::<f32>());
+    }
+    // The cube recedes sideways (β = 0.5 along x, seen along y): Doppler alone changes its
+    // colour, the searchlight then its brightness but not its colour much.
+    assert!((pixels[0] - pixels[1]).abs() > 0.01, "{pixels:?}");
+}
+
+/// Every user error exits with 1 (argument errors too, where clap's own is 2), help with 0;
+/// numbers are echoed in their shortest form; a frame too large is blamed on the flag that
+/// made it so; a time that is not a finite number is the flag's error.
+#[test]
+fn messages_and_exit_status() {
+    let d = Dir::new("messages");
+    let scene = d.file("scene.toml", GOOD);
+    let out = d.0.join("out.png");
+    let (s, o) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    let (code, err) = status(&["render", "--nonsense"]);
+    assert_eq!(code, Some(1), "{err}");
+    let (code, _) = status(&["--help"]);
+    assert_eq!(code, Some(0));
+    let (code, err) = status(&["render", s, "-o", o, "--time", "nan"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("--time") && err.contains("finite"), "{err}");
+    let (code, err) = status(&["render", s, "-o", o, "--set", "camera.fov_y=1e308"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("(got 1e308)") && !err.contains("00000000"),
+        "{err}"
+    );
+    let (code, err) = status(&[
+        "render", s, "-o", o, "--width", "20000", "--height", "20000",
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--width 20000") && !err.contains("scene.toml"),
+        "{err}"
+    );
+    // A key rejected where it stands says why, and does not suggest itself.
+    let lone = d.file(
+        "lone.toml",
+        &with("velocity = [0.5, 0, 0]", "direction = [1, 0, 0]"),
+    );
+    let (code, err) = status(&["render", lone.to_str().unwrap(), "-o", o]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("group.cube.direction") && err.contains("give the speed too"),
+        "{err}"
+    );
+    assert!(!err.contains("did you mean `direction`"), "{err}");
+    let mut entries = d.entries();
+    entries.sort();
+    assert_eq!(entries, ["lone.toml", "scene.toml"], "nothing written");
+}
