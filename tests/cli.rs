@@ -4,7 +4,6 @@
 mod common;
 use common::cli::*;
 use std::path::Path;
-use std::process::Command;
 
 #[test]
 fn good_scene_writes_png_and_exr_with_the_passes() {
@@ -335,7 +334,7 @@ fn asking_a_build_without_embree_for_embree_is_a_clear_error() {
 #[cfg(feature = "embree")]
 #[test]
 fn embree_is_the_default_backend() {
-    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rest-embree"))
         .arg("backends")
         .output()
         .unwrap();
