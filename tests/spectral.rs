@@ -11,6 +11,16 @@ fn centre(f: &Frame) -> rest_embree::render::PixelValue {
     *f.get(f.width / 2, f.height / 2)
 }
 
+/// The centre pixel of the scene `text` rendered on `backend`.
+fn centre_of(text: &str, backend: &str) -> rest_embree::render::PixelValue {
+    centre(&render_with(&scene(text), backend))
+}
+
+/// The chromaticity of a pixel's linear sRGB.
+fn xy(p: &rest_embree::render::PixelValue) -> (f64, f64) {
+    camera::chromaticity(camera::XYZ_TO_SRGB.inverse() * glam::DVec3::from(rgb(p)))
+}
+
 fn rgb(p: &rest_embree::render::PixelValue) -> [f64; 3] {
     p.color.map(f64::from)
 }
@@ -75,27 +85,15 @@ fn a_moving_blackbody_looks_like_a_blackbody_at_d_t() {
     for backend in backends() {
         for beta in [-0.3f64, 0.3, -0.6] {
             // β < 0: approaching (D > 1); β > 0: receding.
-            let moving = render_with(
-                &scene(&glowing_sphere(&emission(t), rest_x(beta), beta)),
-                backend,
-            );
-            let p = centre(&moving);
+            let p = centre_of(&glowing_sphere(&emission(t), rest_x(beta), beta), backend);
             let d = f64::from(p.doppler);
             let phi = (-beta).atanh();
             assert_rel(d, phi.exp(), 1e-6, "head-on D = e^φ");
-            let still = render_with(
-                &scene(&glowing_sphere(&emission(d * t), 50.0, 0.0)),
-                backend,
-            );
-            same_colour(
-                rgb(&p),
-                rgb(&centre(&still)),
-                0.005,
-                &format!("{backend} β {beta}"),
-            );
+            let still = centre_of(&glowing_sphere(&emission(d * t), 50.0, 0.0), backend);
+            same_colour(rgb(&p), rgb(&still), 0.005, &format!("{backend} β {beta}"));
             // And the shift is real: the colour differs from the blackbody at T.
-            let plain = render_with(&scene(&glowing_sphere(&emission(t), 50.0, 0.0)), backend);
-            let (a, b) = (rgb(&p), rgb(&centre(&plain)));
+            let plain = centre_of(&glowing_sphere(&emission(t), 50.0, 0.0), backend);
+            let (a, b) = (rgb(&p), rgb(&plain));
             assert!(
                 (a[2] / a[0] - b[2] / b[0]).abs() > 0.05,
                 "{backend} β {beta}: no shift"
@@ -110,8 +108,7 @@ fn a_moving_line_is_a_shifted_line() {
     for backend in backends() {
         for beta in [-0.2f64, 0.25] {
             let line = "{ line = 560, fwhm = 60, scale = 0.05 }";
-            let moving = render_with(&scene(&glowing_sphere(line, rest_x(beta), beta)), backend);
-            let p = centre(&moving);
+            let p = centre_of(&glowing_sphere(line, rest_x(beta), beta), backend);
             let d = f64::from(p.doppler);
             let shifted = format!(
                 "{{ line = {:?}, fwhm = {:?}, scale = {:?} }}",
@@ -119,13 +116,8 @@ fn a_moving_line_is_a_shifted_line() {
                 60.0 / d,
                 0.05 * d.powi(4)
             );
-            let still = render_with(&scene(&glowing_sphere(&shifted, 50.0, 0.0)), backend);
-            same_colour(
-                rgb(&p),
-                rgb(&centre(&still)),
-                0.005,
-                &format!("{backend} β {beta}"),
-            );
+            let still = centre_of(&glowing_sphere(&shifted, 50.0, 0.0), backend);
+            same_colour(rgb(&p), rgb(&still), 0.005, &format!("{backend} β {beta}"));
         }
     }
 }
@@ -197,8 +189,7 @@ fn a_plate_approaching_a_light_at_the_camera() {
                 &bb_light("[0, 0, 0]", t, s, false),
                 [1.0, 0.0, 0.0],
             );
-            let a = render_with(&scene(&moving), backend);
-            let p = centre(&a);
+            let p = centre_of(&moving, backend);
             assert_rel(f64::from(p.doppler), phi.exp(), 1e-6, "D_out = e^φ");
             let (d_in, d_out) = (phi.exp(), phi.exp());
             let reference = plate(
@@ -208,18 +199,14 @@ fn a_plate_approaching_a_light_at_the_camera() {
                 &bb_light("[0, 0, 0]", t * d_in * d_out, s / (d_in * d_in), false),
                 [1.0, 0.0, 0.0],
             );
-            let b = render_with(&scene(&reference), backend);
+            let b = centre_of(&reference, backend);
             same_colour(
                 rgb(&p),
-                rgb(&centre(&b)),
+                rgb(&b),
                 0.005,
                 &format!("{backend} head-on β {beta}"),
             );
-            let (x, y) =
-                camera::chromaticity(camera::XYZ_TO_SRGB.inverse() * glam::DVec3::from(rgb(&p)));
-            let (x0, y0) = camera::chromaticity(
-                camera::XYZ_TO_SRGB.inverse() * glam::DVec3::from(rgb(&centre(&b))),
-            );
+            let ((x, y), (x0, y0)) = (xy(&p), xy(&b));
             assert!(
                 (x - x0).abs() < 1e-3 && (y - y0).abs() < 1e-3,
                 "{backend}: chromaticity"
@@ -246,8 +233,7 @@ fn a_plate_passing_sideways_dims_by_gamma_cubed() {
                 &bb_light("[0, 0, 0]", t, s, false),
                 [0.0, 1.0, 0.0],
             );
-            let a = render_with(&scene(&moving), backend);
-            let p = centre(&a);
+            let p = centre_of(&moving, backend);
             assert_rel(f64::from(p.doppler), 1.0 / g, 1e-5, "D_out = 1/γ");
             let reference = plate(
                 [-0.1 / g, d, -0.1],
@@ -256,13 +242,8 @@ fn a_plate_passing_sideways_dims_by_gamma_cubed() {
                 &bb_light("[0, 0, 0]", t, s * g.powi(-3), false),
                 [0.0, 1.0, 0.0],
             );
-            let b = render_with(&scene(&reference), backend);
-            same_colour(
-                rgb(&p),
-                rgb(&centre(&b)),
-                0.005,
-                &format!("{backend} 90° β {beta}"),
-            );
+            let b = centre_of(&reference, backend);
+            same_colour(rgb(&p), rgb(&b), 0.005, &format!("{backend} 90° β {beta}"));
         }
     }
 }
@@ -285,8 +266,7 @@ fn a_light_riding_with_the_plate_shifts_by_d_out_alone() {
                 &bb_light(&light, t, s, true),
                 [1.0, 0.0, 0.0],
             );
-            let a = render_with(&scene(&moving), backend);
-            let p = centre(&a);
+            let p = centre_of(&moving, backend);
             let d_out = f64::from(p.doppler);
             assert_rel(d_out, phi.exp(), 1e-6, "D_out = e^φ");
             let reference = plate(
@@ -296,10 +276,10 @@ fn a_light_riding_with_the_plate_shifts_by_d_out_alone() {
                 &bb_light(&light, t * d_out, s, false),
                 [1.0, 0.0, 0.0],
             );
-            let b = render_with(&scene(&reference), backend);
+            let b = centre_of(&reference, backend);
             same_colour(
                 rgb(&p),
-                rgb(&centre(&b)),
+                rgb(&b),
                 0.005,
                 &format!("{backend} riding β {beta}"),
             );
@@ -318,16 +298,11 @@ fn blackbody_chromaticities_match_the_table() {
     for backend in backends() {
         for row in rows {
             let k = row["T_eff_K"].as_f64().unwrap();
-            let f = render_with(
-                &scene(&glowing_sphere(
-                    &format!("{{ blackbody = {k:?} }}"),
-                    50.0,
-                    0.0,
-                )),
+            let f = centre_of(
+                &glowing_sphere(&format!("{{ blackbody = {k:?} }}"), 50.0, 0.0),
                 backend,
             );
-            let xyz = camera::XYZ_TO_SRGB.inverse() * glam::DVec3::from(rgb(&centre(&f)));
-            let (x, y) = camera::chromaticity(xyz);
+            let (x, y) = xy(&f);
             let (x0, y0) = (row["x"].as_f64().unwrap(), row["y"].as_f64().unwrap());
             assert!(
                 (x - x0).abs() < 0.002 && (y - y0).abs() < 0.002,
@@ -403,21 +378,15 @@ name = "still"
         let g = 1.0 / (1.0 - beta * beta).sqrt();
         // x(t) = 45 − β(t + 50); moving at −β, its rest-frame x' = γ(x + βt) = γ(45 − 50β).
         let rest = g * (45.0 - 50.0 * beta);
-        let a = render_with(&scene(&mirror_scene(-beta, false, rest, t)), backend);
+        let a = centre_of(&mirror_scene(-beta, false, rest, t), backend);
         let d = (beta.atanh()).exp();
-        let b = render_with(&scene(&mirror_scene(0.0, false, 45.0, d * t)), backend);
-        same_colour(
-            rgb(&centre(&a)),
-            rgb(&centre(&b)),
-            0.005,
-            &format!("{backend} still mirror"),
-        );
+        let b = centre_of(&mirror_scene(0.0, false, 45.0, d * t), backend);
+        same_colour(rgb(&a), rgb(&b), 0.005, &format!("{backend} still mirror"));
         // The mirror riding with the sphere (group "moving"), slower and closer, so that the
         // view, aberrated in their frame, still meets the sphere after the mirror: only the
         // mirror's own D_out.
         let (beta, near) = (0.2, 18.0);
-        let c = render_with(&scene(&mirror_scene(-beta, true, near, t)), backend);
-        let p = centre(&c);
+        let p = centre_of(&mirror_scene(-beta, true, near, t), backend);
         assert!(p.object_id == 2, "{backend}: the centre sees the mirror");
         let d_out = f64::from(p.doppler);
         assert!(
@@ -425,13 +394,8 @@ name = "still"
             "{backend}: the mirror moves ({d_out})"
         );
         let ref_scene = mirror_scene(0.0, false, near, d_out * t);
-        let e = render_with(&scene(&ref_scene), backend);
-        same_colour(
-            rgb(&p),
-            rgb(&centre(&e)),
-            0.005,
-            &format!("{backend} riding mirror"),
-        );
+        let e = centre_of(&ref_scene, backend);
+        same_colour(rgb(&p), rgb(&e), 0.005, &format!("{backend} riding mirror"));
     }
 }
 

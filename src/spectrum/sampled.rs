@@ -32,10 +32,6 @@ impl Sampled {
             _ => Sampled(std::array::from_fn(|i| spectrum.at(shift * l[i]))),
         }
     }
-
-    pub fn is_finite(&self) -> bool {
-        self.0.iter().all(|v| v.is_finite())
-    }
 }
 
 // Scaling is the loop of `kernels`, vectorised (the rest is in `render::band`, by reference).

@@ -59,14 +59,10 @@ impl Drop for Dir {
     }
 }
 
+/// Whether the command with these arguments succeeded, and its standard error.
 pub fn run(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
-        .args(args)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!err.contains("panicked"), "the command panicked: {err}");
-    (out.status.success(), err)
+    let (code, err) = status(args);
+    (code == Some(0), err)
 }
 
 /// Render `scene_text` with extra args; expect failure with every `needles` in the message and
