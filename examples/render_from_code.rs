@@ -3,7 +3,7 @@
 //! `cargo run --release --example render_from_code -- out.png`
 
 use rest_embree::spacetime::Velocity;
-use rest_embree::{accel, output, render, scene};
+use rest_embree::{accel, output, scene};
 
 const SCENE: &str = r#"
 [camera]
@@ -31,7 +31,7 @@ fn main() -> rest_embree::Result<()> {
     // The cube passes at 0.8c along x: its geometry stays as given, in its own rest frame.
     scene.groups[0].velocity = Velocity::from_beta(glam::DVec3::X, 0.8).expect("below c");
     let backend = accel::backend_by_name(accel::default_backend_name())?;
-    let (frame, stats) = render::render(&scene, backend.as_ref())?;
+    let (frame, stats) = rest_embree::render(&scene, backend.as_ref(), &Default::default())?;
     output::write(&frame, std::path::Path::new(&path))?;
     println!(
         "{path}: {} primary rays in {:.3} s",

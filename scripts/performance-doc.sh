@@ -41,6 +41,6 @@ same boxes in one group; the 100³ lattice at 1024² within 10 s and 4 GB; the s
 HEAD
 sed -e '1{/^Measured with/d}' "$bench"
 echo
-echo '![run time against error](bench/bench.png)'
+echo '![run time against error](bench/bench.svg)'
 } > docs/performance.md
 echo "performance-doc: wrote docs/performance.md"

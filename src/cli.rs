@@ -11,13 +11,13 @@ use std::process::ExitCode;
     version = env!("REST_EMBREE_LONG_VERSION"),
     about = "Special-relativistic ray tracer (REST-frame algorithm)"
 )]
-pub struct Cli {
+pub(crate) struct Cli {
     #[command(subcommand)]
     pub command: Command,
 }
 
 #[derive(Subcommand, Debug)]
-pub enum Command {
+pub(crate) enum Command {
     /// Render a scene file to an EXR (linear, with passes) or PNG (sRGB) image.
     Render(RenderArgs),
     /// Measure each backend's speed and error on the same scenes (default: the paper's lattice).
@@ -27,7 +27,7 @@ pub enum Command {
 }
 
 #[derive(clap::Args, Debug)]
-pub struct BenchArgs {
+pub(crate) struct BenchArgs {
     /// Measure this scene file instead of the fixed suite (the paper's lattice at four speeds,
     /// a 100^3 lattice, 1 to 10,000 velocity groups, merging).
     pub scene: Option<PathBuf>,
@@ -51,13 +51,13 @@ pub struct BenchArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Where to write bench.md, bench.csv and bench.png.
+    /// Where to write bench.md, bench.csv and bench.svg.
     #[arg(long, default_value = "bench-out")]
     pub out: PathBuf,
 }
 
 #[derive(clap::Args, Debug)]
-pub struct RenderArgs {
+pub(crate) struct RenderArgs {
     /// The scene file (TOML).
     pub scene: PathBuf,
     /// Output image; the format follows the extension (.exr or .png).
@@ -122,9 +122,16 @@ fn finite(text: &str) -> Result<f64, String> {
     }
 }
 
-/// Parse the command line: help and version print and exit 0; every other argument error
-/// prints and exits 1, like every other user error.
-pub fn parse() -> Result<Cli, ExitCode> {
+/// The `rest-embree` command: parse the command line and run it. Help and version print and
+/// exit 0; every argument error, like every other user error, prints and exits 1.
+pub fn main() -> ExitCode {
+    match parse() {
+        Ok(cli) => run(cli),
+        Err(code) => code,
+    }
+}
+
+fn parse() -> Result<Cli, ExitCode> {
     Cli::try_parse().map_err(|e| {
         let _ = e.print();
         if e.use_stderr() {
@@ -135,7 +142,7 @@ pub fn parse() -> Result<Cli, ExitCode> {
     })
 }
 
-pub fn run(cli: Cli) -> ExitCode {
+fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Backends => {
             for (i, name) in accel::backend_names().iter().enumerate() {
@@ -271,9 +278,9 @@ fn run_bench(args: &BenchArgs) -> crate::Result<()> {
     };
     write("bench.md", &md)?;
     write("bench.csv", &bench::csv(&rows))?;
-    bench::plot_png(&rows, &args.out.join("bench.png"))?;
+    bench::plot_svg(&rows, &args.out.join("bench.svg"))?;
     eprintln!(
-        "bench: wrote bench.md, bench.csv and bench.png to {}",
+        "bench: wrote bench.md, bench.csv and bench.svg to {}",
         args.out.display()
     );
     Ok(())
@@ -295,7 +302,14 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         output::Format::Exr => render::Passes::All,
         output::Format::Png => render::Passes::Colour,
     };
-    let (frame, stats) = render::render_passes(&scene, backend.as_ref(), passes)?;
+    let (frame, stats) = render::render(
+        &scene,
+        backend.as_ref(),
+        &render::RenderOptions {
+            passes,
+            ..Default::default()
+        },
+    )?;
     if stats.nonfinite_pixels > 0 {
         eprintln!(
             "warning: {} pixels came out NaN or infinite and were set to black; please report this scene",

@@ -5,8 +5,10 @@
 use crate::output::srgb_encode;
 use crate::render::Frame;
 
+/// How two renders of one scene differ.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Comparison {
+    /// Pixels compared.
     pub pixels: usize,
     /// Pixels where some 8-bit sRGB channel differs by more than 1.
     pub differing: usize,
@@ -17,6 +19,7 @@ pub struct Comparison {
 }
 
 impl Comparison {
+    /// The share of pixels that differ (`differing / pixels`).
     pub fn differing_share(&self) -> f64 {
         self.differing as f64 / self.pixels.max(1) as f64
     }
@@ -49,6 +52,7 @@ fn is_edge(f: &Frame, x: u32, y: u32) -> bool {
     false
 }
 
+/// Compare two frames of the same size pixel by pixel.
 pub fn compare(a: &Frame, b: &Frame) -> Comparison {
     assert_eq!(
         (a.width, a.height),

@@ -12,13 +12,21 @@ pub enum Error {
     /// The scene description: file and line (or the flag that set the value), key, what.
     Scene(SceneError),
     /// A command-line flag's value.
-    Flag { flag: String, message: String },
+    Flag {
+        /// The flag as typed, e.g. `--backend`.
+        flag: String,
+        /// What is wrong with its value.
+        message: String,
+    },
     /// A backend could not be had, built or used (an unknown name, Embree's own messages).
     Backend(String),
     /// An image file could not be written or read (the message names the file).
     Image {
+        /// The file.
         path: PathBuf,
+        /// What went wrong with it.
         message: String,
+        /// The underlying error, if any.
         source: Option<Cause>,
     },
 }

@@ -1,9 +1,17 @@
+#![warn(missing_docs)]
 //! rest-embree: a special-relativistic ray tracer after Hsiung & Dunn's REST-frame algorithm.
 //!
-//! Module map: [`spacetime`] (f64 kinematics) → [`scene`] (file format, validation, procedural
-//! objects) → [`geometry`] + [`accel`] (static rest-frame intersection, backends by name) →
-//! [`render`] (past light-cone rays, per-group boost and merge, Whitted shading) → [`output`]
-//! (EXR, PNG). [`cli`] is the command line.
+//! As a library: load a scene ([`scene::load_file`], [`scene::load_str`]), change it in code if
+//! need be, [`render()`] it on a backend ([`accel::backend_by_name`]) and write the frame
+//! ([`output::write`]); `examples/render_from_code.rs` does exactly that.
+//!
+//! Module map: [`spacetime`] (f64 kinematics) → [`scene`] (file format, validation) →
+//! [`geometry`] + [`accel`] (static rest-frame intersection; the [`accel::Backend`] trait is
+//! where a new acceleration structure plugs in) → [`mod@render`] (past light-cone rays,
+//! per-group boost and merge, shading) → [`output`] (EXR, PNG). [`spectrum`] is light as
+//! spectra; [`compare`] tells how two frames differ; [`cli`] is the command line and
+//! [`mod@bench`] its measurements. The renderer's internals are private to the crate, and tested
+//! inside it (src/tests/); docs/architecture.md walks through them.
 
 pub mod accel;
 pub mod bench;
@@ -19,3 +27,10 @@ pub mod spacetime;
 pub mod spectrum;
 
 pub use error::{Cause, Error, Result};
+pub use render::{render, RenderOptions};
+
+// The helpers shared with tests/ name the crate `rest_embree`, as the integration tests do.
+#[cfg(test)]
+extern crate self as rest_embree;
+#[cfg(test)]
+mod tests;

@@ -1,6 +1,3 @@
 fn main() -> std::process::ExitCode {
-    match rest_embree::cli::parse() {
-        Ok(cli) => rest_embree::cli::run(cli),
-        Err(code) => code,
-    }
+    rest_embree::cli::main()
 }

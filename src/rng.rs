@@ -3,9 +3,14 @@
 
 use glam::DVec3;
 
-pub struct Rng(pub u64);
+/// A splitmix64 generator.
+pub struct Rng(
+    /// The state: any value is a seed.
+    pub u64,
+);
 
 impl Rng {
+    /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;

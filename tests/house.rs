@@ -4,22 +4,32 @@
 
 use std::path::{Path, PathBuf};
 
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+fn files_ending(dir: &Path, exts: &[&str], out: &mut Vec<PathBuf>) {
+    if dir.is_file() {
+        out.push(dir.to_path_buf());
+        return;
+    }
     for e in std::fs::read_dir(dir).unwrap() {
         let p = e.unwrap().path();
         if p.is_dir() {
-            rust_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
+            files_ending(&p, exts, out);
+        } else if p.extension().is_some_and(|x| exts.iter().any(|e| x == *e)) {
             out.push(p);
         }
     }
 }
 
+/// The Rust files under `dirs`, with their text.
 fn sources(dirs: &[&str]) -> Vec<(PathBuf, String)> {
+    files_of(dirs, &["rs"])
+}
+
+/// The files under `dirs` (or the files `dirs` names) ending in one of `exts`, with their text.
+fn files_of(dirs: &[&str], exts: &[&str]) -> Vec<(PathBuf, String)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = Vec::new();
     for d in dirs {
-        rust_files(&root.join(d), &mut files);
+        files_ending(&root.join(d), exts, &mut files);
     }
     files
         .into_iter()
@@ -65,7 +75,16 @@ fn embree_is_called_through_its_layer_only() {
 
 #[test]
 fn nothing_cites_files_outside_the_repository() {
-    for (path, text) in sources(&["src", "tests"]) {
+    let places = [
+        "src",
+        "tests",
+        "examples",
+        "docs",
+        "scripts",
+        "README.md",
+        "Makefile",
+    ];
+    for (path, text) in files_of(&places, &["rs", "md", "sh", "py", "toml"]) {
         if path.ends_with("tests/house.rs") {
             continue;
         }

@@ -206,7 +206,8 @@ fn rendering_is_reproducible_with_samples() {
 /// bit, leaves the passes empty, and with several samples traces no ray for them.
 #[test]
 fn colour_only_renders_skip_the_passes() {
-    use rest_embree::render::{render_world_passes, Passes, World};
+    use rest_embree::render::Passes;
+    use rest_embree::RenderOptions;
     let text = scene_text(
         "position = [0, -3, 0]\ndirection = [0, 1, 0]",
         DVec3::new(0.8, 0.0, 0.0),
@@ -219,9 +220,15 @@ fn colour_only_renders_skip_the_passes() {
         ));
         for backend in backends() {
             let b = rest_embree::accel::backend_by_name(backend).unwrap();
-            let world = World::build(&s, b.as_ref()).unwrap();
-            let (all, all_stats) = render_world_passes(&s, &world, Passes::All);
-            let (colour, colour_stats) = render_world_passes(&s, &world, Passes::Colour);
+            let render = |passes| {
+                let options = RenderOptions {
+                    passes,
+                    ..Default::default()
+                };
+                rest_embree::render(&s, b.as_ref(), &options).unwrap()
+            };
+            let (all, all_stats) = render(Passes::All);
+            let (colour, colour_stats) = render(Passes::Colour);
             assert!(all
                 .pixels
                 .iter()

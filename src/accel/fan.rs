@@ -17,9 +17,11 @@ pub struct Fan<'a> {
     pub to_rest: &'a Boost,
     /// The imaging event's position in the group's rest frame, where every ray starts.
     pub origin: DVec3,
-    /// The lanes' image points, pixels right of and above the image centre; `n` lanes in use.
+    /// The lanes' image points, pixels right of the image centre.
     pub u: [f64; PACKET],
+    /// The lanes' image points, pixels above the image centre.
     pub v: [f64; PACKET],
+    /// How many lanes are in use (the first `n`).
     pub n: usize,
 }
 
@@ -30,10 +32,15 @@ pub const NO_HIT: u32 = u32::MAX;
 /// direction, the rest-frame direction (unnormalised, of length `s`, the lookback factor) and
 /// the closest hit for lookback in (0, ∞): `t` and the primitive (NO_HIT for none).
 pub struct FanHits {
+    /// World-frame unit looking direction, by axis then lane.
     pub look: [[f64; PACKET]; 3],
+    /// Rest-frame direction (unnormalised), by axis then lane.
     pub dir: [[f64; PACKET]; 3],
+    /// The lookback factor, the length of `dir`.
     pub s: [f64; PACKET],
+    /// Lookback time of the closest hit.
     pub t: [f64; PACKET],
+    /// The primitive hit, or [`NO_HIT`].
     pub prim: [u32; PACKET],
 }
 

@@ -15,10 +15,10 @@ mod bvh32;
 mod embree;
 mod fan;
 
-pub use bvh::{Bvh, BvhBackend};
-pub use bvh32::Bvh32Backend;
+pub(crate) use bvh::BvhBackend;
+pub(crate) use bvh32::Bvh32Backend;
 #[cfg(feature = "embree")]
-pub use embree::{BareRay, EmbreeAccel, EmbreeBackend};
+pub(crate) use embree::{BareRay, EmbreeAccel, EmbreeBackend};
 pub use fan::{Fan, FanHits, NO_HIT};
 
 use crate::geometry::{Aabb, BoxTree, Geometry, LightBuffer};
@@ -29,9 +29,13 @@ use std::sync::Arc;
 /// inactive (masked) and must be skipped.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
+    /// Where the ray starts.
     pub origin: DVec3,
+    /// Its direction, unnormalised (its length is the lookback factor).
     pub dir: DVec3,
+    /// The search interval's open lower end.
     pub tmin: f64,
+    /// The search interval's open upper end.
     pub tmax: f64,
     /// |dir|, for backends that trace along the unit direction (Embree): where the ray comes
     /// from a boost it is the lookback factor the boost found with the direction (the spatial
@@ -51,6 +55,7 @@ impl Ray {
         }
     }
 
+    /// Whether the ray is to be traced (`tmin ≤ tmax`, not masked).
     pub fn is_active(&self) -> bool {
         self.tmin <= self.tmax
     }
@@ -59,7 +64,9 @@ impl Ray {
 /// The closest hit of a ray: its parameter and the primitive's index in the group geometry.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
+    /// The ray parameter of the hit: the world-frame lookback time.
     pub t: f64,
+    /// The index of the primitive hit in its group's [`Geometry::prims`].
     pub prim: u32,
 }
 
@@ -104,7 +111,9 @@ impl<A: Accelerator + ?Sized> Accelerator for Arc<A> {
 
 /// Builds accelerators; one per kind of backend.
 pub trait Backend: Send + Sync {
+    /// The name `--backend` selects it by.
     fn name(&self) -> &'static str;
+    /// An accelerator over one group's rest-frame geometry.
     fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>>;
     /// What builds culling structures over boxes (the trees over many velocity groups), also
     /// later, on first use; by default the f64 box tree.
@@ -121,6 +130,7 @@ pub type CullerFactory = Arc<dyn Fn(&[Aabb]) -> crate::Result<Box<dyn BoxCuller>
 /// tests an item exactly and returns the ray's new tmax; one below the ray's tmin ends the ray.
 /// Every item whose box a ray meets before its tmax is visited (rounding may add others).
 pub trait BoxCuller: Send + Sync {
+    /// Traverse the packet, visiting every item a ray meets as described above.
     fn traverse_packet(
         &self,
         o: DVec3,
@@ -169,7 +179,7 @@ impl BoxCuller for LightBuffer {
 
 /// Light buffers around `origin` as culling structures (for rays from it, as shadow rays read
 /// backwards from a light are), on every backend.
-pub fn light_buffers(origin: DVec3) -> CullerFactory {
+pub(crate) fn light_buffers(origin: DVec3) -> CullerFactory {
     Arc::new(move |boxes| Ok(Box::new(LightBuffer::build(origin, boxes)) as Box<dyn BoxCuller>))
 }
 
@@ -182,6 +192,7 @@ pub fn backend_names() -> Vec<&'static str> {
     }
 }
 
+/// The backend `render` uses when none is named: Embree where built, else the f64 BVH.
 pub fn default_backend_name() -> &'static str {
     backend_names()[0]
 }
@@ -189,7 +200,7 @@ pub fn default_backend_name() -> &'static str {
 /// The Embree backend of that name: `embree` picks 16- or 8-wide packets from the CPU;
 /// `embree-16`, `embree-8` and `embree-single` fix the width, for comparisons.
 #[cfg(feature = "embree")]
-pub fn embree_backend(name: &str) -> Option<EmbreeBackend> {
+pub(crate) fn embree_backend(name: &str) -> Option<EmbreeBackend> {
     match name {
         "embree" => Some(EmbreeBackend::new()),
         "embree-16" => Some(EmbreeBackend::with_packet_width(16)),

@@ -11,9 +11,10 @@
 
 mod memory;
 mod plot;
+pub mod probe;
 mod suite;
 
-pub use suite::{bars_as_groups, cases, many_groups, paper, PAPER_SCENES};
+pub(crate) use suite::{cases, many_groups, paper};
 
 use crate::accel::backend_by_name;
 use crate::compare::{compare, Comparison};
@@ -25,7 +26,7 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 /// A case of the suite, built only when it is run.
-pub struct LazyCase {
+pub(crate) struct LazyCase {
     pub name: String,
     make: Box<dyn Fn() -> Result<Case, crate::scene::SceneError>>,
 }
@@ -57,7 +58,7 @@ impl LazyCase {
     }
 }
 
-pub struct Case {
+pub(crate) struct Case {
     pub name: String,
     pub scene: Scene,
     pub settings: Vec<String>,
@@ -104,7 +105,7 @@ impl Case {
 }
 
 #[derive(Clone, Debug)]
-pub struct Row {
+pub(crate) struct Row {
     pub case: String,
     pub setting: String,
     pub spp: u32,
@@ -129,7 +130,7 @@ pub struct Row {
 
 /// What the case's other scene costs beside a row (`beside`).
 #[derive(Clone, Debug)]
-pub struct Beside {
+pub(crate) struct Beside {
     /// What the other scene is.
     pub what: String,
     pub build_s: f64,
@@ -144,7 +145,7 @@ impl Row {
 }
 
 /// What a setting may switch off or leave out, beside its backend's name: each word is one.
-pub const SETTING_WORDS: [(&str, &str); 5] = [
+pub(crate) const SETTING_WORDS: [(&str, &str); 5] = [
     ("no-cull", "bounds and screen culling"),
     ("no-tree", "the trees over many groups"),
     ("no-merge", "merging groups of one velocity"),
@@ -154,7 +155,7 @@ pub const SETTING_WORDS: [(&str, &str); 5] = [
 
 /// A setting: a backend name, then any of [`SETTING_WORDS`]; an unknown word is an error, so a
 /// misspelt setting is never measured as another under its name.
-pub fn parse_setting(setting: &str) -> crate::Result<(&str, WorldOptions, Passes)> {
+pub(crate) fn parse_setting(setting: &str) -> crate::Result<(&str, WorldOptions, Passes)> {
     let mut o = WorldOptions::default();
     let mut passes = Passes::All;
     let mut parts = setting.split_whitespace();
@@ -313,7 +314,7 @@ fn beside(
 /// one group traced through an accelerator): bare Embree measured beside the layer on the same
 /// structure.
 #[cfg(feature = "embree")]
-pub fn world_and_accel(
+pub(crate) fn world_and_accel(
     scene: &Scene,
     name: &str,
     options: WorldOptions,
@@ -357,7 +358,7 @@ pub fn world_and_accel(
 /// The scene's primary rays (pixel centres, tile by tile) in the rest frame of the world's one
 /// group, as bare f32 rays for `accel`.
 #[cfg(feature = "embree")]
-pub fn bare_rays(
+pub(crate) fn bare_rays(
     scene: &Scene,
     world: &World,
     accel: &crate::accel::EmbreeAccel,
@@ -415,7 +416,7 @@ fn bare_embree(_: &Case, _: usize) -> crate::Result<Option<(u64, f64, f64)>> {
 }
 
 /// Run the cases; settings whose backend is not in this build are left out.
-pub fn run(
+pub(crate) fn run(
     cases: &[LazyCase],
     repeat: usize,
     mut progress: impl FnMut(&str),
@@ -496,7 +497,7 @@ fn opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
 }
 
 /// The rows as a Markdown table, with the derived ratios the issue asks for.
-pub fn table(rows: &[Row]) -> String {
+pub(crate) fn table(rows: &[Row]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -529,7 +530,7 @@ pub fn table(rows: &[Row]) -> String {
 }
 
 /// The headline ratios, computed from the rows.
-pub fn summary(rows: &[Row]) -> String {
+pub(crate) fn summary(rows: &[Row]) -> String {
     let mut s = String::new();
     let find = |case: &str, setting: &str| {
         rows.iter()
@@ -621,30 +622,49 @@ pub fn summary(rows: &[Row]) -> String {
     s
 }
 
-pub fn csv(rows: &[Row]) -> String {
-    let mut s = String::from(
-        "case,setting,spp,width,height,primitives,groups,build_s,primary_rays,primary_s,mrays_per_s,render_s,first_render_s,peak_mib,differing_share_same_spp,rms_same_spp,differing_share_16spp,rms_16spp\n",
-    );
+pub(crate) fn csv(rows: &[Row]) -> String {
+    const HEADER: [&str; 18] = [
+        "case",
+        "setting",
+        "spp",
+        "width",
+        "height",
+        "primitives",
+        "groups",
+        "build_s",
+        "primary_rays",
+        "primary_s",
+        "mrays_per_s",
+        "render_s",
+        "first_render_s",
+        "peak_mib",
+        "differing_share_same_spp",
+        "rms_same_spp",
+        "differing_share_16spp",
+        "rms_16spp",
+    ];
+    let c = |x: Option<f64>| {
+        x.filter(|v| v.is_finite())
+            .map(|v| format!("{v:.6e}"))
+            .unwrap_or_default()
+    };
+    // The csv crate quotes what needs quoting (a scene's name may hold commas or quotes).
+    let mut w = ::csv::Writer::from_writer(Vec::new());
+    let mut write = |record: &[String]| w.write_record(record).expect("writing to memory");
+    write(&HEADER.map(String::from));
     for r in rows {
-        let c = |x: Option<f64>| {
-            x.filter(|v| v.is_finite())
-                .map(|v| format!("{v:.6e}"))
-                .unwrap_or_default()
-        };
-        let _ = writeln!(
-            s,
-            "\"{}\",\"{}\",{},{},{},{},{},{:.6},{},{:.6},{:.4},{},{},{},{},{},{},{}",
-            r.case,
-            r.setting,
-            r.spp,
-            r.width,
-            r.height,
-            r.primitives,
-            r.groups,
-            r.build_s,
-            r.primary_rays,
-            r.primary_s,
-            r.mrays_per_s(),
+        write(&[
+            r.case.clone(),
+            r.setting.clone(),
+            r.spp.to_string(),
+            r.width.to_string(),
+            r.height.to_string(),
+            r.primitives.to_string(),
+            r.groups.to_string(),
+            format!("{:.6}", r.build_s),
+            r.primary_rays.to_string(),
+            format!("{:.6}", r.primary_s),
+            format!("{:.4}", r.mrays_per_s()),
             c(Some(r.render_s)),
             c(Some(r.first_render_s)),
             c(r.peak_mib),
@@ -652,9 +672,45 @@ pub fn csv(rows: &[Row]) -> String {
             c(r.vs_same.as_ref().map(|x| x.rms)),
             c(r.vs_hi.as_ref().map(|x| x.differing_share())),
             c(r.vs_hi.as_ref().map(|x| x.rms)),
-        );
+        ]);
     }
-    s
+    String::from_utf8(w.into_inner().expect("writing to memory")).expect("UTF-8 in, UTF-8 out")
 }
 
-pub use plot::plot_png;
+pub(crate) use plot::plot_svg;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scene's name may hold commas and quotes: the CSV keeps every field whole.
+    #[test]
+    fn csv_fields_survive_commas_and_quotes() {
+        let row = Row {
+            case: r#"my "scene", at 0.9"#.into(),
+            setting: "embree".into(),
+            spp: 1,
+            width: 64,
+            height: 32,
+            primitives: 7,
+            groups: 2,
+            build_s: 0.5,
+            primary_rays: 2048,
+            primary_s: 0.25,
+            render_s: 1.0,
+            first_render_s: 1.5,
+            peak_mib: None,
+            vs_same: None,
+            vs_hi: None,
+            beside: None,
+        };
+        let text = csv(&[row]);
+        let mut reader = ::csv::Reader::from_reader(text.as_bytes());
+        let header = reader.headers().unwrap().clone();
+        let record = reader.records().next().unwrap().unwrap();
+        assert_eq!(header.len(), record.len());
+        assert_eq!(&record[0], r#"my "scene", at 0.9"#);
+        assert_eq!(&record[13], "", "no peak memory measured: an empty field");
+        assert_eq!(&record[8], "2048");
+    }
+}

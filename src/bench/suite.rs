@@ -6,7 +6,7 @@ use crate::scene::{load_str, SceneError};
 use std::fmt::Write as _;
 
 /// The paper's scenes, built into the binary so the benchmark runs from any directory.
-pub const PAPER_SCENES: [(&str, &str); 3] = [
+pub(crate) const PAPER_SCENES: [(&str, &str); 3] = [
     (
         "calibration_cube",
         include_str!("../../scenes/calibration_cube.toml"),
@@ -16,7 +16,7 @@ pub const PAPER_SCENES: [(&str, &str); 3] = [
 ];
 
 /// A paper scene with overrides.
-pub fn paper(name: &str, sets: &[String]) -> Result<crate::scene::Scene, SceneError> {
+pub(crate) fn paper(name: &str, sets: &[String]) -> Result<crate::scene::Scene, SceneError> {
     let (_, text) = PAPER_SCENES
         .iter()
         .find(|(n, _)| *n == name)
@@ -36,7 +36,7 @@ fn sets(list: &[&str]) -> Vec<String> {
 /// (|β| ≤ 0.8), or (`one_group`) all in one group at rest: the same geometry either way. Both
 /// render in RGB (no Doppler shift or searchlight), so that the comparison measures what many
 /// groups cost, not what spectra cost (the spectral case measures that).
-pub fn many_groups(
+pub(crate) fn many_groups(
     n: usize,
     one_group: bool,
     size: u32,
@@ -85,7 +85,7 @@ pub fn many_groups(
 }
 
 /// The 11 × 11 bars, each bar its own group, all at one velocity (merging makes them one).
-pub fn bars_as_groups(beta: f64) -> Result<crate::scene::Scene, SceneError> {
+pub(crate) fn bars_as_groups(beta: f64) -> Result<crate::scene::Scene, SceneError> {
     let base = PAPER_SCENES[1].1;
     let head = &base[..base.find("[[group]]").expect("bar_array.toml has a group")];
     let mut s = head.replace("group = \"bars\"\n", "").to_string();
@@ -119,7 +119,7 @@ const LATTICE_SETTINGS: [&str; 7] = [
 
 /// The fixed suite, each case built only when it runs (so a row's peak memory is its own).
 /// `quick` shrinks images and scenes for a fast look (CI-sized).
-pub fn cases(quick: bool) -> Vec<LazyCase> {
+pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
     let px: u32 = if quick { 128 } else { 512 };
     fn size(w: u32) -> Vec<String> {
         vec![

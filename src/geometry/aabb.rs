@@ -17,7 +17,9 @@ fn upper(a: DVec3, b: DVec3) -> DVec3 {
 /// An axis-aligned bounding box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// The least corner.
     pub min: DVec3,
+    /// The greatest corner.
     pub max: DVec3,
 }
 
@@ -28,19 +30,23 @@ impl Default for Aabb {
 }
 
 impl Aabb {
+    /// The empty box: the identity of [`Aabb::union`].
     pub const EMPTY: Aabb = Aabb {
         min: DVec3::splat(f64::INFINITY),
         max: DVec3::splat(f64::NEG_INFINITY),
     };
 
+    /// The box between two corners.
     pub fn new(min: DVec3, max: DVec3) -> Self {
         Self { min, max }
     }
 
+    /// Whether it holds no point (min > max on some axis).
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
     }
 
+    /// The smallest box holding both.
     pub fn union(&self, o: &Aabb) -> Aabb {
         Aabb::new(lower(self.min, o.min), upper(self.max, o.max))
     }
@@ -50,6 +56,7 @@ impl Aabb {
         self.min.cmple(o.max).all() && o.min.cmple(self.max).all()
     }
 
+    /// Grow to hold `p`.
     pub fn grow(&mut self, p: DVec3) {
         self.min = lower(self.min, p);
         self.max = upper(self.max, p);
@@ -66,14 +73,17 @@ impl Aabb {
         })
     }
 
+    /// The centre.
     pub fn centroid(&self) -> DVec3 {
         0.5 * (self.min + self.max)
     }
 
+    /// The edge lengths.
     pub fn extent(&self) -> DVec3 {
         (self.max - self.min).max(DVec3::ZERO)
     }
 
+    /// The length of the diagonal (0 for an empty box).
     pub fn diagonal(&self) -> f64 {
         if self.is_empty() {
             0.0
@@ -82,6 +92,7 @@ impl Aabb {
         }
     }
 
+    /// The surface area (0 for an empty box).
     pub fn surface_area(&self) -> f64 {
         if self.is_empty() {
             return 0.0;

@@ -255,10 +255,13 @@ impl LightBuffer {
     }
 
     /// How many boxes it holds.
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.boxes.len()
     }
 
+    /// Whether it holds no box.
+    #[cfg(test)]
     pub fn is_empty(&self) -> bool {
         self.boxes.is_empty()
     }

@@ -10,8 +10,8 @@ mod primitive;
 mod real;
 
 pub use aabb::Aabb;
-pub use box_tree::{walk, BoxTree, TreeNode, PACKET};
-pub use light_buffer::LightBuffer;
+pub(crate) use box_tree::{walk, BoxTree, TreeNode, PACKET};
+pub(crate) use light_buffer::LightBuffer;
 #[cfg(feature = "embree")]
 pub(crate) use primitive::{ball_crossings, capsule_hit, cuboid_hit, cylinder_crossings, AxisRod};
 pub use primitive::{Geometry, Part, Primitive};

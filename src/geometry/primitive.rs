@@ -6,25 +6,55 @@ use glam::{DVec3, Vec3Swizzles};
 /// caps).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Primitive {
-    Sphere { center: DVec3, radius: f64 },
-    Capsule { a: DVec3, b: DVec3, radius: f64 },
-    Cuboid { min: DVec3, max: DVec3 },
-    Triangle { v: [DVec3; 3] },
+    /// A sphere.
+    Sphere {
+        /// Its centre.
+        center: DVec3,
+        /// Its radius.
+        radius: f64,
+    },
+    /// A rod: the points within `radius` of the segment from `a` to `b`.
+    Capsule {
+        /// One end of the axis.
+        a: DVec3,
+        /// The other end of the axis.
+        b: DVec3,
+        /// The radius.
+        radius: f64,
+    },
+    /// An axis-aligned box.
+    Cuboid {
+        /// The least corner.
+        min: DVec3,
+        /// The greatest corner.
+        max: DVec3,
+    },
+    /// A triangle (two-sided).
+    Triangle {
+        /// Its corners, counter-clockwise seen from the front.
+        v: [DVec3; 3],
+    },
 }
 
 /// A run of primitives that came from one scene object, with one material.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Part {
+    /// The first primitive of the run.
     pub start: u32,
+    /// One past the last primitive of the run.
     pub end: u32,
+    /// The scene object (index into [`Scene::objects`](crate::scene::Scene::objects)).
     pub object: u32,
+    /// The material (index into [`Scene::materials`](crate::scene::Scene::materials)).
     pub material: u32,
 }
 
 /// The static geometry of one velocity group, in its rest frame.
 #[derive(Clone, Debug, Default)]
 pub struct Geometry {
+    /// The primitives.
     pub prims: Vec<Primitive>,
+    /// The runs of primitives, in order, covering every primitive.
     pub parts: Vec<Part>,
 }
 
@@ -55,12 +85,14 @@ impl Geometry {
         &self.parts[i]
     }
 
+    /// The box holding every primitive.
     pub fn bounds(&self) -> Aabb {
         self.prims
             .iter()
             .fold(Aabb::EMPTY, |b, p| b.union(&p.bounds()))
     }
 
+    /// Whether it holds no primitive.
     pub fn is_empty(&self) -> bool {
         self.prims.is_empty()
     }
@@ -141,6 +173,7 @@ impl Primitive {
         }
     }
 
+    /// Its bounding box.
     pub fn bounds(&self) -> Aabb {
         match *self {
             Primitive::Sphere { center, radius } => {

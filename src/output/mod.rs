@@ -8,9 +8,12 @@ use crate::render::Frame;
 use crate::{Cause, Error};
 use std::path::{Path, PathBuf};
 
+/// An image format, chosen by the output file's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
+    /// OpenEXR: every pass, linear, 32-bit float.
     Exr,
+    /// PNG: colour and alpha, sRGB-encoded, 8 bits.
     Png,
 }
 

@@ -12,8 +12,7 @@ use std::ops::Mul;
 
 /// Light along a ray: in a frame whose wavelengths are `shift` times the camera's. Large bands
 /// are combined in place and by reference (a spectrum is 64 numbers).
-pub trait Band: Copy + Mul<f64, Output = Self> {
-    const ZERO: Self;
+pub(crate) trait Band: Copy + Mul<f64, Output = Self> {
     /// A frame's shift as this band reads colours with it (prepared once per frame).
     type At: Copy;
     /// The frame whose wavelengths are `shift` times the camera's.
@@ -40,7 +39,6 @@ pub trait Band: Copy + Mul<f64, Output = Self> {
 }
 
 impl Band for DVec3 {
-    const ZERO: Self = DVec3::ZERO;
     type At = ();
     fn at(_shift: f64) {}
     fn of(c: &Colour, _: ()) -> Self {
@@ -74,7 +72,6 @@ impl Band for DVec3 {
 }
 
 impl Band for Sampled {
-    const ZERO: Self = Sampled::ZERO;
     type At = Shift;
     fn at(shift: f64) -> Shift {
         Shift::new(shift)

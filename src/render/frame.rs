@@ -1,7 +1,9 @@
 /// One pixel's values.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelValue {
+    /// Linear sRGB colour.
     pub color: [f32; 3],
+    /// Coverage: the share of the pixel's samples that hit a surface.
     pub alpha: f32,
     /// World-frame lookback time of the primary hit (0 where nothing was hit).
     pub lookback: f32,
@@ -22,12 +24,16 @@ pub struct PixelValue {
 /// The rendered image and its extra passes, row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// The pixels, row by row from the top.
     pub pixels: Vec<PixelValue>,
 }
 
 impl Frame {
+    /// A frame of empty pixels.
     pub fn new(width: u32, height: u32) -> Self {
         Self {
             width,
@@ -36,6 +42,7 @@ impl Frame {
         }
     }
 
+    /// The pixel at column `x`, row `y` from the top.
     pub fn get(&self, x: u32, y: u32) -> &PixelValue {
         &self.pixels[(y * self.width + x) as usize]
     }

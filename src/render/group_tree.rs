@@ -144,6 +144,7 @@ fn half(c: f64, k: f64, t0: &mut f64, t1: &mut f64) {
 impl GroupTree {
     /// `groups`: each group's rest-frame bounds and velocity; `t_ref`: the reference time
     /// (the view time keeps the numbers small near the imaging event).
+    #[cfg(test)]
     pub fn build(groups: &[(Aabb, Velocity)], t_ref: f64) -> GroupTree {
         Self::build_for(groups, t_ref, None)
     }

@@ -14,14 +14,21 @@ mod shade;
 mod tile;
 mod world;
 
-pub use apparent_tree::{apparent_box, ApparentTree};
-pub use band::{needs_spectra, Band, Seen};
-pub use camera::CameraRays;
+pub use band::needs_spectra;
 pub use frame::{Frame, PixelValue, CHANNELS};
-pub use group_tree::{world_box, GroupTree, SlicedGroupTree};
-pub use light_tree::{reach_box, LightTree};
-pub use screen_cull::ScreenCull;
-pub use world::{PrimaryHits, SurfaceHit, World, WorldOptions, GROUP_TREE_MIN};
+pub use world::WorldOptions;
+
+pub(crate) use band::Seen;
+pub(crate) use camera::CameraRays;
+pub(crate) use screen_cull::ScreenCull;
+pub(crate) use world::World;
+// What the tests of the internals reach (src/tests/).
+#[cfg(test)]
+pub(crate) use {
+    apparent_tree::apparent_box,
+    group_tree::{world_box, GroupTree, SlicedGroupTree},
+    light_tree::{reach_box, LightTree},
+};
 
 use crate::accel::Backend;
 use crate::scene::Scene;
@@ -30,13 +37,16 @@ use glam::DVec3;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
-pub const TILE: u32 = 16;
+pub(crate) const TILE: u32 = 16;
 
 /// What a render did, for the command's report and the benchmarks.
 #[derive(Clone, Debug, Default)]
 pub struct RenderStats {
+    /// Building the acceleration structures.
     pub build_time: Duration,
+    /// Tracing and shading every pixel.
     pub trace_time: Duration,
+    /// Primary rays traced (samples, and with several, the passes' centre rays).
     pub primary_rays: u64,
     /// Pixels whose colour came out NaN or infinite and were replaced by black (a bug if > 0).
     pub nonfinite_pixels: u64,
@@ -54,22 +64,38 @@ pub enum Passes {
     Colour,
 }
 
-/// Build the acceleration structures with `backend` and render the scene, with every pass.
-pub fn render(scene: &Scene, backend: &dyn Backend) -> crate::Result<(Frame, RenderStats)> {
-    render_passes(scene, backend, Passes::All)
+/// How to render: which passes to fill in, and what the renderer may skip or fuse.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderOptions {
+    /// What to fill in besides colour and alpha.
+    pub passes: Passes,
+    /// The renderer's skips and fusions; each leaves the picture the same (the tests and the
+    /// bench switch them off to prove it and to measure them).
+    pub world: WorldOptions,
 }
 
-/// As [`render`], filling in only `passes`.
-pub fn render_passes(
+impl Default for RenderOptions {
+    /// Every pass, every skip.
+    fn default() -> Self {
+        Self {
+            passes: Passes::All,
+            world: WorldOptions::default(),
+        }
+    }
+}
+
+/// Render `scene`: build one acceleration structure per velocity group with `backend`, then
+/// trace every pixel. The one entry point of the library (see `examples/render_from_code.rs`).
+pub fn render(
     scene: &Scene,
     backend: &dyn Backend,
-    passes: Passes,
+    options: &RenderOptions,
 ) -> crate::Result<(Frame, RenderStats)> {
     let t0 = Instant::now();
-    let world = World::build(scene, backend)?;
+    let world = World::build_with(scene, backend, options.world)?;
     let build_time = t0.elapsed();
     let t1 = Instant::now();
-    let (frame, mut stats) = render_world_passes(scene, &world, passes);
+    let (frame, mut stats) = render_world_passes(scene, &world, options.passes);
     stats.build_time = build_time;
     stats.trace_time = t1.elapsed();
     Ok((frame, stats))
@@ -85,7 +111,7 @@ fn tiles(scene: &Scene) -> Vec<(u32, u32)> {
 
 /// Trace every primary ray of the image through the world without shading (the benchmark's
 /// measure of intersection throughput); returns (rays, hits).
-pub fn trace_primary(scene: &Scene, world: &World) -> (u64, u64) {
+pub(crate) fn trace_primary(scene: &Scene, world: &World) -> (u64, u64) {
     let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
     let cull = ScreenCull::new(world, &cam);
     tiles(scene)
@@ -98,7 +124,8 @@ pub fn trace_primary(scene: &Scene, world: &World) -> (u64, u64) {
 
 /// Every pixel-centre primary ray, tile by tile in the order the renderer traces them (for the
 /// benchmark's bare-Embree baseline).
-pub fn primary_rays_by_tile(scene: &Scene) -> Vec<Vec<crate::spacetime::NullRay>> {
+#[cfg(feature = "embree")]
+pub(crate) fn primary_rays_by_tile(scene: &Scene) -> Vec<Vec<crate::spacetime::NullRay>> {
     let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
     let (w, h) = scene.image.frame_size();
     tiles(scene)
@@ -119,12 +146,16 @@ pub fn primary_rays_by_tile(scene: &Scene) -> Vec<Vec<crate::spacetime::NullRay>
 
 /// Render with acceleration structures already built. Each band of TILE rows is rendered tile
 /// by tile straight into its rows of the frame (no second copy of the image in flight).
-pub fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
+pub(crate) fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
     render_world_passes(scene, world, Passes::All)
 }
 
 /// As [`render_world`], filling in only `passes`.
-pub fn render_world_passes(scene: &Scene, world: &World, passes: Passes) -> (Frame, RenderStats) {
+pub(crate) fn render_world_passes(
+    scene: &Scene,
+    world: &World,
+    passes: Passes,
+) -> (Frame, RenderStats) {
     let (w, h) = scene.image.frame_size();
     let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
     let cull = ScreenCull::new(world, &cam);

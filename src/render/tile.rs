@@ -63,6 +63,7 @@ fn image_points(
 }
 
 /// The primary rays of `coords` (see `image_points`).
+#[cfg(feature = "embree")]
 pub fn primary_rays(
     cam: &CameraRays,
     coords: &[(u32, u32)],

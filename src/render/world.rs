@@ -42,7 +42,9 @@ fn corner_distance(b: &Aabb, p: DVec3) -> f64 {
     (b.min - p).abs().max((b.max - p).abs()).length()
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// What the renderer may skip or fuse. Each switch leaves the picture the same; the tests and
+/// the bench turn them off to prove it and to measure what they save.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct WorldOptions {
     /// Merge groups with the same velocity into one rest-frame scene.
     pub merge_equal_velocities: bool,
@@ -319,7 +321,7 @@ impl World {
         // from the imaging event (secondary rays reach further back).
         let apparent: Vec<Aabb> = items
             .iter()
-            .map(|(b, v)| super::apparent_box(b, v, event))
+            .map(|(b, v)| super::apparent_tree::apparent_box(b, v, event))
             .collect();
         let deepest = apparent
             .iter()
@@ -360,11 +362,8 @@ impl World {
         Ok((kinetic, primary, lights))
     }
 
-    /// The imaging event (world frame), where every primary ray starts.
-    pub fn event(&self) -> crate::spacetime::Event {
-        self.event
-    }
-
+    /// Whether the kinetic group tree is in use (the tests check when it is).
+    #[cfg(test)]
     pub fn uses_group_tree(&self) -> bool {
         self.tree.is_some()
     }

@@ -4,12 +4,16 @@ use std::fmt;
 /// set the value), which key, and what is wrong.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneError {
+    /// `file:line`, or the flag that set the value.
     pub at: String,
+    /// The key, dotted from the table (empty where the error is about no key).
     pub key: String,
+    /// What is wrong, and where it helps, what would be right.
     pub message: String,
 }
 
 impl SceneError {
+    /// An error at `at`, on `key`.
     pub fn new(at: impl Into<String>, key: impl Into<String>, message: impl Into<String>) -> Self {
         Self {
             at: at.into(),

@@ -564,7 +564,7 @@ fn add_object(
                 .get("vertices")
                 .ok_or_else(|| t.error("vertices", "missing: give [[x, y, z], ...]"))?;
             let verts = match &vn.val {
-                super::Val::Array(items) => items
+                super::doc::Val::Array(items) => items
                     .iter()
                     .map(|e| {
                         t.numbers_of(e, "vertices", Some(3))
@@ -577,7 +577,7 @@ fn add_object(
                 .get("indices")
                 .ok_or_else(|| t.error("indices", "missing: give [[i, j, k], ...]"))?;
             let tris = match &inn.val {
-                super::Val::Array(items) => items
+                super::doc::Val::Array(items) => items
                     .iter()
                     .map(|e| {
                         let v = t.numbers_of(e, "indices", Some(3))?;

@@ -9,10 +9,8 @@ mod model;
 mod procedural;
 mod reader;
 
-pub use doc::{Doc, Node, Origin, Val};
 pub use error::SceneError;
 pub use load::{load_file, load_str};
 pub use model::{
     Camera, Group, ImageSettings, Light, Material, ObjectInfo, Projection, RenderSettings, Scene,
 };
-pub use procedural::{bar_array, lattice, BarArray, Lattice};

@@ -8,9 +8,15 @@ use std::sync::Arc;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Projection {
     /// Pinhole with a vertical field of view (radians).
-    Pinhole { fov_y: f64 },
+    Pinhole {
+        /// The vertical field of view, radians.
+        fov_y: f64,
+    },
     /// Parallel rays from an image plane that is simultaneous in the camera frame (Scott & Viner).
-    Orthographic { view_height: f64 },
+    Orthographic {
+        /// The image plane's height, scene units.
+        view_height: f64,
+    },
     /// The whole sky: longitude across, latitude down, the look direction at the centre.
     Equirectangular,
 }
@@ -19,25 +25,37 @@ pub enum Projection {
 /// own rest frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
+    /// Where the imaging event is (world frame).
     pub position: DVec3,
+    /// When the imaging event is (world time).
     pub time: f64,
+    /// The unit look direction (camera rest frame).
     pub forward: DVec3,
+    /// The unit direction of the image's +x (camera rest frame).
     pub right: DVec3,
+    /// The unit direction of the image's up (camera rest frame).
     pub up: DVec3,
+    /// How directions map to pixels.
     pub projection: Projection,
+    /// The camera's velocity in the world frame.
     pub velocity: Velocity,
 }
 
 impl Camera {
+    /// The event of the exposure (world frame), where every primary ray starts.
     pub fn imaging_event(&self) -> Event {
         Event::new(self.time, self.position)
     }
 }
 
+/// The image: its size, samples, background and crop.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImageSettings {
+    /// Width of the full image, pixels.
     pub width: u32,
+    /// Height of the full image, pixels.
     pub height: u32,
+    /// Samples per pixel (stratified).
     pub samples: u32,
     /// What a ray that meets nothing sees: radiance of a sky at rest in the world frame.
     pub background: Colour,
@@ -58,6 +76,7 @@ impl ImageSettings {
     }
 }
 
+/// How light is followed: bounces, ambient light, and which relativistic effects on light apply.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     /// Reflection/refraction bounces after the primary hit.
@@ -82,20 +101,26 @@ impl RenderSettings {
 /// A rest-frame surface description: Phong plus Whitted mirror and dielectric terms.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
+    /// The name objects refer to it by.
     pub name: String,
     /// Diffuse reflectance.
     pub color: Colour,
     /// Phong highlight's reflectance.
     pub specular: Colour,
+    /// The Phong exponent.
     pub shininess: f64,
+    /// The share of light mirrored (Whitted).
     pub reflect: f64,
+    /// The share of light refracted (Whitted).
     pub transmit: f64,
+    /// The index of refraction, for `transmit`.
     pub ior: f64,
     /// Radiance emitted in the surface's rest frame (the surface then reflects nothing).
     pub emission: Option<Colour>,
 }
 
 impl Material {
+    /// The material of objects that name none: grey 0.8 diffuse.
     pub fn default_white() -> Material {
         Material {
             name: "default".into(),
@@ -114,35 +139,52 @@ impl Material {
 /// frame's coordinates (whose origin passes through the world origin at world time 0).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Light {
+    /// Where it is, in its own rest frame.
     pub position: DVec3,
     /// Radiant intensity in the light's rest frame: its colour times its intensity.
     pub radiance: Colour,
+    /// Its velocity in the world frame.
     pub velocity: Velocity,
+    /// Whether its irradiance falls off as 1/r² (else it is constant, as in the paper).
     pub inverse_square: bool,
 }
 
 /// Objects sharing one uniform velocity; geometry in their rest frame.
 #[derive(Clone, Debug)]
 pub struct Group {
+    /// The name `--set group.NAME.…` refers to it by.
     pub name: String,
+    /// The velocity all its objects share (world frame).
     pub velocity: Velocity,
+    /// Its primitives, in its rest frame.
     pub geometry: Arc<Geometry>,
 }
 
+/// A `[[group.object]]` of the scene, for naming what a pixel sees.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ObjectInfo {
+    /// Its `name`, where it has one.
     pub name: Option<String>,
+    /// Its `type` (`sphere`, `box`, `lattice`, …).
     pub kind: String,
+    /// The index of its group in [`Scene::groups`].
     pub group: usize,
 }
 
+/// A loaded scene (see docs/scene-format.md): what a render needs, validated.
 #[derive(Clone, Debug)]
 pub struct Scene {
+    /// The camera and its imaging event.
     pub camera: Camera,
+    /// The image.
     pub image: ImageSettings,
+    /// How light is followed.
     pub render: RenderSettings,
+    /// The materials, by index.
     pub materials: Vec<Material>,
+    /// The point lights.
     pub lights: Vec<Light>,
+    /// The velocity groups.
     pub groups: Vec<Group>,
     /// Every `[[group.object]]` in file order; `object_id` in the output is index + 1.
     pub objects: Vec<ObjectInfo>,
@@ -166,6 +208,7 @@ impl Scene {
         s
     }
 
+    /// How many primitives all groups hold.
     pub fn primitive_count(&self) -> usize {
         self.groups.iter().map(|g| g.geometry.prims.len()).sum()
     }

@@ -110,11 +110,3 @@ impl BarArray {
         })
     }
 }
-
-pub fn lattice(l: &Lattice) -> impl Iterator<Item = Primitive> + '_ {
-    l.spheres().chain(l.rods())
-}
-
-pub fn bar_array(b: &BarArray) -> impl Iterator<Item = Primitive> + '_ {
-    b.bars()
-}

@@ -17,6 +17,7 @@ pub struct Boost {
 }
 
 impl Boost {
+    /// The boost that changes nothing.
     pub const IDENTITY: Boost = Boost {
         axis: DVec3::ZERO,
         e_pos: 1.0,
@@ -47,6 +48,7 @@ impl Boost {
         Self::to_rest(&v.reversed())
     }
 
+    /// The boost back (into the frame this one starts from).
     pub fn inverse(&self) -> Boost {
         if self.identity {
             return *self;

@@ -4,16 +4,20 @@ use std::ops::{Add, Sub};
 /// A spacetime event `(t, x)` in some inertial frame (c = 1).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Event {
+    /// Time.
     pub t: f64,
+    /// Position.
     pub x: DVec3,
 }
 
 impl Event {
+    /// The event (0, 0).
     pub const ORIGIN: Event = Event {
         t: 0.0,
         x: DVec3::ZERO,
     };
 
+    /// The event at time `t`, position `x`.
     pub fn new(t: f64, x: DVec3) -> Self {
         Self { t, x }
     }

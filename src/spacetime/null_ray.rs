@@ -6,15 +6,19 @@ use glam::DVec3;
 /// direction the light travels.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NullRay {
+    /// Where the ray starts looking back from (the imaging event, for a primary ray).
     pub origin: Event,
+    /// The unit looking direction.
     pub dir: DVec3,
 }
 
 impl NullRay {
+    /// The ray from `origin` looking along `dir` (unit).
     pub fn new(origin: Event, dir: DVec3) -> Self {
         Self { origin, dir }
     }
 
+    /// The event at lookback time `lambda`.
     pub fn at(&self, lambda: f64) -> Event {
         Event::new(self.origin.t - lambda, self.origin.x + lambda * self.dir)
     }

@@ -10,12 +10,18 @@ pub struct Velocity {
     rapidity: f64,
 }
 
+/// Why a velocity cannot be had.
 #[derive(Clone, Debug, PartialEq)]
 pub enum VelocityError {
+    /// A component is NaN or infinite.
     NotFinite,
+    /// The speed (given) is 1 or more.
     NotBelowLight(f64),
+    /// A speed, rapidity or 1 − β (named) is negative.
     Negative(&'static str, f64),
+    /// The direction given is the zero vector.
     ZeroDirection,
+    /// 1 − β (given) is outside (0, 1].
     OneMinusBetaRange(f64),
 }
 
@@ -37,6 +43,7 @@ impl fmt::Display for VelocityError {
 }
 
 impl Velocity {
+    /// At rest.
     pub const ZERO: Velocity = Velocity {
         dir: DVec3::ZERO,
         rapidity: 0.0,
@@ -114,6 +121,7 @@ impl Velocity {
         Self::from_rapidity(direction, phi)
     }
 
+    /// Whether it is at rest.
     pub fn is_zero(&self) -> bool {
         self.rapidity == 0.0
     }
@@ -121,18 +129,23 @@ impl Velocity {
     pub fn direction(&self) -> DVec3 {
         self.dir
     }
+    /// The rapidity φ = artanh β.
     pub fn rapidity(&self) -> f64 {
         self.rapidity
     }
+    /// The speed β = tanh φ (units of c).
     pub fn beta(&self) -> f64 {
         self.rapidity.tanh()
     }
+    /// The velocity β·direction (units of c).
     pub fn beta_vec(&self) -> DVec3 {
         self.dir * self.beta()
     }
+    /// The Lorentz factor γ = cosh φ.
     pub fn gamma(&self) -> f64 {
         self.rapidity.cosh()
     }
+    /// γβ = sinh φ, exact for speeds near c.
     pub fn gamma_beta(&self) -> f64 {
         self.rapidity.sinh()
     }

@@ -1,7 +1,7 @@
 //! The camera's spectral response: CIE 1931 2° colour matching to XYZ, then linear sRGB
 //! (IEC 61966-2-1 primaries, D65 white, no chromatic adaptation).
 //!
-//! The camera reads radiance at [`SAMPLES`] fixed wavelengths, the geometric centres of bins of
+//! The camera reads radiance at `SAMPLES` (64) fixed wavelengths, the geometric centres of bins of
 //! equal width in ln λ over 380-780 nm (so a Doppler shift, a factor on every wavelength, moves
 //! them all by the same distance in ln λ); bin i weighs by the integral of x̄, ȳ, z̄ over the bin
 //! (trapezoids on the 1 nm table). Radiance that is constant over each bin is integrated

@@ -6,7 +6,7 @@
 //! view) together with the RGB it has at rest ([`Colour`]). The renderer follows a fixed set of
 //! camera-frame wavelengths ([`camera::wavelengths`]) back along each path: in a frame whose
 //! wavelengths are `shift` times the camera's, a spectrum is read at `shift · λ_i`
-//! ([`Sampled::of`]). The camera turns the radiance at its wavelengths into CIE XYZ and linear
+//! (`Sampled::of`). The camera turns the radiance at its wavelengths into CIE XYZ and linear
 //! sRGB ([`camera`]). See docs/physics.md, "Light and colour".
 
 pub mod camera;
@@ -16,7 +16,7 @@ mod sampled;
 mod table;
 mod uplift;
 
-pub use sampled::{Sampled, SAMPLES};
+pub(crate) use sampled::{Sampled, SAMPLES};
 
 use glam::DVec3;
 use std::sync::Arc;
@@ -29,7 +29,7 @@ const C2: f64 = 1.438_776_877_503_933_8e-2;
 /// A frame's wavelengths over the camera's, with its logarithm (what a log-wavelength table
 /// needs), computed once for all the colours read in that frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Shift {
+pub(crate) struct Shift {
     pub factor: f64,
     pub ln: f64,
 }
@@ -50,19 +50,43 @@ pub enum Spectrum {
     Flat(f64),
     /// `scale · σ(c₀x² + c₁x + c₂)`, x = (λ − 380)/400 held in [0, 1] (constant outside the
     /// visible band): a smooth reflectance uplifted from RGB (Jakob & Hanika 2019).
-    Sigmoid { coeffs: [f64; 3], scale: f64 },
+    Sigmoid {
+        /// c₀, c₁, c₂.
+        coeffs: [f64; 3],
+        /// The scale (1 for RGB in [0, 1]).
+        scale: f64,
+    },
     /// `scale · σ(…) · W(λ)`: an RGB emitter, the sigmoid times the camera's white
     /// ([`camera::white`]), so that RGB (1, 1, 1) is exactly the white.
-    Illuminant { coeffs: [f64; 3], scale: f64 },
+    Illuminant {
+        /// c₀, c₁, c₂.
+        coeffs: [f64; 3],
+        /// The scale.
+        scale: f64,
+    },
     /// Planck's law at `kelvin`, in W·sr⁻¹·m⁻²·nm⁻¹, times `scale`.
-    Blackbody { kelvin: f64, scale: f64 },
+    Blackbody {
+        /// The temperature, K.
+        kelvin: f64,
+        /// The scale.
+        scale: f64,
+    },
     /// A Gaussian line at `centre` nm with full width at half maximum `fwhm` nm whose integral
     /// over wavelength is `scale`.
-    Line { centre: f64, fwhm: f64, scale: f64 },
+    Line {
+        /// The centre wavelength, nm.
+        centre: f64,
+        /// The full width at half maximum, nm.
+        fwhm: f64,
+        /// The integral over wavelength.
+        scale: f64,
+    },
     /// Linear interpolation in a table (wavelengths strictly increasing), held at the end
     /// values beyond the first and last wavelength.
     Tabulated {
+        /// The wavelengths, nm, strictly increasing.
         wavelengths: Arc<[f64]>,
+        /// The values at those wavelengths.
         values: Arc<[f64]>,
     },
 }
@@ -136,7 +160,9 @@ impl Spectrum {
 /// and an RGB emitter is a multiple of the camera's white.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Role {
+    /// A reflectance (diffuse or specular colour): RGB in [0, 1] gives a spectrum in [0, 1].
     Reflectance,
+    /// An emitter (emission, light, background, ambient): RGB gives a multiple of the white.
     Emitter,
 }
 
@@ -144,7 +170,9 @@ pub enum Role {
 /// renderer uses, and exactly the RGB given where the colour was given as RGB).
 #[derive(Clone, Debug)]
 pub struct Colour {
+    /// Linear sRGB at rest.
     pub rgb: DVec3,
+    /// The spectrum.
     pub spectrum: Spectrum,
     /// Whether it was given as RGB (a scene of RGB colours only, all at rest relative to each
     /// other, needs no spectral rendering).
@@ -179,7 +207,7 @@ impl Colour {
     }
 
     /// The colour at the camera's wavelengths times `shift`.
-    pub fn sampled(&self, shift: Shift) -> Sampled {
+    pub(crate) fn sampled(&self, shift: Shift) -> Sampled {
         match &self.table {
             Some(t) => t.sample(shift, &self.spectrum),
             None => Sampled::of(&self.spectrum, shift.factor),

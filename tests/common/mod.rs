@@ -1,69 +1,21 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-/// The crate's deterministic generator (splitmix64), for property tests.
-pub use rest_embree::rng::Rng;
-
-/// Two renders of one picture: at most `max_id_share` of the pixels see another object, and
-/// where they see the same one the colours differ by at most `max_color`.
-pub fn same_picture(a: &Frame, b: &Frame, what: &str, max_id_share: f64, max_color: f32) {
-    let ids = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .filter(|(p, q)| p.object_id != q.object_id)
-        .count();
-    let share = ids as f64 / a.pixels.len() as f64;
-    assert!(
-        share <= max_id_share,
-        "{what}: {ids} pixels see another object"
-    );
-    let mut worst = 0.0f32;
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        if p.object_id == q.object_id {
-            for k in 0..3 {
-                worst = worst.max((p.color[k] - q.color[k]).abs());
-            }
-        }
-    }
-    assert!(worst <= max_color, "{what}: colour differs by {worst}");
-}
-
-pub fn assert_close(a: f64, b: f64, tol: f64, what: &str) {
-    assert!(
-        (a - b).abs() <= tol,
-        "{what}: got {a}, expected {b} (tolerance {tol})"
-    );
-}
-
-pub fn assert_rel(a: f64, b: f64, rel: f64, what: &str) {
-    assert!(
-        ((a - b) / b).abs() <= rel,
-        "{what}: got {a}, expected {b} (relative tolerance {rel})"
-    );
-}
-
-/// The worked cases of docs/physics.md §2-§4 (tests/data/cases.json; its "source" says where they come from).
-pub fn cases() -> serde_json::Value {
-    serde_json::from_str(include_str!("../data/cases.json")).expect("cases.json parses")
-}
+mod basics;
 pub mod cli;
 pub mod conformance;
+pub use basics::*;
 
 use rest_embree::render::Frame;
 use rest_embree::scene::Scene;
-
-pub fn scene(toml: &str) -> Scene {
-    rest_embree::scene::load_str("test.toml", toml, &[]).unwrap_or_else(|e| panic!("scene: {e}"))
-}
 
 /// Render on `backend`. Groups of a few primitives are normally intersected directly in f64,
 /// whatever the backend; here only the f64 BVH keeps that path, so tests on Embree trace every
 /// group through Embree.
 pub fn render_with(scene: &Scene, backend: &str) -> Frame {
-    use rest_embree::render::{render_world, World, WorldOptions};
+    use rest_embree::render::{RenderOptions, WorldOptions};
     let b = rest_embree::accel::backend_by_name(backend).unwrap();
-    let options = WorldOptions {
+    let world = WorldOptions {
         direct_max: if backend == "bvh" {
             WorldOptions::default().direct_max
         } else {
@@ -71,15 +23,13 @@ pub fn render_with(scene: &Scene, backend: &str) -> Frame {
         },
         ..Default::default()
     };
-    let world = World::build_with(scene, b.as_ref(), options).unwrap();
-    let (frame, stats) = render_world(scene, &world);
+    let options = RenderOptions {
+        world,
+        ..Default::default()
+    };
+    let (frame, stats) = rest_embree::render(scene, b.as_ref(), &options).unwrap();
     assert_eq!(stats.nonfinite_pixels, 0, "no NaN or infinite pixel");
     frame
-}
-
-/// The backends of this build (every render test runs on each).
-pub fn backends() -> Vec<&'static str> {
-    rest_embree::accel::backend_names()
 }
 
 /// The vertical field of view, in degrees, that gives focal length `f` pixels at `height`.

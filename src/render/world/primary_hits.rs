@@ -30,6 +30,7 @@ impl World {
     }
 
     /// Whether `primary_hits` hands the primary rays through `cam` to the backend as fans.
+    #[cfg(all(test, feature = "embree"))]
     pub fn serves_fans(&self, cam: &CameraRays) -> bool {
         self.fan_group(cam).is_some()
     }
@@ -121,10 +122,6 @@ pub struct PrimaryHits {
 impl PrimaryHits {
     pub fn len(&self) -> usize {
         self.len
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
     }
 
     fn lane(&self, i: usize) -> (&FanHits, usize) {

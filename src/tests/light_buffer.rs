@@ -2,10 +2,9 @@
 //! light: every box a ray from the light meets in its interval is offered, once, nearest
 //! boxes first; rays from elsewhere still find every box.
 
-mod common;
-use common::Rng;
+use super::common::Rng;
+use crate::geometry::{Aabb, LightBuffer};
 use glam::DVec3;
-use rest_embree::geometry::{Aabb, LightBuffer};
 
 /// Boxes of every kind around the light at `o`: small and far, large, straddling the planes
 /// through the light that part the cube's faces, flat ones, and some that hold the light.

@@ -1,11 +1,10 @@
 //! Shadow rays of a tile are traced together (packets per group): `World::occluded_many` must
 //! answer exactly as `World::occluded` ray by ray, on every backend, with few groups and many.
 
-mod common;
-use common::*;
+use super::common::*;
+use crate::render::World;
+use crate::spacetime::{Event, NullRay};
 use glam::DVec3;
-use rest_embree::render::World;
-use rest_embree::spacetime::{Event, NullRay};
 
 fn scene_text(groups: usize) -> String {
     let mut r = Rng(5);
@@ -44,7 +43,7 @@ fn batched_shadow_rays_equal_single_ones() {
     for groups in [1, 3, 40] {
         let s = scene(&scene_text(groups));
         for name in backends() {
-            let backend = rest_embree::accel::backend_by_name(name).unwrap();
+            let backend = crate::accel::backend_by_name(name).unwrap();
             let world = World::build(&s, backend.as_ref()).unwrap();
             let mut r = Rng(9);
             let rays: Vec<NullRay> = (0..3000)

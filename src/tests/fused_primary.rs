@@ -4,12 +4,10 @@
 
 #![cfg(feature = "embree")]
 
-mod common;
-
-use rest_embree::accel::backend_by_name;
-use rest_embree::bench::paper;
-use rest_embree::render::{render_world, trace_primary, CameraRays, Frame, World, WorldOptions};
-use rest_embree::scene::Scene;
+use crate::accel::backend_by_name;
+use crate::bench::paper;
+use crate::render::{render_world, trace_primary, CameraRays, Frame, World, WorldOptions};
+use crate::scene::Scene;
 
 fn lattice(sets: &[&str]) -> Scene {
     let mut all = vec!["image.width=96", "image.height=80", "image.samples=1"];
@@ -155,7 +153,7 @@ fn one_group(objects: &[String]) -> Scene {
     for o in objects {
         text += &format!("[[group.object]]\n{o}\n");
     }
-    rest_embree::scene::load_str("one_group.toml", &text, &[]).unwrap()
+    crate::scene::load_str("one_group.toml", &text, &[]).unwrap()
 }
 
 #[test]
@@ -203,7 +201,7 @@ fn every_way_the_backend_reads_hits_back() {
             let world = World::build(&scene, backend_by_name(name).unwrap().as_ref()).unwrap();
             render_world(&scene, &world).0
         };
-        common::same_picture(&frame("embree"), &frame("bvh"), what, 0.001, 1e-4);
+        super::common::same_picture(&frame("embree"), &frame("bvh"), what, 0.001, 1e-4);
         let world = World::build(&scene, backend_by_name("embree").unwrap().as_ref()).unwrap();
         let (rays, hits) = trace_primary(&scene, &world);
         assert!(

@@ -1,12 +1,11 @@
 //! Many velocity groups: the kinetic group tree finds every group a ray can meet (never fewer),
 //! and renders with and without it, or with equal velocities merged or not, are identical.
 
-mod common;
-use common::*;
+use super::common::*;
+use crate::geometry::Aabb;
+use crate::render::{render_world, Frame, GroupTree, SlicedGroupTree, World, WorldOptions};
+use crate::spacetime::{Boost, Event, NullRay, Velocity};
 use glam::DVec3;
-use rest_embree::geometry::Aabb;
-use rest_embree::render::{render_world, Frame, GroupTree, SlicedGroupTree, World, WorldOptions};
-use rest_embree::spacetime::{Boost, Event, NullRay, Velocity};
 
 /// Exact: whether the ray meets a group's bounds in lookback (0, tmax), tested in the group's
 /// rest frame against its rest-frame bounds.
@@ -146,7 +145,7 @@ position = [0, -20, 30]
 fn group_tree_and_merging_do_not_change_the_picture() {
     let s = scene(&many_groups_scene(200));
     for name in backends() {
-        let backend = rest_embree::accel::backend_by_name(name).unwrap();
+        let backend = crate::accel::backend_by_name(name).unwrap();
         let plain = World::build_with(
             &s,
             backend.as_ref(),
@@ -190,8 +189,8 @@ fn group_tree_and_merging_do_not_change_the_picture() {
 
 #[test]
 fn apparent_boxes_hold_every_apparent_position() {
-    use rest_embree::render::apparent_box;
-    use rest_embree::spacetime::retarded_position;
+    use crate::render::apparent_box;
+    use crate::spacetime::retarded_position;
     let mut r = Rng(5);
     for _ in 0..400 {
         let c = DVec3::new(
@@ -211,7 +210,7 @@ fn apparent_boxes_hold_every_apparent_position() {
             ),
         );
         let b = apparent_box(&rest, &v, event);
-        let now = rest_embree::render::world_box(&rest, &v, event.t);
+        let now = crate::render::world_box(&rest, &v, event.t);
         // Points of the body (lab-simultaneous at the view time) and where they are seen.
         for _ in 0..50 {
             let p = now.min + (now.max - now.min) * DVec3::new(r.f(), r.f(), r.f());
@@ -246,7 +245,7 @@ fn random_group(r: &mut Rng, spread: f64) -> (Aabb, Velocity) {
 
 #[test]
 fn reach_boxes_hold_every_point_light_from_the_slice_meets() {
-    use rest_embree::render::reach_box;
+    use crate::render::reach_box;
     let mut r = Rng(17);
     let mut checked = 0;
     for _ in 0..400 {
@@ -306,7 +305,7 @@ fn shadow_origin(r: &mut Rng, event: Event, on_cone: f64) -> Event {
 
 #[test]
 fn light_tree_visits_every_group_a_shadow_ray_meets() {
-    use rest_embree::render::LightTree;
+    use crate::render::LightTree;
     let mut r = Rng(23);
     let groups: Vec<(Aabb, Velocity)> = (0..500).map(|_| random_group(&mut r, 50.0)).collect();
     let light = DVec3::new(10.0, -70.0, 30.0);
@@ -330,8 +329,8 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
     });
     for (name, event, on_cone, slices, min_served) in cases {
         let cullers = match name {
-            "light-buffer" => rest_embree::accel::light_buffers(light),
-            _ => rest_embree::accel::backend_by_name(name).unwrap().cullers(),
+            "light-buffer" => crate::accel::light_buffers(light),
+            _ => crate::accel::backend_by_name(name).unwrap().cullers(),
         };
         let tree = LightTree::new(
             groups.clone().into(),
@@ -447,7 +446,7 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
 
 #[test]
 fn refitted_trees_bound_their_new_boxes() {
-    use rest_embree::geometry::BoxTree;
+    use crate::geometry::BoxTree;
     let mut r = Rng(29);
     let boxes: Vec<Aabb> = (0..300).map(|_| random_group(&mut r, 40.0).0).collect();
     let tree = BoxTree::build(&boxes);
@@ -482,12 +481,8 @@ fn refitted_trees_bound_their_new_boxes() {
 
 /// The scene rendered on `backend` without the group trees and with them (the picture they
 /// must not change), equal velocities merged or not as `merge` says.
-fn without_and_with_trees(
-    s: &rest_embree::scene::Scene,
-    backend: &str,
-    merge: bool,
-) -> (Frame, Frame) {
-    let backend = rest_embree::accel::backend_by_name(backend).unwrap();
+fn without_and_with_trees(s: &crate::scene::Scene, backend: &str, merge: bool) -> (Frame, Frame) {
+    let backend = crate::accel::backend_by_name(backend).unwrap();
     let options = |group_tree| WorldOptions {
         merge_equal_velocities: merge,
         group_tree,
@@ -606,7 +601,7 @@ fn the_moving_bounds_test_turns_away_no_hit() {
     // turned a ray away from a group it meets would change which object a pixel sees.
     let s = scene(&many_groups_scene(200));
     for name in backends() {
-        let backend = rest_embree::accel::backend_by_name(name).unwrap();
+        let backend = crate::accel::backend_by_name(name).unwrap();
         let culled = World::build(&s, backend.as_ref()).unwrap();
         let plain = World::build_with(
             &s,

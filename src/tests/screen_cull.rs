@@ -3,9 +3,9 @@
 //! in a block it keeps, every block it keeps lies in a tile it keeps, and renders with and
 //! without bounds culling agree.
 
-use rest_embree::bench::paper;
-use rest_embree::render::{render_world, CameraRays, ScreenCull, World, WorldOptions, TILE};
-use rest_embree::scene::Scene;
+use crate::bench::paper;
+use crate::render::{render_world, CameraRays, ScreenCull, World, WorldOptions, TILE};
+use crate::scene::Scene;
 
 fn scenes() -> Vec<(String, Scene)> {
     let mut out = Vec::new();
@@ -82,7 +82,7 @@ fn scenes() -> Vec<(String, Scene)> {
         .concat(),
     )
     .unwrap()
-    .translated(rest_embree::spacetime::Event::new(
+    .translated(crate::spacetime::Event::new(
         1e6,
         glam::DVec3::new(-1e6, 3e5, 1e6),
     ));
@@ -106,7 +106,7 @@ fn scenes() -> Vec<(String, Scene)> {
 
 #[test]
 fn every_pixel_that_sees_a_group_is_kept() {
-    let backend = rest_embree::accel::backend_by_name("bvh").unwrap();
+    let backend = crate::accel::backend_by_name("bvh").unwrap();
     let (mut culled_somewhere, mut whole_tiles) = (false, false);
     for (name, s) in scenes() {
         let cam = CameraRays::new(&s.camera, s.image.width, s.image.height);

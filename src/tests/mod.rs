@@ -1,0 +1,12 @@
+//! Tests of the renderer's internals: the group and light trees, the culls, the fans of primary
+//! rays, batched shadow rays. The integration tests in tests/ use the public API alone; these
+//! reach what the crate keeps to itself.
+
+#[path = "../../tests/common/basics.rs"]
+mod common;
+
+mod fused_primary;
+mod light_buffer;
+mod many_groups;
+mod screen_cull;
+mod shadow_batches;

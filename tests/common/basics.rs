@@ -1,0 +1,66 @@
+//! The helpers the integration tests (tests/) and the tests of the crate's internals
+//! (src/tests/) share; written against `rest_embree::` paths, which inside the crate name the
+//! crate itself.
+#![allow(dead_code)]
+
+use rest_embree::render::Frame;
+use rest_embree::scene::Scene;
+
+/// The crate's deterministic generator (splitmix64), for property tests.
+pub use rest_embree::rng::Rng;
+
+/// |a − b| ≤ tol, or a message naming `what`.
+pub fn assert_close(a: f64, b: f64, tol: f64, what: &str) {
+    assert!(
+        (a - b).abs() <= tol,
+        "{what}: got {a}, expected {b} (tolerance {tol})"
+    );
+}
+
+/// |a − b| ≤ rel·|b|, or a message naming `what`.
+pub fn assert_rel(a: f64, b: f64, rel: f64, what: &str) {
+    assert!(
+        ((a - b) / b).abs() <= rel,
+        "{what}: got {a}, expected {b} (relative tolerance {rel})"
+    );
+}
+
+/// The worked cases of docs/physics.md §2-§4 (tests/data/cases.json; its "source" says where they come from).
+pub fn cases() -> serde_json::Value {
+    serde_json::from_str(include_str!("../data/cases.json")).expect("cases.json parses")
+}
+
+/// A scene from TOML text; panics with the error.
+pub fn scene(toml: &str) -> Scene {
+    rest_embree::scene::load_str("test.toml", toml, &[]).unwrap_or_else(|e| panic!("scene: {e}"))
+}
+
+/// The backends of this build (every render test runs on each).
+pub fn backends() -> Vec<&'static str> {
+    rest_embree::accel::backend_names()
+}
+
+/// Two renders of one picture: at most `max_id_share` of the pixels see another object, and
+/// where they see the same one the colours differ by at most `max_color`.
+pub fn same_picture(a: &Frame, b: &Frame, what: &str, max_id_share: f64, max_color: f32) {
+    let ids = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .filter(|(p, q)| p.object_id != q.object_id)
+        .count();
+    let share = ids as f64 / a.pixels.len() as f64;
+    assert!(
+        share <= max_id_share,
+        "{what}: {ids} pixels see another object"
+    );
+    let mut worst = 0.0f32;
+    for (p, q) in a.pixels.iter().zip(&b.pixels) {
+        if p.object_id == q.object_id {
+            for k in 0..3 {
+                worst = worst.max((p.color[k] - q.color[k]).abs());
+            }
+        }
+    }
+    assert!(worst <= max_color, "{what}: colour differs by {worst}");
+}
