@@ -291,3 +291,70 @@ radius = 1
         );
     }
 }
+
+/// Two facing half-mirrors that also transmit half: the ray tree doubles at every bounce, so
+/// `max_depth = 64` would never end without the ray budget (`render.max_rays`). A budget that
+/// holds the full tree changes no pixel; a smaller one ends, with every pixel finite, and a
+/// larger budget comes closer to a much larger one.
+#[test]
+fn the_ray_budget_bounds_a_doubling_ray_tree() {
+    let text = |depth: u32, rays: u32| {
+        format!(
+            r#"
+[camera]
+position = [0, 5, 0]
+look_at = [0.3, 10, 0.2]
+[image]
+width = 24
+height = 24
+[render]
+max_depth = {depth}
+max_rays = {rays}
+[[light]]
+position = [0, 5, 3]
+[[material]]
+name = "half"
+color = 0.5
+reflect = 0.5
+transmit = 0.5
+[[group]]
+name = "walls"
+[[group.object]]
+type = "box"
+min = [-5, 8, -5]
+max = [5, 8.5, 5]
+material = "half"
+[[group.object]]
+type = "box"
+min = [-5, 1.5, -5]
+max = [5, 2, 5]
+material = "half"
+"#
+        )
+    };
+    let mean_diff = |a: &rest_embree::render::Frame, b: &rest_embree::render::Frame| {
+        let d: f64 = a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .map(|(p, q)| (0..3).map(|k| (p.color[k] - q.color[k]).abs() as f64).sum::<f64>())
+            .sum();
+        d / (3 * a.pixels.len()) as f64
+    };
+    for backend in backends() {
+        // Depth 5: 62 secondary rays at most, so a budget of 62 is the full tree.
+        let full = render_with(&scene(&text(5, 62)), backend);
+        let large = render_with(&scene(&text(5, 65536)), backend);
+        assert_eq!(full.pixels, large.pixels, "{backend}: the full tree either way");
+        let [small, medium, reference] =
+            [32, 256, 4096].map(|rays| render_with(&scene(&text(64, rays)), backend));
+        for f in [&small, &medium, &reference] {
+            assert_all_finite(f, backend);
+        }
+        let (far, near) = (mean_diff(&small, &reference), mean_diff(&medium, &reference));
+        assert!(
+            near < far && far > 0.0,
+            "{backend}: more rays come closer ({near} against {far})"
+        );
+    }
+}

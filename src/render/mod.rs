@@ -8,6 +8,7 @@ mod camera;
 mod frame;
 mod group_tree;
 mod light_tree;
+mod ray_budget;
 mod sampler;
 mod screen_cull;
 mod shade;

@@ -9,6 +9,7 @@
 //! photon's frequency there over its world-frame frequency ([`Boost::null_dir`]).
 
 use super::band::{Band, Seen};
+use super::ray_budget::{Branch, Budget};
 use super::world::{SurfaceHit, World};
 use crate::scene::{Light, Scene};
 use crate::spacetime::{Boost, Event, NullRay};
@@ -81,14 +82,15 @@ impl<'a, B: Band> Shader<'a, B> {
 
     /// The light arriving along a world-frame null ray at a receiver whose lookback factor
     /// for the ray's direction is `receiver_s` and whose wavelengths are `shift` times the
-    /// camera's, in the receiver's frame.
-    pub fn trace(&self, ray: &NullRay, receiver_s: f64, shift: f64, depth: u32) -> B {
+    /// camera's, in the receiver's frame; and the secondary rays spent below its hit.
+    pub fn trace(&self, ray: &NullRay, receiver_s: f64, shift: f64, budget: Budget) -> (B, u64) {
         match self.world.closest_hit(ray, 0.0) {
             Some(h) => {
                 let (shift, k) = self.arriving(receiver_s, h.s, shift);
-                self.shade(ray, &h, shift, depth) * k
+                let (light, spent) = self.shade(ray, &h, shift, budget);
+                (light * k, spent)
             }
-            None => self.background(receiver_s, shift),
+            None => (self.background(receiver_s, shift), 0),
         }
     }
 
@@ -128,14 +130,14 @@ impl<'a, B: Band> Shader<'a, B> {
     /// The light leaving a hit toward the ray's origin, in the surface's frame at wavelengths
     /// `shift` times the camera's: its light from each light not in shadow, and what it
     /// reflects and transmits.
-    pub fn shade(&self, ray: &NullRay, hit: &SurfaceHit, shift: f64, depth: u32) -> B {
+    pub fn shade(&self, ray: &NullRay, hit: &SurfaceHit, shift: f64, budget: Budget) -> (B, u64) {
         let mut shadows = Vec::with_capacity(self.lights.len());
         let lit = self.prepare(ray, hit, shift, &mut shadows);
         self.finish(
             &lit,
             &shadows,
             |light, q| !self.world.shadowed(light, &q.ray, q.tmax),
-            depth,
+            budget,
         )
     }
 
@@ -147,6 +149,11 @@ impl<'a, B: Band> Shader<'a, B> {
     /// Whether the background is black at every wavelength (then a miss needs no spectrum).
     pub fn black_background(&self) -> bool {
         self.scene.image.background.is_black()
+    }
+
+    /// What the ray tree below a primary hit may spend.
+    pub fn primary_budget(&self) -> Budget {
+        Budget::primary(self.scene.render.max_rays)
     }
 
     pub fn light_count(&self) -> usize {
@@ -239,11 +246,11 @@ impl<'a, B: Band> Shader<'a, B> {
         lit: &Lit,
         shadows: &[Option<ShadowQuery>],
         reaches: impl Fn(usize, &ShadowQuery) -> bool,
-        depth: u32,
-    ) -> B {
+        budget: Budget,
+    ) -> (B, u64) {
         let (mat, at) = (lit.mat, B::at(lit.shift));
         if let Some(e) = &mat.emission {
-            return B::of(e, at);
+            return (B::of(e, at), 0);
         }
         let diffuse = B::of(&mat.color, at);
         let mut color = B::of(&self.scene.render.ambient, at);
@@ -257,8 +264,9 @@ impl<'a, B: Band> Shader<'a, B> {
                 color.add_lit(&light, t.atten, &diffuse, t.ndl, glint, t.k);
             }
         }
-        if depth >= self.scene.render.max_depth {
-            return color;
+        let max_depth = self.scene.render.max_depth;
+        if budget.depth >= max_depth {
+            return (color, 0);
         }
         let (v, nf, event) = (lit.v, lit.nf, lit.event);
         let (mut kr, mut kt) = (mat.reflect, mat.transmit);
@@ -278,17 +286,32 @@ impl<'a, B: Band> Shader<'a, B> {
                 }
             }
         }
-        if kr > 0.0 {
-            let r = self.spawn(lit.group, event, nf, reflect(v, nf));
-            let s = self.lookback_factor(lit.group, r.dir);
-            color.add(&(self.trace(&r, s, lit.shift, depth + 1) * kr));
+        let refracted = refracted.filter(|_| kt > 0.0);
+        let (mut seen_r, mut seen_t) = (None, None);
+        let spent = budget.follow(
+            max_depth,
+            (kr > 0.0).then_some(kr),
+            refracted.map(|_| kt),
+            |branch, b| {
+                let (side, dir, seen) = match branch {
+                    Branch::Reflected => (nf, reflect(v, nf), &mut seen_r),
+                    Branch::Refracted => (-nf, refracted.expect("a refracted ray"), &mut seen_t),
+                };
+                let r = self.spawn(lit.group, event, side, dir);
+                let s = self.lookback_factor(lit.group, r.dir);
+                let (light, spent) = self.trace(&r, s, lit.shift, b);
+                *seen = Some(light);
+                1 + spent
+            },
+        );
+        // Added in this order whichever was traced first (the sum is the same to the bit).
+        if let Some(light) = seen_r {
+            color.add(&(light * kr));
         }
-        if let (Some(t), true) = (refracted, kt > 0.0) {
-            let r = self.spawn(lit.group, event, -nf, t);
-            let s = self.lookback_factor(lit.group, r.dir);
-            color.add(&(self.trace(&r, s, lit.shift, depth + 1) * kt));
+        if let Some(light) = seen_t {
+            color.add(&(light * kt));
         }
-        color
+        (color, spent)
     }
 }
 

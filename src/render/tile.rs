@@ -201,6 +201,7 @@ fn shade_hits<B: Band>(
 ) -> Vec<DVec3> {
     // One entry per light and hit (None where there is no shadow ray), hit-major.
     let lights = shader.light_count();
+    let budget = shader.primary_budget();
     let follows = shader.follows_frames();
     let black_sky = shader.black_background();
     let mut shadows = Vec::with_capacity(lights * primary.len());
@@ -250,8 +251,14 @@ fn shade_hits<B: Band>(
         .map(|(k, lit)| match lit {
             Ok((l, factor)) => {
                 let mine = k * lights..(k + 1) * lights;
-                let seen =
-                    shader.finish(l, &shadows[mine], |light, _| visible[k * lights + light], 0);
+                let seen = shader
+                    .finish(
+                        l,
+                        &shadows[mine],
+                        |light, _| visible[k * lights + light],
+                        budget,
+                    )
+                    .0;
                 // The camera leg's factor, on the RGB (linear, so as on every wavelength).
                 seen.to_rgb() * *factor
             }

@@ -80,12 +80,7 @@ fn build(doc: &Doc) -> SceneResult<Scene> {
     };
     let render = match root.table("render")? {
         Some(t) => render_settings(&t)?,
-        None => RenderSettings {
-            max_depth: 5,
-            ambient: Colour::grey(0.1, Role::Emitter),
-            doppler: true,
-            searchlight: true,
-        },
+        None => RenderSettings::default(),
     };
     let mut materials = vec![Material::default_white()];
     let mut material_ids: HashMap<String, u32> = HashMap::new();
@@ -364,15 +359,15 @@ fn image(t: &Table) -> SceneResult<ImageSettings> {
 }
 
 fn render_settings(t: &Table) -> SceneResult<RenderSettings> {
+    let d = RenderSettings::default();
     let s = RenderSettings {
-        max_depth: t.uint("max_depth", Some(5), 0, 64)? as u32,
-        ambient: t
-            .colour("ambient", Role::Emitter)?
-            .unwrap_or_else(|| Colour::grey(0.1, Role::Emitter)),
-        doppler: t.bool_or("doppler", true)?,
-        searchlight: t.bool_or("searchlight", true)?,
+        max_depth: t.uint("max_depth", Some(d.max_depth.into()), 0, 64)? as u32,
+        max_rays: t.uint("max_rays", Some(d.max_rays.into()), 0, MAX_RAYS.into())? as u32,
+        ambient: t.colour("ambient", Role::Emitter)?.unwrap_or(d.ambient),
+        doppler: t.bool_or("doppler", d.doppler)?,
+        searchlight: t.bool_or("searchlight", d.searchlight)?,
     };
-    t.finish(&["max_depth", "ambient", "doppler", "searchlight"])?;
+    t.finish(&["max_depth", "max_rays", "ambient", "doppler", "searchlight"])?;
     Ok(s)
 }
 

@@ -13,4 +13,5 @@ pub use error::SceneError;
 pub use load::{load_file, load_str};
 pub use model::{
     Camera, Group, ImageSettings, Light, Material, ObjectInfo, Projection, RenderSettings, Scene,
+    MAX_RAYS,
 };

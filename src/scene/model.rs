@@ -81,6 +81,9 @@ impl ImageSettings {
 pub struct RenderSettings {
     /// Reflection/refraction bounces after the primary hit.
     pub max_depth: u32,
+    /// Secondary rays one primary sample may spawn, at most (see `render/ray_budget.rs`): the
+    /// ray tree's cost is bounded whatever `max_depth` is.
+    pub max_rays: u32,
     /// Light every surface receives in its own rest frame (a rendering convenience, not
     /// shifted), times its reflectance.
     pub ambient: Colour,
@@ -89,6 +92,22 @@ pub struct RenderSettings {
     /// Scale radiance by D⁴ (and a point light's irradiance by D²) at every change of frame
     /// (the searchlight effect).
     pub searchlight: bool,
+}
+
+/// The largest `max_rays` a scene may give.
+pub const MAX_RAYS: u32 = 65536;
+
+impl Default for RenderSettings {
+    /// Five bounces (every ray of their tree: 62 at most), ambient 0.1, both effects on light.
+    fn default() -> Self {
+        Self {
+            max_depth: 5,
+            max_rays: 256,
+            ambient: Colour::grey(0.1, Role::Emitter),
+            doppler: true,
+            searchlight: true,
+        }
+    }
 }
 
 impl RenderSettings {
