@@ -2,7 +2,7 @@
 
 use crate::{accel, bench, output, render, scene, Error};
 use clap::{Parser, Subcommand};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser, Debug)]
@@ -125,6 +125,13 @@ fn finite(text: &str) -> Result<f64, String> {
 /// The `rest-embree` command: parse the command line and run it. Help and version print and
 /// exit 0; every argument error, like every other user error, prints and exits 1.
 pub fn main() -> ExitCode {
+    // Ctrl-C, SIGTERM, SIGHUP: no half-written file is left behind (a handler that cannot be
+    // installed only loses that).
+    let _ = ctrlc::set_handler(|| {
+        output::file::remove_partial_files();
+        eprintln!("interrupted");
+        std::process::exit(130);
+    });
     match parse() {
         Ok(cli) => run(cli),
         Err(code) => code,
@@ -165,10 +172,31 @@ fn report(r: crate::Result<()>) -> ExitCode {
     }
 }
 
+/// Whether two paths name one existing file (through links).
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// More threads than this per core only costs memory (each has a stack) and switching.
+const THREADS_PER_CORE: usize = 8;
+
 fn set_threads(threads: Option<usize>) -> crate::Result<()> {
     if let Some(n) = threads {
         if n == 0 {
             return Err(Error::flag("--threads", "must be at least 1"));
+        }
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        if n > THREADS_PER_CORE * cores {
+            return Err(Error::flag(
+                "--threads",
+                format!(
+                    "{n} is more than {THREADS_PER_CORE} per core ({} on this machine's {cores} cores)",
+                    THREADS_PER_CORE * cores
+                ),
+            ));
         }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -295,6 +323,15 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         .unwrap_or_else(|| accel::default_backend_name().to_string());
     let backend = accel::backend_by_name(&backend_name).map_err(|e| e.on_flag("--backend"))?;
     set_threads(args.threads)?;
+    if same_file(&args.scene, &args.output) {
+        return Err(Error::flag(
+            "-o",
+            format!(
+                "`{}` is the scene file itself; it was left as it is",
+                args.output.display()
+            ),
+        ));
+    }
     let scene = scene::load_file(&args.scene, &args.overrides())?;
     // A PNG holds colour alone: the passes (and with several samples, their extra ray per
     // pixel) are skipped.

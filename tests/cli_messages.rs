@@ -186,3 +186,69 @@ fn messages_and_exit_status() {
     entries.sort();
     assert_eq!(entries, ["lone.toml", "scene.toml"], "nothing written");
 }
+
+/// No file is lost: the scene file is never written over, a link is written through, a
+/// read-only image is left as it is, a dead run's partial file is cleaned up; and a thread
+/// count beyond any use is refused before anything starts.
+#[test]
+fn files_are_never_lost() {
+    let d = Dir::new("files");
+    // A scene file whose name ends in .png, given as the output.
+    let scene = d.file("scene.png", GOOD);
+    let s = scene.to_str().unwrap();
+    let (code, err) = status(&["render", s, "-o", s]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("-o") && err.contains("scene file"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(&scene).unwrap(),
+        GOOD,
+        "the scene is intact"
+    );
+    #[cfg(unix)]
+    {
+        let real = d.file("real.png", "old");
+        let link = d.0.join("link.png");
+        std::os::unix::fs::symlink("real.png", &link).unwrap();
+        let (code, err) = status(&["render", s, "-o", link.to_str().unwrap(), "-q"]);
+        assert_eq!(code, Some(0), "{err}");
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(
+            &std::fs::read(&real).unwrap()[1..4],
+            b"PNG",
+            "written through the link"
+        );
+    }
+    let kept = d.file("kept.png", "keep");
+    let mut p = std::fs::metadata(&kept).unwrap().permissions();
+    p.set_readonly(true);
+    std::fs::set_permissions(&kept, p).unwrap();
+    let (code, err) = status(&["render", s, "-o", kept.to_str().unwrap()]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("read-only"), "{err}");
+    assert_eq!(std::fs::read_to_string(&kept).unwrap(), "keep");
+    // A partial file of a run that was killed (no process has this id) goes with the next run.
+    let stale = d.file(".out.png.partial-4194305", "half");
+    let out = d.0.join("out.png");
+    let (code, err) = status(&["render", s, "-o", out.to_str().unwrap(), "-q"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        !stale.exists() || !cfg!(target_os = "linux"),
+        "the stale partial file is gone"
+    );
+    let (code, err) = status(&[
+        "render",
+        s,
+        "-o",
+        out.to_str().unwrap(),
+        "--threads",
+        "100000",
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--threads") && err.contains("per core"),
+        "{err}"
+    );
+}

@@ -337,7 +337,11 @@ material = "half"
             .pixels
             .iter()
             .zip(&b.pixels)
-            .map(|(p, q)| (0..3).map(|k| (p.color[k] - q.color[k]).abs() as f64).sum::<f64>())
+            .map(|(p, q)| {
+                (0..3)
+                    .map(|k| (p.color[k] - q.color[k]).abs() as f64)
+                    .sum::<f64>()
+            })
             .sum();
         d / (3 * a.pixels.len()) as f64
     };
@@ -345,13 +349,19 @@ material = "half"
         // Depth 5: 62 secondary rays at most, so a budget of 62 is the full tree.
         let full = render_with(&scene(&text(5, 62)), backend);
         let large = render_with(&scene(&text(5, 65536)), backend);
-        assert_eq!(full.pixels, large.pixels, "{backend}: the full tree either way");
+        assert_eq!(
+            full.pixels, large.pixels,
+            "{backend}: the full tree either way"
+        );
         let [small, medium, reference] =
             [32, 256, 4096].map(|rays| render_with(&scene(&text(64, rays)), backend));
         for f in [&small, &medium, &reference] {
             assert_all_finite(f, backend);
         }
-        let (far, near) = (mean_diff(&small, &reference), mean_diff(&medium, &reference));
+        let (far, near) = (
+            mean_diff(&small, &reference),
+            mean_diff(&medium, &reference),
+        );
         assert!(
             near < far && far > 0.0,
             "{backend}: more rays come closer ({near} against {far})"

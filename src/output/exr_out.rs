@@ -1,4 +1,4 @@
-use super::cause;
+use super::file::cause;
 use crate::render::{Frame, CHANNELS};
 use crate::{Cause, Error};
 use exr::prelude::*;

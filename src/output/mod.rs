@@ -2,11 +2,12 @@
 //! sRGB), chosen by the file extension. Files are written whole or not at all.
 
 mod exr_out;
+pub mod file;
 mod png_out;
 
 use crate::render::Frame;
-use crate::{Cause, Error};
-use std::path::{Path, PathBuf};
+use crate::Error;
+use std::path::Path;
 
 /// An image format, chosen by the output file's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,34 +41,13 @@ impl Format {
     }
 }
 
-/// Write the frame; the file appears only when it is complete (written beside it, then renamed).
+/// Write the frame; the file appears only when it is complete (see [`file`]).
 pub fn write(frame: &Frame, path: &Path) -> crate::Result<()> {
     let format = Format::for_path(path)?;
-    let tmp = temp_path(path);
-    let result = match format {
-        Format::Exr => exr_out::write(frame, &tmp),
-        Format::Png => png_out::write(frame, &tmp),
-    }
-    .and_then(|_| std::fs::rename(&tmp, path).map_err(cause));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        let message = format!("cannot write `{}`: {e}", path.display());
-        return Err(Error::image(path, message, Some(e)));
-    }
-    Ok(())
-}
-
-fn temp_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.partial-{}", std::process::id()))
-}
-
-/// An encoder's or the file system's error as a shared cause.
-fn cause(e: impl std::error::Error + Send + Sync + 'static) -> Cause {
-    std::sync::Arc::new(e)
+    file::write_whole(path, |tmp| match format {
+        Format::Exr => exr_out::write(frame, tmp),
+        Format::Png => png_out::write(frame, tmp),
+    })
 }
 
 /// Linear to sRGB-encoded, after clamping to [0, 1].

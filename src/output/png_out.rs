@@ -1,4 +1,5 @@
-use super::{cause, srgb_encode};
+use super::file::cause;
+use super::srgb_encode;
 use crate::render::Frame;
 use crate::Cause;
 use std::io::BufWriter;

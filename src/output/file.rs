@@ -1,0 +1,229 @@
+//! Writing a file so that no file is lost and none is left half-written: the bytes go to a
+//! hidden file beside the target (`.NAME.partial-PID`), are synced to the disk, and are renamed
+//! over the target only when complete, with the target's permissions. A symbolic link is
+//! written through (the link stays, its target is replaced); a read-only target or a directory
+//! is refused. Partial files of runs that died (killed, or the machine stopped) are removed by
+//! the next write to the same name; the command line removes its own on Ctrl-C and SIGTERM
+//! ([`remove_partial_files`]).
+
+use crate::{Cause, Error};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Partial files being written now, for [`remove_partial_files`].
+static PARTIAL: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Remove the partial files this process is writing (for a signal handler: the process is
+/// about to end).
+pub fn remove_partial_files() {
+    let files = PARTIAL.lock().map(|f| f.clone()).unwrap_or_default();
+    for f in files {
+        let _ = std::fs::remove_file(f);
+    }
+}
+
+/// Write `path` through `write` (which writes the whole file at the path it is given).
+pub(crate) fn write_whole(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), Cause>,
+) -> crate::Result<()> {
+    let refuse = |why: String| {
+        Error::image(
+            path,
+            format!("cannot write `{}`: {why}", path.display()),
+            None,
+        )
+    };
+    let target = through_links(path).map_err(refuse)?;
+    let existing = std::fs::metadata(&target).ok();
+    if let Some(m) = &existing {
+        if m.is_dir() {
+            return Err(refuse("it is a directory".into()));
+        }
+        if m.permissions().readonly() {
+            return Err(refuse("the file is read-only; it was left as it is".into()));
+        }
+    }
+    remove_stale_partials(&target);
+    let tmp = partial_name(&target, std::process::id());
+    if let Ok(mut p) = PARTIAL.lock() {
+        p.push(tmp.clone());
+    }
+    let result = write(&tmp).and_then(|_| {
+        if let Some(m) = &existing {
+            std::fs::set_permissions(&tmp, m.permissions()).map_err(cause)?;
+        }
+        std::fs::File::open(&tmp)
+            .and_then(|f| f.sync_all())
+            .map_err(cause)?;
+        std::fs::rename(&tmp, &target).map_err(cause)?;
+        // The rename itself is on the disk once the directory is.
+        if let Some(dir) = target.parent().filter(|d| !d.as_os_str().is_empty()) {
+            let _ = std::fs::File::open(dir).and_then(|d| d.sync_all());
+        }
+        Ok(())
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    if let Ok(mut p) = PARTIAL.lock() {
+        p.retain(|f| f != &tmp);
+    }
+    result.map_err(|e| {
+        let message = format!("cannot write `{}`: {e}", path.display());
+        Error::image(path, message, Some(e))
+    })
+}
+
+/// The file a path names, following symbolic links (relative ones from the link's directory).
+fn through_links(path: &Path) -> Result<PathBuf, String> {
+    let mut p = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let to = std::fs::read_link(&p).map_err(|e| e.to_string())?;
+                p = match p.parent() {
+                    Some(dir) if to.is_relative() => dir.join(to),
+                    _ => to,
+                };
+            }
+            _ => return Ok(p),
+        }
+    }
+    Err("too many levels of symbolic links".into())
+}
+
+fn partial_name(target: &Path, pid: u32) -> PathBuf {
+    let name = target
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    target.with_file_name(format!(".{name}.partial-{pid}"))
+}
+
+/// Remove the partial files of `target` left by processes that no longer run (Linux: no
+/// /proc/PID). Elsewhere, or where it cannot tell, it leaves them.
+fn remove_stale_partials(target: &Path) {
+    let (Some(dir), Some(name)) = (target.parent(), target.file_name()) else {
+        return;
+    };
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let prefix = format!(".{}.partial-", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let file = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = file
+            .strip_prefix(&prefix)
+            .and_then(|p| p.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// An encoder's or the file system's error as a shared cause.
+pub(crate) fn cause(e: impl std::error::Error + Send + Sync + 'static) -> Cause {
+    std::sync::Arc::new(e)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d =
+            std::env::temp_dir().join(format!("rest-embree-file-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn bytes(text: &'static str) -> impl FnOnce(&Path) -> Result<(), Cause> {
+        move |p| std::fs::write(p, text).map_err(cause)
+    }
+
+    #[test]
+    fn a_failed_write_leaves_the_old_file_and_no_partial() {
+        let d = dir("fail");
+        let target = d.join("out.png");
+        std::fs::write(&target, "old").unwrap();
+        let failing = |p: &Path| {
+            std::fs::write(p, "half").unwrap();
+            Err(cause(std::io::Error::other("encoder failed")))
+        };
+        assert!(write_whole(&target, failing).is_err());
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "old");
+        assert_eq!(
+            std::fs::read_dir(&d).unwrap().count(),
+            1,
+            "no partial file left"
+        );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn links_are_written_through_and_modes_kept() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = dir("link");
+        let real = d.join("real.png");
+        std::fs::write(&real, "old").unwrap();
+        std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o640)).unwrap();
+        let link = d.join("link.png");
+        std::os::unix::fs::symlink("real.png", &link).unwrap();
+        write_whole(&link, bytes("new")).unwrap();
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read_to_string(&real).unwrap(), "new");
+        let mode = std::fs::metadata(&real).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o640, "the target's mode is kept");
+    }
+
+    #[test]
+    fn read_only_files_and_directories_are_refused() {
+        let d = dir("ro");
+        let target = d.join("keep.png");
+        std::fs::write(&target, "keep").unwrap();
+        let mut p = std::fs::metadata(&target).unwrap().permissions();
+        p.set_readonly(true);
+        std::fs::set_permissions(&target, p).unwrap();
+        let e = write_whole(&target, bytes("new")).unwrap_err().to_string();
+        assert!(e.contains("read-only"), "{e}");
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep");
+        let e = write_whole(&d, bytes("new")).unwrap_err().to_string();
+        assert!(e.contains("directory"), "{e}");
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn partial_files_of_dead_runs_are_removed() {
+        let d = dir("stale");
+        let target = d.join("out.exr");
+        // No process has this id (above the kernel's pid_max of 2^22).
+        let dead = partial_name(&target, 4_194_305);
+        // Process 1 always runs: its partial file may be in the middle of being written.
+        let live = partial_name(&target, 1);
+        let other = partial_name(&d.join("other.exr"), 4_194_305);
+        for f in [&dead, &live, &other] {
+            std::fs::write(f, "half").unwrap();
+        }
+        write_whole(&target, bytes("whole")).unwrap();
+        assert!(!dead.exists(), "a dead run's partial file is removed");
+        assert!(live.exists(), "a running process's partial file is left");
+        assert!(other.exists(), "another file's partials are not touched");
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "whole");
+    }
+}
