@@ -1,6 +1,6 @@
 //! The command line: `rest-embree render SCENE -o OUT.{exr,png} [options]`.
 
-use crate::{accel, bench, output, render, scene, Error};
+use crate::{accel, bench, memory, output, render, scene, Error};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -84,6 +84,10 @@ pub(crate) struct RenderArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// The most memory the render may use, e.g. 8G or 512M (default: the machine's available
+    /// memory); a render that would need more is refused before it starts.
+    #[arg(long, value_name = "SIZE", value_parser = memory::parse_size)]
+    pub max_memory: Option<u64>,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -170,6 +174,40 @@ fn report(r: crate::Result<()>) -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Refuse a render whose frame and geometry would not fit in memory, blaming the image size.
+fn fits_in_memory(
+    scene: &scene::Scene,
+    format: output::Format,
+    args: &RenderArgs,
+) -> crate::Result<()> {
+    let (w, h) = scene.image.frame_size();
+    let pixels = u64::from(w) * u64::from(h);
+    let per_pixel = match format {
+        output::Format::Exr => memory::BYTES_PER_PIXEL_EXR,
+        output::Format::Png => memory::BYTES_PER_PIXEL_PNG,
+    };
+    let prims = scene.primitive_count() as u64;
+    let need = pixels
+        .saturating_mul(per_pixel)
+        .saturating_add(prims.saturating_mul(memory::BYTES_PER_PRIMITIVE));
+    let what = format!("a {w}x{h} render of {prims} primitives");
+    let Some(why) = memory::too_much(need, &what) else {
+        return Ok(());
+    };
+    let why = format!(
+        "{why}; render it in crops (image.crop) or smaller, or allow more with --max-memory"
+    );
+    Err(match (args.width, args.height) {
+        (Some(_), _) => Error::flag("--width", why),
+        (None, Some(_)) => Error::flag("--height", why),
+        _ => Error::Scene(scene::SceneError::new(
+            args.scene.display().to_string(),
+            "image.width",
+            why,
+        )),
+    })
 }
 
 /// Whether two paths name one existing file (through links).
@@ -332,7 +370,9 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
             ),
         ));
     }
+    memory::set_limit(args.max_memory);
     let scene = scene::load_file(&args.scene, &args.overrides())?;
+    fits_in_memory(&scene, format, args)?;
     // A PNG holds colour alone: the passes (and with several samples, their extra ray per
     // pixel) are skipped.
     let passes = match format {

@@ -19,6 +19,7 @@ pub mod cli;
 pub mod compare;
 mod error;
 pub mod geometry;
+pub mod memory;
 pub mod output;
 pub mod render;
 pub mod rng;

@@ -137,7 +137,7 @@ fn bad_values_name_line_and_key() {
         "range",
         &with("fov_y = 30", "fov_y = 190"),
         &[],
-        &["scene.toml:4", "camera.fov_y", "between 0 and 180"],
+        &["scene.toml:4", "camera.fov_y", "below 180 degrees"],
     );
     fails(
         "width",

@@ -159,7 +159,7 @@ fn messages_and_exit_status() {
     let (code, err) = status(&["render", s, "-o", o, "--set", "camera.fov_y=1e308"]);
     assert_eq!(code, Some(1), "{err}");
     assert!(
-        err.contains("(got 1e308)") && !err.contains("00000000"),
+        err.contains("1e308 is beyond") && !err.contains("00000000"),
         "{err}"
     );
     let (code, err) = status(&[
@@ -251,4 +251,37 @@ fn files_are_never_lost() {
         err.contains("--threads") && err.contains("per core"),
         "{err}"
     );
+}
+
+/// A render that would not fit in memory is refused before it starts, with the estimate, the
+/// limit and the flag that set the size.
+#[test]
+fn renders_beyond_the_memory_limit_are_refused() {
+    let d = Dir::new("memory");
+    let scene = d.file("scene.toml", GOOD);
+    let out = d.0.join("out.exr");
+    let (s, o) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    let (code, err) = status(&[
+        "render",
+        s,
+        "-o",
+        o,
+        "--width",
+        "4096",
+        "--height",
+        "4096",
+        "--max-memory",
+        "64M",
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--width") && err.contains("GiB of memory") && err.contains("64 MiB"),
+        "{err}"
+    );
+    let (code, err) = status(&["render", s, "-o", o, "--max-memory", "lots"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("--max-memory"), "{err}");
+    let (code, err) = status(&["render", s, "-o", o, "--max-memory", "64M", "-q"]);
+    assert_eq!(code, Some(0), "a small render fits: {err}");
+    assert!(out.exists());
 }

@@ -56,7 +56,7 @@ impl Budget {
     ) -> u64 {
         let need = Self::need(max_depth, self.depth + 1);
         let child = |allowance: u64| {
-            (allowance > 0).then_some(Budget {
+            (allowance > 0).then(|| Budget {
                 depth: self.depth + 1,
                 rays: allowance - 1,
             })

@@ -367,7 +367,7 @@ pub fn render_tile<B: Band>(
                 c = DVec3::ZERO;
             }
             let mut value = PixelValue {
-                color: [c.x as f32, c.y as f32, c.z as f32],
+                color: c.to_array().map(to_f32),
                 alpha: covered[k] as f32 / n as f32,
                 ..Default::default()
             };
@@ -375,14 +375,14 @@ pub fn render_tile<B: Band>(
                 let g = &world.groups[hit.group];
                 let prim = &g.geometry.prims[hit.prim as usize];
                 let nrm = prim.normal(hit.point);
-                value.lookback = hit.lambda as f32;
-                value.doppler = (cam.lookback_factor(r.dir) / hit.s) as f32;
+                value.lookback = to_f32(hit.lambda);
+                value.doppler = to_f32(cam.lookback_factor(r.dir) / hit.s);
                 value.object_id = g.geometry.part_of(hit.prim).object + 1;
                 value.normal = [nrm.x as f32, nrm.y as f32, nrm.z as f32];
                 let p = r.at(hit.lambda).x;
-                value.position = [p.x as f32, p.y as f32, p.z as f32];
+                value.position = p.to_array().map(to_f32);
                 let q = hit.point;
-                value.rest_position = [q.x as f32, q.y as f32, q.z as f32];
+                value.rest_position = q.to_array().map(to_f32);
             }
             TilePixel { x, y, value }
         })
@@ -392,4 +392,10 @@ pub fn render_tile<B: Band>(
         primary_rays: traced,
         nonfinite,
     }
+}
+
+/// An f64 value as f32, saturating at f32's largest finite values (radiance under a strong
+/// searchlight can exceed f32's range; an image holds no infinity).
+fn to_f32(v: f64) -> f32 {
+    v.clamp(-f64::from(f32::MAX), f64::from(f32::MAX)) as f32
 }

@@ -278,7 +278,9 @@ impl World {
                 bounds,
                 geometry,
                 accel,
-                epsilon: 1e-7 * bounds.diagonal().max(1e-3) + 1e-12 * bounds.max_abs(),
+                // Relative to the group's size and place alone, so that a scene scaled as a
+                // whole renders the same (tests/envelope.rs).
+                epsilon: 1e-7 * bounds.diagonal() + 1e-12 * bounds.max_abs(),
                 moving: MovingBounds::new(&bounds, &velocity, event.t),
             });
         }

@@ -109,7 +109,18 @@ fn build(doc: &Doc) -> SceneResult<Scene> {
         let mut geometry = Geometry::default();
         for o in t.tables("object")? {
             let id = objects.len() as u32;
+            let first = geometry.prims.len();
             let kind = add_object(&o, id, &material_ids, &mut geometry, &mut total)?;
+            let reach = geometry.prims[first..]
+                .iter()
+                .map(|p| {
+                    let b = p.bounds();
+                    b.min.abs().max(b.max.abs()).max_element()
+                })
+                .fold(0.0, f64::max);
+            if reach > super::envelope::MAX_MAGNITUDE {
+                return Err(o.error("type", super::envelope::reaches_too_far(&kind, reach)));
+            }
             objects.push(ObjectInfo {
                 name: o.string("name")?.map(str::to_string),
                 kind,
@@ -215,7 +226,11 @@ fn velocity(t: &Table, dir_key: &str) -> SceneResult<Option<Velocity>> {
         "rapidity" => Velocity::from_rapidity(dir, s),
         _ => Velocity::from_one_minus_beta(dir, s),
     };
-    v.map(Some).map_err(|e| t.error_at(n, form, e.to_string()))
+    let v = v.map_err(|e| t.error_at(n, form, e.to_string()))?;
+    if let Some(why) = super::envelope::too_fast(v.rapidity()) {
+        return Err(t.error_at(n, form, why));
+    }
+    Ok(Some(v))
 }
 
 fn camera(t: &Table) -> SceneResult<Camera> {
@@ -260,8 +275,8 @@ fn camera(t: &Table) -> SceneResult<Camera> {
     let fov_y = t.f64_where(
         "fov_y",
         Some(40.0),
-        |v| v > 0.0 && v < 180.0,
-        "between 0 and 180 degrees",
+        |v| (super::envelope::MIN_FOV_DEG..180.0).contains(&v),
+        "at least 1e-6 and below 180 degrees",
     )?;
     let view_height = t.f64("view_height")?;
     if let Some(h) = view_height.filter(|&h| h <= 0.0) {
@@ -520,6 +535,11 @@ fn budget(t: &Table, key: &str, total: &mut u64, add: u64) -> SceneResult<()> {
                 *total
             ),
         ));
+    }
+    let what = format!("a scene of {} primitives", *total);
+    let need = total.saturating_mul(crate::memory::BYTES_PER_PRIMITIVE);
+    if let Some(why) = crate::memory::too_much(need, &what) {
+        return Err(t.error(key, why));
     }
     Ok(())
 }

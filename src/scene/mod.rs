@@ -3,6 +3,7 @@
 
 mod colour;
 mod doc;
+mod envelope;
 mod error;
 mod load;
 mod model;

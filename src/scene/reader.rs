@@ -85,6 +85,9 @@ impl<'a> Table<'a> {
         if !v.is_finite() {
             return Err(self.error_at(n, key, format!("expected a finite number, found {v}")));
         }
+        if v.abs() > super::envelope::MAX_MAGNITUDE {
+            return Err(self.error_at(n, key, super::envelope::too_large(v)));
+        }
         Ok(v)
     }
 

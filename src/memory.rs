@@ -1,0 +1,124 @@
+//! The memory a render needs, estimated before anything large is allocated, against a limit:
+//! the machine's available memory (Linux: `MemAvailable`), or what `--max-memory` says. A
+//! render that would not fit is refused with the estimate and the limit, instead of aborting
+//! on a failed allocation halfway.
+//!
+//! The estimates are upper bounds from the sizes of the structures: per pixel the frame's
+//! [`PixelValue`](crate::render::PixelValue) (64 bytes) and, for an EXR, the encoder's copy of
+//! its channels; per primitive the f64 primitive, its share of the accelerator and the build's
+//! buffers (the bench's 100³ lattice, 4 million primitives, peaks near 270 bytes each).
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Bytes per primitive: the scene's copy, the accelerator and its build.
+pub const BYTES_PER_PRIMITIVE: u64 = 320;
+/// Bytes per pixel of a PNG render: the frame, and the 8-bit image encoded from it.
+pub const BYTES_PER_PIXEL_PNG: u64 = 72;
+/// Bytes per pixel of an EXR render: the frame, and the encoder's channels.
+pub const BYTES_PER_PIXEL_EXR: u64 = 136;
+
+/// The limit set by [`set_limit`]; 0 for the machine's available memory.
+static LIMIT: AtomicU64 = AtomicU64::new(0);
+
+/// Limit what a render may use to `bytes` (None: the machine's available memory).
+pub fn set_limit(bytes: Option<u64>) {
+    LIMIT.store(bytes.unwrap_or(0), Ordering::Relaxed);
+}
+
+/// The limit, and where it comes from; None where it cannot be known (no limit set, and not
+/// Linux), when nothing is checked.
+pub fn limit() -> Option<(u64, &'static str)> {
+    match LIMIT.load(Ordering::Relaxed) {
+        0 => available().map(|b| (b, "available")),
+        b => Some((b, "allowed by --max-memory")),
+    }
+}
+
+/// The machine's available memory (Linux), in bytes.
+fn available() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Why `need` bytes (for `what`) will not fit, or None when they do or nothing can be known.
+pub fn too_much(need: u64, what: &str) -> Option<String> {
+    exceeds(need, what, limit())
+}
+
+fn exceeds(need: u64, what: &str, limit: Option<(u64, &str)>) -> Option<String> {
+    let (limit, source) = limit?;
+    (need > limit).then(|| {
+        format!(
+            "{what} needs about {} of memory, more than the {} {source}",
+            human(need),
+            human(limit)
+        )
+    })
+}
+
+/// A size for people: GiB or MiB.
+pub fn human(bytes: u64) -> String {
+    let gib = bytes as f64 / f64::from(1u32 << 30);
+    if gib >= 1.0 {
+        format!("{gib:.1} GiB")
+    } else {
+        format!("{:.0} MiB", bytes as f64 / f64::from(1u32 << 20))
+    }
+}
+
+/// A size as people write it: `8G`, `512M`, `64k` or bytes.
+pub fn parse_size(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let (number, unit) = t
+        .find(|c: char| c.is_ascii_alphabetic())
+        .map_or((t, ""), |i| t.split_at(i));
+    let factor: u64 = match unit.to_ascii_lowercase().as_str() {
+        "" | "b" => 1,
+        "k" | "kb" | "kib" => 1 << 10,
+        "m" | "mb" | "mib" => 1 << 20,
+        "g" | "gb" | "gib" => 1 << 30,
+        "t" | "tb" | "tib" => 1 << 40,
+        _ => return Err(format!("`{text}`: the unit must be k, M, G or T")),
+    };
+    let n: f64 = number
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a size such as 8G or 512M"))?;
+    let bytes = n * factor as f64;
+    if !(bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64) {
+        return Err(format!("`{text}` is not a size such as 8G or 512M"));
+    }
+    Ok(bytes as u64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_as_people_write_them() {
+        assert_eq!(parse_size("8G"), Ok(8 << 30));
+        assert_eq!(parse_size("512M"), Ok(512 << 20));
+        assert_eq!(parse_size("1.5 GiB"), Ok(3 << 29));
+        assert_eq!(parse_size("4096"), Ok(4096));
+        for bad in ["", "G", "-1G", "8X", "nanG", "0"] {
+            assert!(parse_size(bad).is_err(), "{bad}");
+        }
+        assert_eq!(human(3 << 29), "1.5 GiB");
+        assert_eq!(human(200 << 20), "200 MiB");
+    }
+
+    #[test]
+    fn a_limit_refuses_what_exceeds_it() {
+        let limit = Some((1 << 30, "allowed by --max-memory"));
+        assert!(exceeds(1 << 29, "x", limit).is_none());
+        let why = exceeds(3 << 30, "this render", limit).unwrap();
+        assert!(why.contains("3.0 GiB") && why.contains("1.0 GiB allowed by --max-memory"));
+        assert!(
+            exceeds(u64::MAX, "x", None).is_none(),
+            "nothing known, nothing refused"
+        );
+    }
+}
