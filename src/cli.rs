@@ -176,6 +176,29 @@ fn report(r: crate::Result<()>) -> ExitCode {
     }
 }
 
+/// A PNG render: colour alone (the passes, and with several samples their extra ray per pixel,
+/// are skipped), written band by band as it is rendered, so a large image is never held whole.
+fn render_png(
+    scene: &scene::Scene,
+    backend: &dyn accel::Backend,
+    path: &Path,
+) -> crate::Result<render::RenderStats> {
+    let t0 = std::time::Instant::now();
+    let world = render::World::build(scene, backend)?;
+    let build_time = t0.elapsed();
+    let t1 = std::time::Instant::now();
+    let (w, h) = scene.image.frame_size();
+    let mut stats = render::RenderStats::default();
+    output::write_png_in_bands(path, w, h, |put| {
+        let colour = render::Passes::Colour;
+        stats = render::render_world_in_bands(scene, &world, colour, memory::BAND_PIXELS, put)?;
+        Ok(())
+    })?;
+    stats.build_time = build_time;
+    stats.trace_time = t1.elapsed();
+    Ok(stats)
+}
+
 /// Refuse a render whose frame and geometry would not fit in memory, blaming the image size.
 fn fits_in_memory(
     scene: &scene::Scene,
@@ -184,14 +207,16 @@ fn fits_in_memory(
 ) -> crate::Result<()> {
     let (w, h) = scene.image.frame_size();
     let pixels = u64::from(w) * u64::from(h);
-    let per_pixel = match format {
-        output::Format::Exr => memory::BYTES_PER_PIXEL_EXR,
-        output::Format::Png => memory::BYTES_PER_PIXEL_PNG,
+    // A PNG is written band by band: only a band is held at a time.
+    let held = match format {
+        output::Format::Exr => pixels.saturating_mul(memory::BYTES_PER_PIXEL_EXR),
+        output::Format::Png => {
+            let band = memory::BAND_PIXELS + u64::from(w) * u64::from(render::TILE);
+            pixels.min(band).saturating_mul(memory::BYTES_PER_PIXEL_PNG)
+        }
     };
     let prims = scene.primitive_count() as u64;
-    let need = pixels
-        .saturating_mul(per_pixel)
-        .saturating_add(prims.saturating_mul(memory::BYTES_PER_PRIMITIVE));
+    let need = held.saturating_add(prims.saturating_mul(memory::BYTES_PER_PRIMITIVE));
     let what = format!("a {w}x{h} render of {prims} primitives");
     let Some(why) = memory::too_much(need, &what) else {
         return Ok(());
@@ -373,27 +398,20 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
     memory::set_limit(args.max_memory);
     let scene = scene::load_file(&args.scene, &args.overrides())?;
     fits_in_memory(&scene, format, args)?;
-    // A PNG holds colour alone: the passes (and with several samples, their extra ray per
-    // pixel) are skipped.
-    let passes = match format {
-        output::Format::Exr => render::Passes::All,
-        output::Format::Png => render::Passes::Colour,
+    let stats = match format {
+        output::Format::Exr => {
+            let (frame, stats) = render::render(&scene, backend.as_ref(), &Default::default())?;
+            output::write(&frame, &args.output)?;
+            stats
+        }
+        output::Format::Png => render_png(&scene, backend.as_ref(), &args.output)?,
     };
-    let (frame, stats) = render::render(
-        &scene,
-        backend.as_ref(),
-        &render::RenderOptions {
-            passes,
-            ..Default::default()
-        },
-    )?;
     if stats.nonfinite_pixels > 0 {
         eprintln!(
             "warning: {} pixels came out NaN or infinite and were set to black; please report this scene",
             stats.nonfinite_pixels
         );
     }
-    output::write(&frame, &args.output)?;
     if !args.quiet {
         let secs = stats.trace_time.as_secs_f64();
         eprintln!(

@@ -5,15 +5,22 @@
 //!
 //! The estimates are upper bounds from the sizes of the structures: per pixel the frame's
 //! [`PixelValue`](crate::render::PixelValue) (64 bytes) and, for an EXR, the encoder's copy of
-//! its channels; per primitive the f64 primitive, its share of the accelerator and the build's
+//! its channels (a PNG is rendered and written a band of [`BAND_PIXELS`] at a time, so only a
+//! band counts); per primitive the f64 primitive, its share of the accelerator and the build's
 //! buffers (the bench's 100³ lattice, 4 million primitives, peaks near 270 bytes each).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Bytes per primitive: the scene's copy, the accelerator and its build.
 pub const BYTES_PER_PRIMITIVE: u64 = 320;
-/// Bytes per pixel of a PNG render: the frame, and the 8-bit image encoded from it.
+/// Bytes of memory per byte of a scene file while it is read (a file of numbers, such as an
+/// inline mesh, measured at about 45).
+pub const BYTES_PER_SCENE_BYTE: u64 = 64;
+/// Bytes per pixel of a PNG render's band: the frame's rows, and their 8-bit encoding.
 pub const BYTES_PER_PIXEL_PNG: u64 = 72;
+/// Pixels a PNG render holds at a time, at least (whole rows of tiles): it is written band by
+/// band as it is rendered.
+pub const BAND_PIXELS: u64 = 1 << 22;
 /// Bytes per pixel of an EXR render: the frame, and the encoder's channels.
 pub const BYTES_PER_PIXEL_EXR: u64 = 136;
 

@@ -6,7 +6,7 @@ pub mod file;
 mod png_out;
 
 use crate::render::Frame;
-use crate::Error;
+use crate::{Cause, Error};
 use std::path::Path;
 
 /// An image format, chosen by the output file's extension.
@@ -48,6 +48,17 @@ pub fn write(frame: &Frame, path: &Path) -> crate::Result<()> {
         Format::Exr => exr_out::write(frame, tmp),
         Format::Png => png_out::write(frame, tmp),
     })
+}
+
+/// Write a PNG of `width` × `height` whose rows `fill` hands on in bands, top to bottom, as it
+/// renders them (see [`crate::render`]'s banded rendering): the image is never held whole.
+pub(crate) fn write_png_in_bands(
+    path: &Path,
+    width: u32,
+    height: u32,
+    fill: impl FnOnce(&mut png_out::Bands) -> Result<(), Cause>,
+) -> crate::Result<()> {
+    file::write_whole(path, |tmp| png_out::write_bands(tmp, width, height, fill))
 }
 
 /// Linear to sRGB-encoded, after clamping to [0, 1].

@@ -157,43 +157,106 @@ pub(crate) fn render_world_passes(
     world: &World,
     passes: Passes,
 ) -> (Frame, RenderStats) {
+    let (_, h) = scene.image.frame_size();
+    Rows::new(scene, world, passes).render(0..h)
+}
+
+/// Render the frame a band of at least `min_pixels` pixels at a time (whole rows of tiles), top
+/// to bottom, handing each band to `put`: a large image written as it is rendered never holds
+/// the whole frame. The bands hold the whole frame's pixels exactly.
+pub(crate) fn render_world_in_bands<E>(
+    scene: &Scene,
+    world: &World,
+    passes: Passes,
+    min_pixels: u64,
+    mut put: impl FnMut(&Frame) -> Result<(), E>,
+) -> Result<RenderStats, E> {
     let (w, h) = scene.image.frame_size();
-    let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
-    let cull = ScreenCull::new(world, &cam);
-    let spectral = needs_spectra(scene);
-    let mut frame = Frame::new(w, h);
-    let band = (w * TILE) as usize;
-    let per_band: Vec<(u64, u64)> = frame
-        .pixels
-        .par_chunks_mut(band.max(1))
-        .enumerate()
-        .map(|(b, rows)| {
-            let y0 = b as u32 * TILE;
-            let (mut counts, mut scratch) = ((0, 0), tile::TileScratch::default());
-            for x0 in (0..w).step_by(TILE as usize) {
-                let xy = (x0, y0);
-                let cull = cull.as_ref();
-                let tile = if spectral {
-                    let seen = Seen::of(scene);
-                    let s = &mut scratch;
-                    tile::render_tile::<Sampled>(seen, scene, world, &cam, cull, xy, passes, s)
-                } else {
-                    let s = &mut scratch;
-                    tile::render_tile::<DVec3>(Seen::NONE, scene, world, &cam, cull, xy, passes, s)
-                };
-                counts.0 += tile.primary_rays;
-                counts.1 += tile.nonfinite;
-                for p in tile.pixels {
-                    rows[((p.y - y0) * w + p.x) as usize] = p.value;
-                }
-            }
-            counts
-        })
-        .collect();
+    let tile_rows = min_pixels
+        .div_ceil(u64::from(w.max(1)) * u64::from(TILE))
+        .max(1);
+    let rows_per_band = u32::try_from(tile_rows * u64::from(TILE)).unwrap_or(u32::MAX);
+    let rows = Rows::new(scene, world, passes);
     let mut stats = RenderStats::default();
-    for (rays, nonfinite) in per_band {
-        stats.primary_rays += rays;
-        stats.nonfinite_pixels += nonfinite;
+    let mut y = 0;
+    while y < h {
+        let end = y.saturating_add(rows_per_band).min(h);
+        let (band, s) = rows.render(y..end);
+        put(&band)?;
+        stats.primary_rays += s.primary_rays;
+        stats.nonfinite_pixels += s.nonfinite_pixels;
+        y = end;
     }
-    (frame, stats)
+    Ok(stats)
+}
+
+/// What renders rows of the frame: the camera's rays, the screen cull, the kind of light.
+struct Rows<'a> {
+    scene: &'a Scene,
+    world: &'a World,
+    passes: Passes,
+    cam: CameraRays,
+    cull: Option<ScreenCull>,
+    spectral: bool,
+}
+
+impl<'a> Rows<'a> {
+    fn new(scene: &'a Scene, world: &'a World, passes: Passes) -> Self {
+        let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
+        let cull = ScreenCull::new(world, &cam);
+        let spectral = needs_spectra(scene);
+        Self {
+            scene,
+            world,
+            passes,
+            cam,
+            cull,
+            spectral,
+        }
+    }
+
+    /// Rows `rows` of the frame (`rows.start` a multiple of TILE), as a frame of their own.
+    /// Each band of TILE rows is rendered tile by tile straight into its rows (no second copy
+    /// of the image in flight).
+    fn render(&self, rows: std::ops::Range<u32>) -> (Frame, RenderStats) {
+        debug_assert!(rows.start.is_multiple_of(TILE));
+        let (scene, world, passes) = (self.scene, self.world, self.passes);
+        let (w, _) = scene.image.frame_size();
+        let mut frame = Frame::new(w, rows.end - rows.start);
+        let band = (w * TILE) as usize;
+        let per_band: Vec<(u64, u64)> = frame
+            .pixels
+            .par_chunks_mut(band.max(1))
+            .enumerate()
+            .map(|(b, out)| {
+                let y0 = rows.start + b as u32 * TILE;
+                let (mut counts, mut scratch) = ((0, 0), tile::TileScratch::default());
+                for x0 in (0..w).step_by(TILE as usize) {
+                    let xy = (x0, y0);
+                    let (cam, cull) = (&self.cam, self.cull.as_ref());
+                    let tile = if self.spectral {
+                        let seen = Seen::of(scene);
+                        let s = &mut scratch;
+                        tile::render_tile::<Sampled>(seen, scene, world, cam, cull, xy, passes, s)
+                    } else {
+                        let s = &mut scratch;
+                        let seen = Seen::NONE;
+                        tile::render_tile::<DVec3>(seen, scene, world, cam, cull, xy, passes, s)
+                    };
+                    counts.0 += tile.primary_rays;
+                    counts.1 += tile.nonfinite;
+                    for p in tile.pixels {
+                        out[((p.y - y0) * w + p.x) as usize] = p.value;
+                    }
+                }
+                counts
+            })
+            .collect();
+        let mut stats = RenderStats::default();
+        for (rays, nonfinite) in per_band {
+            stats.primary_rays += rays;
+            stats.nonfinite_pixels += nonfinite;
+        }
+        (frame, stats)
+    }
 }

@@ -22,6 +22,15 @@ pub fn load_file(
     overrides: &[(String, String)],
 ) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
+    // Parsing keeps every value with its place in the file: about 45 bytes of memory per byte
+    // of a file of numbers (a mesh). Refused here rather than aborted halfway.
+    if let Ok(m) = std::fs::metadata(path) {
+        let need = m.len().saturating_mul(crate::memory::BYTES_PER_SCENE_BYTE);
+        let what = format!("reading a scene file of {}", crate::memory::human(m.len()));
+        if let Some(why) = crate::memory::too_much(need, &what) {
+            return Err(SceneError::new(shown, "", why));
+        }
+    }
     let text = std::fs::read_to_string(path).map_err(|e| {
         SceneError::new(
             shown.clone(),

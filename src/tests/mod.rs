@@ -5,6 +5,7 @@
 #[path = "../../tests/common/basics.rs"]
 mod common;
 
+mod bands;
 mod fused_primary;
 mod light_buffer;
 mod many_groups;

@@ -1,0 +1,75 @@
+//! Large PNGs are rendered and written a band of rows at a time: the bands hold exactly the
+//! whole frame's pixels, and the PNG decodes to the whole frame's colours.
+
+use crate::accel::backend_by_name;
+use crate::bench::paper;
+use crate::output::srgb_encode;
+use crate::render::{render_world_in_bands, render_world_passes, Frame, Passes, World};
+
+fn lattice(sets: &[&str]) -> crate::scene::Scene {
+    let mut all: Vec<String> = vec![
+        "image.width=72".into(),
+        "image.height=53".into(),
+        "group.lattice.velocity=[-0.9,0,0]".into(),
+    ];
+    all.extend(sets.iter().map(|s| s.to_string()));
+    paper("lattice", &all).unwrap()
+}
+
+#[test]
+fn bands_hold_the_whole_frame() {
+    for sets in [
+        &[][..],
+        &["image.samples=2"],
+        &["image.crop=[5, 7, 40, 33]"],
+    ] {
+        let s = lattice(sets);
+        let world = World::build(&s, backend_by_name("bvh").unwrap().as_ref()).unwrap();
+        let (whole, whole_stats) = render_world_passes(&s, &world, Passes::Colour);
+        let (w, _) = s.image.frame_size();
+        for min_pixels in [1, u64::from(w) * 40, u64::MAX / 2] {
+            let mut pixels = Vec::new();
+            let mut bands = 0;
+            let stats = render_world_in_bands(&s, &world, Passes::Colour, min_pixels, |b| {
+                assert_eq!(b.width, w);
+                pixels.extend_from_slice(&b.pixels);
+                bands += 1;
+                Ok::<(), ()>(())
+            })
+            .unwrap();
+            assert_eq!(
+                pixels, whole.pixels,
+                "{sets:?}, bands of {min_pixels} pixels"
+            );
+            assert_eq!(stats.primary_rays, whole_stats.primary_rays);
+            if min_pixels == 1 {
+                assert!(bands > 1, "several bands");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_png_written_in_bands_is_the_whole_frame() {
+    let s = lattice(&[]);
+    let world = World::build(&s, backend_by_name("bvh").unwrap().as_ref()).unwrap();
+    let (whole, _) = render_world_passes(&s, &world, Passes::Colour);
+    let path = std::env::temp_dir().join(format!("rest-embree-bands-{}.png", std::process::id()));
+    crate::output::write_png_in_bands(&path, whole.width, whole.height, |put| {
+        render_world_in_bands(&s, &world, Passes::Colour, 1, |b: &Frame| put(b)).map(|_| ())
+    })
+    .unwrap();
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let _ = std::fs::remove_file(&path);
+    assert_eq!((info.width, info.height), (whole.width, whole.height));
+    let expected: Vec<u8> = whole
+        .pixels
+        .iter()
+        .flat_map(|p| p.color.map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8))
+        .collect();
+    assert_eq!(&buf[..info.buffer_size()], &expected[..]);
+    assert!(expected.iter().any(|&b| b > 0), "something is seen");
+}
