@@ -297,3 +297,54 @@ fn renders_beyond_the_memory_limit_are_refused() {
         "{err}"
     );
 }
+
+/// A render stopped by SIGTERM (or Ctrl-C) leaves no partial file: a PNG is written as it
+/// renders, so its partial file exists for the whole render.
+#[cfg(unix)]
+#[test]
+fn a_stopped_render_leaves_no_partial_file() {
+    use std::time::{Duration, Instant};
+    let d = Dir::new("signal");
+    let scene = d.file("scene.toml", GOOD);
+    let out = d.0.join("out.png");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .args([
+            "--width",
+            "4000",
+            "--height",
+            "4000",
+            "--samples",
+            "64",
+            "-q",
+        ])
+        .spawn()
+        .unwrap();
+    let partial = d.0.join(format!(".out.png.partial-{}", child.id()));
+    let start = Instant::now();
+    while !partial.exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no partial file appeared"
+        );
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the render ended too soon to stop"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let killed = std::process::Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{status:?}");
+    assert!(!partial.exists(), "the partial file is removed");
+    assert!(!out.exists(), "no image");
+}
