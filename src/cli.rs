@@ -84,6 +84,13 @@ pub(crate) struct RenderArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Store colour, alpha, normals and the Doppler factor as half floats in an EXR (positions,
+    /// depth, lookback and ids stay full floats).
+    #[arg(long)]
+    pub half: bool,
+    /// An EXR's compression: zip (default), zips, piz, rle or none.
+    #[arg(long, value_name = "NAME", value_parser = exr_compression)]
+    pub compression: Option<output::Compression>,
     /// The most memory the render may use, e.g. 8G or 512M (default: the machine's available
     /// memory); a render that would need more is refused before it starts.
     #[arg(long, value_name = "SIZE", value_parser = memory::parse_size)]
@@ -142,6 +149,11 @@ pub fn main() -> ExitCode {
     }
 }
 
+fn exr_compression(name: &str) -> Result<output::Compression, String> {
+    output::Compression::by_name(name)
+        .ok_or_else(|| format!("one of {}", output::Compression::NAMES.join(", ")))
+}
+
 fn parse() -> Result<Cli, ExitCode> {
     Cli::try_parse().map_err(|e| {
         let _ = e.print();
@@ -176,6 +188,81 @@ fn report(r: crate::Result<()>) -> ExitCode {
     }
 }
 
+/// What an EXR's header says about its render, beside the standard attributes: the scene
+/// file, its overrides on the command line, the backend, samples, the camera's time and velocity, each group's
+/// velocity, and `worldToCamera`.
+fn header(
+    scene: &scene::Scene,
+    backend: &str,
+    args: &RenderArgs,
+) -> Vec<(String, output::Attribute)> {
+    use output::Attribute as A;
+    let cam = &scene.camera;
+    let beta = |v: &crate::spacetime::Velocity| v.beta_vec().to_array().map(|x| x as f32);
+    // OpenEXR's camera space: x right, y up, z the view direction, rows transform row vectors.
+    let (r, u, f, e) = (cam.right, cam.up, cam.forward, cam.position);
+    let world_to_camera = [
+        r.x,
+        u.x,
+        f.x,
+        0.0,
+        r.y,
+        u.y,
+        f.y,
+        0.0,
+        r.z,
+        u.z,
+        f.z,
+        0.0,
+        -e.dot(r),
+        -e.dot(u),
+        -e.dot(f),
+        1.0,
+    ]
+    .map(|x| x as f32);
+    const SHOWN_GROUPS: usize = 1000;
+    let mut groups: Vec<String> = scene
+        .groups
+        .iter()
+        .take(SHOWN_GROUPS)
+        .map(|g| {
+            // β to 12 significant digits: the rapidity it is kept as rounds 0.5 to 0.49999….
+            let b = g
+                .velocity
+                .beta_vec()
+                .to_array()
+                .map(|x| format!("{x:.12e}").parse::<f64>().unwrap_or(x));
+            format!("{}: beta = {b:?}", g.name)
+        })
+        .collect();
+    if scene.groups.len() > SHOWN_GROUPS {
+        groups.push(format!("and {} more", scene.groups.len() - SHOWN_GROUPS));
+    }
+    // What changed the scene on the command line (the flags that change nothing in the
+    // picture, such as --threads or -o, stay out: the same render makes the same file).
+    let overrides: Vec<String> = args
+        .overrides()
+        .into_iter()
+        .map(|(shown, _)| shown)
+        .collect();
+    let scene_file = args.scene.display().to_string();
+    let mut attributes = vec![
+        ("renderScene".into(), A::Text(scene_file)),
+        ("renderBackend".into(), A::Text(backend.into())),
+        ("renderSamples".into(), A::Int(scene.image.samples as i32)),
+        ("cameraTime".into(), A::Number(cam.time)),
+        ("cameraVelocity".into(), A::Vector(beta(&cam.velocity))),
+        ("worldToCamera".into(), A::Matrix(world_to_camera)),
+    ];
+    // OpenEXR has no empty list of strings.
+    for (name, list) in [("renderOverrides", overrides), ("groupVelocities", groups)] {
+        if !list.is_empty() {
+            attributes.push((name.into(), A::Texts(list)));
+        }
+    }
+    attributes
+}
+
 /// A PNG render: colour alone (the passes, and with several samples their extra ray per pixel,
 /// are skipped), written band by band as it is rendered, so a large image is never held whole.
 fn render_png(
@@ -189,7 +276,8 @@ fn render_png(
     let t1 = std::time::Instant::now();
     let (w, h) = scene.image.frame_size();
     let mut stats = render::RenderStats::default();
-    output::write_png_in_bands(path, w, h, |put| {
+    let alpha = scene.image.is_transparent();
+    output::write_png_in_bands(path, (w, h), alpha, |put| {
         let colour = render::Passes::Colour;
         stats = render::render_world_in_bands(scene, &world, colour, memory::BAND_PIXELS, put)?;
         Ok(())
@@ -396,12 +484,22 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         ));
     }
     memory::set_limit(args.max_memory);
-    let scene = scene::load_file(&args.scene, &args.overrides())?;
+    let mut scene = scene::load_file(&args.scene, &args.overrides())?;
+    // A PNG is opaque (the background composited, alpha 1) unless the scene asks for
+    // `transparent = true` (then RGBA); an EXR is transparent unless it asks otherwise.
+    if format == output::Format::Png {
+        scene.image.transparent.get_or_insert(false);
+    }
     fits_in_memory(&scene, format, args)?;
     let stats = match format {
         output::Format::Exr => {
             let (frame, stats) = render::render(&scene, backend.as_ref(), &Default::default())?;
-            output::write(&frame, &args.output)?;
+            let exr = output::ExrOptions {
+                compression: args.compression.unwrap_or_default(),
+                half: args.half,
+                attributes: header(&scene, &backend_name, args),
+            };
+            output::write_with(&frame, &args.output, &exr)?;
             stats
         }
         output::Format::Png => render_png(&scene, backend.as_ref(), &args.output)?,

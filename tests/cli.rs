@@ -33,15 +33,24 @@ fn good_scene_writes_png_and_exr_with_the_passes() {
     assert!(ok, "{err}");
     let (w, h, ch) = rest_embree::output::read_exr_channels(&exr).unwrap();
     assert_eq!((w, h), (40, 32));
-    for name in ["R", "G", "B", "A", "lookback", "doppler", "object_id"] {
+    for name in [
+        "R",
+        "G",
+        "B",
+        "A",
+        "relativity.lookback",
+        "relativity.doppler",
+        "object_id",
+        "depth.Z",
+    ] {
         let c = ch
             .get(name)
             .unwrap_or_else(|| panic!("channel {name} missing; have {:?}", ch.keys()));
         assert!(c.iter().all(|v| v.is_finite()), "channel {name} is finite");
     }
     let ids = &ch["object_id"];
-    let lookback = &ch["lookback"];
-    let doppler = &ch["doppler"];
+    let lookback = &ch["relativity.lookback"];
+    let doppler = &ch["relativity.doppler"];
     let hit = ids
         .iter()
         .position(|&i| i == 1.0)
@@ -102,6 +111,15 @@ fn toml_syntax_error_names_the_line() {
         &with("fov_y = 30", "fov_y = = 30"),
         &[],
         &["scene.toml:4", "not valid TOML"],
+    );
+    // The line is shown with a caret under the place, as cargo shows errors.
+    let d = Dir::new("caret");
+    let scene = d.file("scene.toml", &with("fov_y = 30", "fov_y = [1 2]"));
+    let (ok, err) = run(&["render", scene.to_str().unwrap(), "-o", "x.png"]);
+    assert!(!ok);
+    assert!(
+        err.contains("\n4 | fov_y = [1 2]\n  |            ^"),
+        "{err}"
     );
 }
 
@@ -312,12 +330,15 @@ fn set_addresses_entries_by_name_and_overrides_any_value() {
         "camera.projection=orthographic",
         "--set",
         "camera.view_height=4",
+        "--set",
+        "image.transparent=false",
     ];
     let (ok, err) = run(&args);
     assert!(ok, "{err}");
     let (_, _, ch) = rest_embree::output::read_exr_channels(Path::new(&out)).unwrap();
     let bg = ch["object_id"].iter().position(|&i| i == 0.0).unwrap();
     assert_eq!((ch["R"][bg], ch["G"][bg], ch["B"][bg]), (0.25, 0.5, 1.0));
+    assert!(ch["A"].iter().all(|&a| a == 1.0), "opaque: alpha 1");
 }
 
 #[cfg(not(feature = "embree"))]

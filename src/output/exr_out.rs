@@ -1,4 +1,5 @@
 use super::file::cause;
+use super::{Attribute, ExrOptions};
 use crate::render::{Frame, CHANNELS};
 use crate::{Cause, Error};
 use exr::prelude::*;
@@ -6,26 +7,72 @@ use smallvec::SmallVec;
 use std::collections::HashMap;
 use std::path::Path;
 
-pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), Cause> {
+/// Channels that may be stored as half floats (`--half`): colour, coverage, normals and the
+/// Doppler factor. Positions, depth, lookback and ids keep full precision.
+const MAY_BE_HALF: [&str; 8] = [
+    "R",
+    "G",
+    "B",
+    "A",
+    "N.X",
+    "N.Y",
+    "N.Z",
+    "relativity.doppler",
+];
+
+pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::Result<(), Cause> {
     let size = (frame.width as usize, frame.height as usize);
     let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = CHANNELS
         .iter()
         .map(|&name| {
-            AnyChannel::new(
-                name,
-                FlatSamples::F32(frame.channel(name).expect("known channel")),
-            )
+            let values = frame.channel(name).expect("known channel");
+            let samples = if options.half && MAY_BE_HALF.contains(&name) {
+                FlatSamples::F16(values.into_iter().map(f16::from_f32).collect())
+            } else {
+                FlatSamples::F32(values)
+            };
+            AnyChannel::new(name, samples)
         })
         .collect();
-    let attrs = LayerAttributes {
-        software_name: Some(Text::from("rest-embree")),
+    let mut attrs = LayerAttributes {
+        software_name: Some(Text::from(concat!(
+            "rest-embree ",
+            env!("CARGO_PKG_VERSION")
+        ))),
         ..Default::default()
     };
-    // Blocks in increasing order: compressed in parallel, they are otherwise written as they
-    // finish, and the same image would make a different file from run to run.
+    for (name, value) in &options.attributes {
+        // The standard attributes the exr crate keeps in fields of their own.
+        match (name.as_str(), value) {
+            ("worldToCamera", Attribute::Matrix(m)) => {
+                attrs.world_to_camera = Some(*m);
+                continue;
+            }
+            ("worldToNDC", Attribute::Matrix(m)) => {
+                attrs.world_to_normalized_device = Some(*m);
+                continue;
+            }
+            _ => {}
+        }
+        let value = match value {
+            Attribute::Text(t) => AttributeValue::Text(Text::from(t.as_str())),
+            Attribute::Texts(ts) => {
+                AttributeValue::TextVector(ts.iter().map(|t| Text::from(t.as_str())).collect())
+            }
+            Attribute::Number(x) => AttributeValue::F64(*x),
+            Attribute::Int(i) => AttributeValue::I32(*i),
+            Attribute::Vector(v) => AttributeValue::FloatVec3((v[0], v[1], v[2])),
+            Attribute::Matrix(m) => AttributeValue::Matrix4x4(*m),
+        };
+        attrs.other.insert(Text::from(name.as_str()), value);
+    }
+    // Scanlines, which compositors stream; blocks in increasing order: compressed in
+    // parallel, they are otherwise written as they finish, and the same image would make a
+    // different file from run to run.
     let encoding = Encoding {
+        compression: options.compression.exr(),
+        blocks: Blocks::ScanLines,
         line_order: LineOrder::Increasing,
-        ..Encoding::FAST_LOSSLESS
     };
     let layer = Layer::new(size, attrs, encoding, AnyChannels::sort(list));
     let mut image = Image::from_layer(layer);
@@ -37,7 +84,69 @@ pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), Cause> {
         blue: b,
         white: w,
     });
-    image.write().to_file(path).map_err(cause)
+    image.write().to_file(path).map_err(cause)?;
+    sort_header_attributes(path).map_err(cause)
+}
+
+/// Put the header's attributes in the order of their names. The exr crate keeps custom
+/// attributes in a `HashMap`, whose order changes from process to process, and the same render
+/// would make a different file. The header keeps its length, so the offsets after it hold.
+fn sort_header_attributes(path: &Path) -> std::io::Result<()> {
+    use std::io::{Read, Seek, SeekFrom, Write};
+    let mut file = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(path)?;
+    let mut header = Vec::new();
+    let spans = loop {
+        let mut chunk = vec![0; 1 << 16];
+        let n = file.read(&mut chunk)?;
+        header.extend_from_slice(&chunk[..n]);
+        if let Some(spans) = attribute_spans(&header) {
+            break spans;
+        }
+        if n == 0 {
+            return Err(std::io::Error::other("an EXR header without its end"));
+        }
+    };
+    let (start, end) = (spans[0].start, spans.last().map_or(8, |s| s.end));
+    let mut sorted = spans.clone();
+    sorted.sort_by(|a, b| name_of(&header, a).cmp(name_of(&header, b)));
+    let bytes: Vec<u8> = sorted
+        .iter()
+        .flat_map(|s| header[s.clone()].to_vec())
+        .collect();
+    debug_assert_eq!(bytes.len(), end - start);
+    file.seek(SeekFrom::Start(start as u64))?;
+    file.write_all(&bytes)?;
+    Ok(())
+}
+
+/// The byte ranges of a single-part EXR header's attributes (after the magic number and the
+/// version), or None if `bytes` ends before the header does.
+fn attribute_spans(bytes: &[u8]) -> Option<Vec<std::ops::Range<usize>>> {
+    let mut spans = Vec::new();
+    let mut at = 8;
+    loop {
+        if *bytes.get(at)? == 0 {
+            return Some(spans);
+        }
+        let name_end = at + bytes[at..].iter().position(|&b| b == 0)?;
+        let type_end = name_end + 1 + bytes[name_end + 1..].iter().position(|&b| b == 0)?;
+        let size = bytes.get(type_end + 1..type_end + 5)?;
+        let size = u32::from_le_bytes(size.try_into().ok()?) as usize;
+        let end = type_end + 5 + size;
+        if end > bytes.len() {
+            return None;
+        }
+        spans.push(at..end);
+        at = end;
+    }
+}
+
+fn name_of<'a>(header: &'a [u8], span: &std::ops::Range<usize>) -> &'a [u8] {
+    let s = &header[span.clone()];
+    &s[..s.iter().position(|&b| b == 0).unwrap_or(s.len())]
 }
 
 /// Width, height and every channel by name (f32, row-major) of an EXR file's first layer.

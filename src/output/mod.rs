@@ -41,24 +41,99 @@ impl Format {
     }
 }
 
-/// Write the frame; the file appears only when it is complete (see [`file`]).
+/// Write the frame; the file appears only when it is complete (see [`file`]). An EXR is
+/// written with [`ExrOptions::default`].
 pub fn write(frame: &Frame, path: &Path) -> crate::Result<()> {
+    write_with(frame, path, &ExrOptions::default())
+}
+
+/// As [`write`], an EXR with `exr`'s compression, precision and header attributes.
+pub fn write_with(frame: &Frame, path: &Path, exr: &ExrOptions) -> crate::Result<()> {
     let format = Format::for_path(path)?;
     file::write_whole(path, |tmp| match format {
-        Format::Exr => exr_out::write(frame, tmp),
+        Format::Exr => exr_out::write(frame, tmp, exr),
         Format::Png => png_out::write(frame, tmp),
     })
+}
+
+/// How an EXR is written besides its pixels.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ExrOptions {
+    /// The compression of its scanlines.
+    pub compression: Compression,
+    /// Colour, alpha, normals and the Doppler factor as half floats (positions, depth,
+    /// lookback and ids stay full floats).
+    pub half: bool,
+    /// Attributes of the header beside the standard ones, by name.
+    pub attributes: Vec<(String, Attribute)>,
+}
+
+/// An EXR's lossless compressions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Compression {
+    /// zlib over blocks of 16 scanlines: small, and what compositors read fastest.
+    #[default]
+    Zip,
+    /// zlib per scanline.
+    Zips,
+    /// Wavelets and Huffman: smallest for grainy images.
+    Piz,
+    /// Run lengths: fastest to write, largest.
+    Rle,
+    /// None.
+    None,
+}
+
+impl Compression {
+    /// The names `--compression` takes.
+    pub const NAMES: [&'static str; 5] = ["zip", "zips", "piz", "rle", "none"];
+
+    /// The compression of a name in [`Compression::NAMES`].
+    pub fn by_name(name: &str) -> Option<Compression> {
+        let all = [Self::Zip, Self::Zips, Self::Piz, Self::Rle, Self::None];
+        Self::NAMES.iter().position(|n| *n == name).map(|i| all[i])
+    }
+
+    fn exr(self) -> exr::prelude::Compression {
+        use exr::prelude::Compression as C;
+        match self {
+            Self::Zip => C::ZIP16,
+            Self::Zips => C::ZIP1,
+            Self::Piz => C::PIZ,
+            Self::Rle => C::RLE,
+            Self::None => C::Uncompressed,
+        }
+    }
+}
+
+/// A header attribute's value.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Attribute {
+    /// A string.
+    Text(String),
+    /// Strings.
+    Texts(Vec<String>),
+    /// A double.
+    Number(f64),
+    /// An integer.
+    Int(i32),
+    /// A vector of three floats.
+    Vector([f32; 3]),
+    /// A 4 × 4 matrix, row-major.
+    Matrix([f32; 16]),
 }
 
 /// Write a PNG of `width` × `height` whose rows `fill` hands on in bands, top to bottom, as it
 /// renders them (see [`crate::render`]'s banded rendering): the image is never held whole.
 pub(crate) fn write_png_in_bands(
     path: &Path,
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
+    alpha: bool,
     fill: impl FnOnce(&mut png_out::Bands) -> Result<(), Cause>,
 ) -> crate::Result<()> {
-    file::write_whole(path, |tmp| png_out::write_bands(tmp, width, height, fill))
+    file::write_whole(path, |tmp| {
+        png_out::write_bands(tmp, width, height, alpha, fill)
+    })
 }
 
 /// Linear to sRGB-encoded, after clamping to [0, 1].

@@ -8,34 +8,63 @@ use std::path::Path;
 /// Bands of rows, top to bottom, handed to a sink that encodes them.
 pub type Bands<'a> = dyn FnMut(&Frame) -> Result<(), Cause> + 'a;
 
-/// Write a whole frame.
+/// Write a whole frame (RGB; see [`write_bands`]).
 pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), Cause> {
-    write_bands(path, frame.width, frame.height, |put| put(frame))
+    write_bands(path, frame.width, frame.height, false, |put| put(frame))
 }
 
 /// Write a `width` × `height` image whose rows `fill` hands to its sink in bands, top to
 /// bottom: the rows are encoded as they come, so the image is never held whole.
+/// With `alpha`, RGBA: PNG's alpha is straight, so the premultiplied colour is divided by it.
+/// sRGB, with gAMA and cHRM for readers that ignore the sRGB chunk, and a Software chunk.
 pub fn write_bands(
     path: &Path,
     width: u32,
     height: u32,
+    alpha: bool,
     fill: impl FnOnce(&mut Bands) -> Result<(), Cause>,
 ) -> std::result::Result<(), Cause> {
     let file = std::fs::File::create(path).map_err(cause)?;
     let mut enc = png::Encoder::new(BufWriter::new(file), width, height);
-    enc.set_color(png::ColorType::Rgb);
+    enc.set_color(if alpha {
+        png::ColorType::Rgba
+    } else {
+        png::ColorType::Rgb
+    });
     enc.set_depth(png::BitDepth::Eight);
+    // The sRGB chunk, and the gAMA and cHRM values the PNG specification gives for it.
     enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    enc.set_source_gamma(png::ScaledFloat::from_scaled(45455));
+    let [r, g, b, w] = crate::spectrum::camera::SRGB_CHROMATICITIES
+        .map(|[x, y]| (png::ScaledFloat::new(x), png::ScaledFloat::new(y)));
+    enc.set_source_chromaticities(png::SourceChromaticities::new(
+        (w.0.into_value(), w.1.into_value()),
+        (r.0.into_value(), r.1.into_value()),
+        (g.0.into_value(), g.1.into_value()),
+        (b.0.into_value(), b.1.into_value()),
+    ));
+    let software = concat!("rest-embree ", env!("CARGO_PKG_VERSION"));
+    enc.add_text_chunk("Software".into(), software.into())
+        .map_err(cause)?;
     let mut w = enc.write_header().map_err(cause)?;
     let mut stream = w.stream_writer().map_err(cause)?;
     let mut rows = 0u64;
     fill(&mut |band: &Frame| {
         debug_assert_eq!(band.width, width);
-        let data: Vec<u8> = band
-            .pixels
-            .iter()
-            .flat_map(|p| p.color.map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8))
-            .collect();
+        let byte = |c: f32| (srgb_encode(c) * 255.0 + 0.5) as u8;
+        let data: Vec<u8> = if alpha {
+            band.pixels
+                .iter()
+                .flat_map(|p| {
+                    let a = p.alpha;
+                    let straight = p.color.map(|c| if a > 0.0 { c / a } else { 0.0 });
+                    let [r, g, b] = straight.map(byte);
+                    [r, g, b, (a.clamp(0.0, 1.0) * 255.0 + 0.5) as u8]
+                })
+                .collect()
+        } else {
+            band.pixels.iter().flat_map(|p| p.color.map(byte)).collect()
+        };
         rows += u64::from(band.height);
         stream.write_all(&data).map_err(cause)
     })?;

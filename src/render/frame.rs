@@ -19,7 +19,13 @@ pub struct PixelValue {
     /// The primary hit's point in its group's rest frame (a reference position that follows
     /// the object, for texturing in compositing; 0 for background).
     pub rest_position: [f32; 3],
+    /// Distance along the camera's look axis, in the camera's rest frame, from the imaging
+    /// event to the primary hit's emission event ([`DEPTH_FAR`] where nothing was hit).
+    pub depth: f32,
 }
+
+/// `depth` where nothing was hit: farther than anything a valid scene holds, and finite.
+pub const DEPTH_FAR: f32 = f32::MAX;
 
 /// The rendered image and its extra passes, row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
@@ -54,8 +60,9 @@ impl Frame {
             "G" => |p| p.color[1],
             "B" => |p| p.color[2],
             "A" => |p| p.alpha,
-            "lookback" => |p| p.lookback,
-            "doppler" => |p| p.doppler,
+            "relativity.lookback" => |p| p.lookback,
+            "relativity.doppler" => |p| p.doppler,
+            "depth.Z" => |p| p.depth,
             "object_id" => |p| p.object_id as f32,
             "N.X" => |p| p.normal[0],
             "N.Y" => |p| p.normal[1],
@@ -73,13 +80,14 @@ impl Frame {
 }
 
 /// Channel names written to EXR, in this order.
-pub const CHANNELS: [&str; 16] = [
+pub const CHANNELS: [&str; 17] = [
     "R",
     "G",
     "B",
     "A",
-    "lookback",
-    "doppler",
+    "depth.Z",
+    "relativity.lookback",
+    "relativity.doppler",
     "object_id",
     "N.X",
     "N.Y",

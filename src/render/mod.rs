@@ -16,7 +16,7 @@ mod tile;
 mod world;
 
 pub use band::needs_spectra;
-pub use frame::{Frame, PixelValue, CHANNELS};
+pub use frame::{Frame, PixelValue, CHANNELS, DEPTH_FAR};
 pub use world::WorldOptions;
 
 pub(crate) use band::Seen;

@@ -151,6 +151,12 @@ impl<'a, B: Band> Shader<'a, B> {
         self.scene.image.background.is_black()
     }
 
+    /// Whether primary rays that meet nothing add nothing (a transparent image), or the
+    /// background (an opaque one).
+    pub fn primary_misses_add_nothing(&self) -> bool {
+        self.black_background() || self.scene.image.is_transparent()
+    }
+
     /// What the ray tree below a primary hit may spend.
     pub fn primary_budget(&self) -> Budget {
         Budget::primary(self.scene.render.max_rays)

@@ -203,7 +203,7 @@ fn shade_hits<B: Band>(
     let lights = shader.light_count();
     let budget = shader.primary_budget();
     let follows = shader.follows_frames();
-    let black_sky = shader.black_background();
+    let black_sky = shader.primary_misses_add_nothing();
     let mut shadows = Vec::with_capacity(lights * primary.len());
     // Each ray's hit prepared for shading with the factor its light gains on the way to the
     // camera, or the camera's lookback factor along a ray that meets nothing.
@@ -299,13 +299,17 @@ pub fn render_tile<B: Band>(
     let coords = tile_pixels(x0, y0, w, h);
     let n = scene.image.samples;
     let shader = Shader::<B>::new(scene, world, seen);
-    // Pixels left out by the cull see the background in every sample: the same everywhere
+    // Pixels left out by the cull see the background in every sample (nothing, in a
+    // transparent image): the same everywhere
     // unless the camera moves through a background that is not black (then each pixel's, as
     // seen along its centre ray).
     let still = scene.camera.velocity.is_zero()
         || !shader.follows_frames()
         || scene.image.background.is_black();
-    let mut sum = if still {
+    let transparent = scene.image.is_transparent();
+    let mut sum = if transparent {
+        vec![DVec3::ZERO; coords.len()]
+    } else if still {
         vec![n as f64 * shader.background(1.0, 1.0).to_rgb(); coords.len()]
     } else {
         coords
@@ -357,6 +361,11 @@ pub fn render_tile<B: Band>(
         }
     }
     let mut nonfinite = 0;
+    // Depth is measured in the camera's rest frame, from the imaging event.
+    let (to_camera, eye) = (
+        crate::spacetime::Boost::to_rest(&scene.camera.velocity),
+        scene.camera.imaging_event(),
+    );
     let pixels = coords
         .iter()
         .enumerate()
@@ -368,7 +377,11 @@ pub fn render_tile<B: Band>(
             }
             let mut value = PixelValue {
                 color: c.to_array().map(to_f32),
-                alpha: covered[k] as f32 / n as f32,
+                alpha: if transparent {
+                    covered[k] as f32 / n as f32
+                } else {
+                    1.0
+                },
                 ..Default::default()
             };
             if let Some((r, hit)) = aov[k] {
@@ -383,6 +396,10 @@ pub fn render_tile<B: Band>(
                 value.position = p.to_array().map(to_f32);
                 let q = hit.point;
                 value.rest_position = q.to_array().map(to_f32);
+                let seen_at = to_camera.event(r.at(hit.lambda) - eye).x;
+                value.depth = to_f32(seen_at.dot(scene.camera.forward));
+            } else if aov_sample.is_some() {
+                value.depth = super::DEPTH_FAR;
             }
             TilePixel { x, y, value }
         })

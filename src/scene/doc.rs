@@ -156,16 +156,35 @@ fn convert_item(item: &Item, origin: Origin, lines: &Lines) -> Node {
     }
 }
 
+/// The line `line` (1-based) of `text` with a caret under byte `at`, as cargo shows errors.
+fn pointed(text: &str, lines: &Lines, line: usize, at: usize) -> String {
+    let start = lines.0.get(line - 1).copied().unwrap_or(0);
+    let end = text[start..].find('\n').map_or(text.len(), |e| start + e);
+    let shown = text[start..end].trim_end_matches('\r');
+    // The caret sits under the character, counted in characters (tabs kept as they are).
+    let before: String = text[start..at.clamp(start, end)]
+        .chars()
+        .map(|c| if c == '\t' { '\t' } else { ' ' })
+        .collect();
+    let gutter = " ".repeat(line.to_string().len());
+    format!("\n{gutter} |\n{line} | {shown}\n{gutter} | {before}^")
+}
+
 impl Doc {
     /// Parse a scene file's text; `file` names it in errors.
     pub fn parse(file: &str, text: &str) -> Result<Doc, SceneError> {
         let lines = Lines::new(text);
         let doc = ImDocument::parse(text.to_string()).map_err(|e| {
             let line = lines.line(e.span());
+            let message = e.message().trim().replace('\n', ", ");
+            let shown = e
+                .span()
+                .map(|s| pointed(text, &lines, line, s.start))
+                .unwrap_or_default();
             SceneError::new(
                 format!("{file}:{line}"),
                 "",
-                format!("not valid TOML: {}", e.message().trim()),
+                format!("not valid TOML: {message}{shown}"),
             )
         })?;
         Ok(Doc {

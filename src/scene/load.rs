@@ -85,6 +85,7 @@ fn build(doc: &Doc) -> SceneResult<Scene> {
             samples: 1,
             background: Colour::grey(0.0, Role::Emitter),
             crop: None,
+            transparent: None,
         },
     };
     let render = match root.table("render")? {
@@ -365,6 +366,10 @@ fn image(t: &Table) -> SceneResult<ImageSettings> {
             .colour("background", Role::Emitter)?
             .unwrap_or_else(|| Colour::grey(0.0, Role::Emitter)),
         crop,
+        transparent: match t.get("transparent") {
+            Some(_) => Some(t.bool_or("transparent", true)?),
+            None => None,
+        },
     };
     let (fw, fh) = s.frame_size();
     if fw as u64 * fh as u64 > 1 << 28 {
@@ -378,7 +383,14 @@ fn image(t: &Table) -> SceneResult<ImageSettings> {
             format!("a {fw}x{fh} frame is too large (at most 2^28 pixels; render it in crops)"),
         ));
     }
-    t.finish(&["width", "height", "samples", "background", "crop"])?;
+    t.finish(&[
+        "width",
+        "height",
+        "samples",
+        "background",
+        "crop",
+        "transparent",
+    ])?;
     Ok(s)
 }
 

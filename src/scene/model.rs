@@ -61,9 +61,20 @@ pub struct ImageSettings {
     pub background: Colour,
     /// Render only this window `[x, y, width, height]` of the full image (pixels).
     pub crop: Option<[u32; 4]>,
+    /// Whether the background is left out of the primary rays' colour (premultiplied RGB,
+    /// alpha the coverage) or composited in (alpha 1). None: transparent, except for a PNG
+    /// written by the command line (see [`ImageSettings::is_transparent`]).
+    pub transparent: Option<bool>,
 }
 
 impl ImageSettings {
+    /// Whether the render leaves the background out (the default when the scene says
+    /// nothing): RGB premultiplied by alpha, so that "over" a plate in a compositor equals a
+    /// render with that plate as the background.
+    pub fn is_transparent(&self) -> bool {
+        self.transparent.unwrap_or(true)
+    }
+
     /// Size of the rendered frame: the crop window, or the whole image.
     pub fn frame_size(&self) -> (u32, u32) {
         self.crop

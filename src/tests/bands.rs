@@ -55,7 +55,7 @@ fn a_png_written_in_bands_is_the_whole_frame() {
     let world = World::build(&s, backend_by_name("bvh").unwrap().as_ref()).unwrap();
     let (whole, _) = render_world_passes(&s, &world, Passes::Colour);
     let path = std::env::temp_dir().join(format!("rest-embree-bands-{}.png", std::process::id()));
-    crate::output::write_png_in_bands(&path, whole.width, whole.height, |put| {
+    crate::output::write_png_in_bands(&path, (whole.width, whole.height), false, |put| {
         render_world_in_bands(&s, &world, Passes::Colour, 1, |b: &Frame| put(b)).map(|_| ())
     })
     .unwrap();
