@@ -1,5 +1,6 @@
 //! The command line: `rest-embree render SCENE -o OUT.{exr,png} [options]`.
 
+use crate::render::Passes;
 use crate::{accel, bench, memory, output, render, scene, Error};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -263,27 +264,56 @@ fn header(
     attributes
 }
 
-/// A PNG render: colour alone (the passes, and with several samples their extra ray per pixel,
-/// are skipped), written band by band as it is rendered, so a large image is never held whole.
-fn render_png(
+/// Render to `args.output`: an EXR with every pass, whole; a PNG with colour alone (the passes,
+/// and with several samples their extra ray per pixel, are skipped), written band by band as it
+/// is rendered, so a large image is never held whole. A bar shows the progress when stderr is a
+/// terminal (and not --quiet).
+fn render_to_file(
     scene: &scene::Scene,
     backend: &dyn accel::Backend,
-    path: &Path,
+    backend_name: &str,
+    format: output::Format,
+    args: &RenderArgs,
 ) -> crate::Result<render::RenderStats> {
+    use std::io::IsTerminal;
     let t0 = std::time::Instant::now();
     let world = render::World::build(scene, backend)?;
     let build_time = t0.elapsed();
     let t1 = std::time::Instant::now();
     let (w, h) = scene.image.frame_size();
+    let watching = !args.quiet && std::io::stderr().is_terminal();
+    let progress = watching.then(|| render::Progress::new(u64::from(w) * u64::from(h)));
+    let progress = progress.as_ref();
     let mut stats = render::RenderStats::default();
-    let alpha = scene.image.is_transparent();
-    output::write_png_in_bands(path, (w, h), alpha, |put| {
-        let colour = render::Passes::Colour;
-        stats = render::render_world_in_bands(scene, &world, colour, memory::BAND_PIXELS, put)?;
-        Ok(())
-    })?;
+    let written = match format {
+        output::Format::Exr => {
+            let frame;
+            (frame, stats) = render::render_world_watched(scene, &world, Passes::All, progress);
+            progress.inspect(|p| p.finish());
+            stats.trace_time = t1.elapsed();
+            let exr = output::ExrOptions {
+                compression: args.compression.unwrap_or_default(),
+                half: args.half,
+                attributes: header(scene, backend_name, args),
+            };
+            output::write_with(&frame, &args.output, &exr)
+        }
+        output::Format::Png => {
+            let alpha = scene.image.is_transparent();
+            let written = output::write_png_in_bands(&args.output, (w, h), alpha, |put| {
+                let band = memory::BAND_PIXELS;
+                let colour = Passes::Colour;
+                stats = render::render_world_in_bands(scene, &world, colour, band, progress, put)?;
+                Ok(())
+            });
+            progress.inspect(|p| p.finish());
+            // Rendering and writing are one here.
+            stats.trace_time = t1.elapsed();
+            written
+        }
+    };
+    written?;
     stats.build_time = build_time;
-    stats.trace_time = t1.elapsed();
     Ok(stats)
 }
 
@@ -491,19 +521,7 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         scene.image.transparent.get_or_insert(false);
     }
     fits_in_memory(&scene, format, args)?;
-    let stats = match format {
-        output::Format::Exr => {
-            let (frame, stats) = render::render(&scene, backend.as_ref(), &Default::default())?;
-            let exr = output::ExrOptions {
-                compression: args.compression.unwrap_or_default(),
-                half: args.half,
-                attributes: header(&scene, &backend_name, args),
-            };
-            output::write_with(&frame, &args.output, &exr)?;
-            stats
-        }
-        output::Format::Png => render_png(&scene, backend.as_ref(), &args.output)?,
-    };
+    let stats = render_to_file(&scene, backend.as_ref(), &backend_name, format, args)?;
     if stats.nonfinite_pixels > 0 {
         eprintln!(
             "warning: {} pixels came out NaN or infinite and were set to black; please report this scene",

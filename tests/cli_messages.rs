@@ -348,3 +348,54 @@ fn a_stopped_render_leaves_no_partial_file() {
     assert!(!partial.exists(), "the partial file is removed");
     assert!(!out.exists(), "no image");
 }
+
+/// A render longer than half a second shows a progress bar when stderr is a terminal (here a
+/// pseudo-terminal from `script`), and none when it is a file or with --quiet.
+#[cfg(unix)]
+#[test]
+fn a_progress_bar_on_a_terminal_only() {
+    let d = Dir::new("progress");
+    let scene = d.file("scene.toml", GOOD);
+    let out = d.0.join("out.png");
+    let args = [
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "2000",
+        "--height",
+        "2000",
+        "--samples",
+        "16",
+    ];
+    let on_a_terminal = |extra: &str| {
+        let cmd = format!(
+            "{} {} {extra}",
+            env!("CARGO_BIN_EXE_rest-embree"),
+            args.join(" ")
+        );
+        let out = std::process::Command::new("script")
+            .args(["-qec", &cmd, "/dev/null"])
+            .output()
+            .expect("script (util-linux) runs a command on a pseudo-terminal");
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let shown = on_a_terminal("");
+    assert!(
+        shown.contains("rendering [")
+            && shown.contains("left")
+            && shown.contains("out.png: 2000x2000"),
+        "a bar, then the summary: {shown}"
+    );
+    assert!(
+        !on_a_terminal("--quiet").contains("rendering ["),
+        "--quiet: no bar"
+    );
+    let (code, err) = status(&args);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        !err.contains("rendering [") && err.contains("out.png: 2000x2000"),
+        "{err}"
+    );
+}

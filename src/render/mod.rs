@@ -8,6 +8,7 @@ mod camera;
 mod frame;
 mod group_tree;
 mod light_tree;
+mod progress;
 mod ray_budget;
 mod sampler;
 mod screen_cull;
@@ -21,6 +22,7 @@ pub use world::WorldOptions;
 
 pub(crate) use band::Seen;
 pub(crate) use camera::CameraRays;
+pub(crate) use progress::Progress;
 pub(crate) use screen_cull::ScreenCull;
 pub(crate) use world::World;
 // What the tests of the internals reach (src/tests/).
@@ -157,8 +159,18 @@ pub(crate) fn render_world_passes(
     world: &World,
     passes: Passes,
 ) -> (Frame, RenderStats) {
+    render_world_watched(scene, world, passes, None)
+}
+
+/// As [`render_world_passes`], counting the pixels done on `progress`.
+pub(crate) fn render_world_watched(
+    scene: &Scene,
+    world: &World,
+    passes: Passes,
+    progress: Option<&Progress>,
+) -> (Frame, RenderStats) {
     let (_, h) = scene.image.frame_size();
-    Rows::new(scene, world, passes).render(0..h)
+    Rows::new(scene, world, passes, progress).render(0..h)
 }
 
 /// Render the frame a band of at least `min_pixels` pixels at a time (whole rows of tiles), top
@@ -169,6 +181,7 @@ pub(crate) fn render_world_in_bands<E>(
     world: &World,
     passes: Passes,
     min_pixels: u64,
+    progress: Option<&Progress>,
     mut put: impl FnMut(&Frame) -> Result<(), E>,
 ) -> Result<RenderStats, E> {
     let (w, h) = scene.image.frame_size();
@@ -176,7 +189,7 @@ pub(crate) fn render_world_in_bands<E>(
         .div_ceil(u64::from(w.max(1)) * u64::from(TILE))
         .max(1);
     let rows_per_band = u32::try_from(tile_rows * u64::from(TILE)).unwrap_or(u32::MAX);
-    let rows = Rows::new(scene, world, passes);
+    let rows = Rows::new(scene, world, passes, progress);
     let mut stats = RenderStats::default();
     let mut y = 0;
     while y < h {
@@ -198,10 +211,16 @@ struct Rows<'a> {
     cam: CameraRays,
     cull: Option<ScreenCull>,
     spectral: bool,
+    progress: Option<&'a Progress>,
 }
 
 impl<'a> Rows<'a> {
-    fn new(scene: &'a Scene, world: &'a World, passes: Passes) -> Self {
+    fn new(
+        scene: &'a Scene,
+        world: &'a World,
+        passes: Passes,
+        progress: Option<&'a Progress>,
+    ) -> Self {
         let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
         let cull = ScreenCull::new(world, &cam);
         let spectral = needs_spectra(scene);
@@ -212,6 +231,7 @@ impl<'a> Rows<'a> {
             cam,
             cull,
             spectral,
+            progress,
         }
     }
 
@@ -245,6 +265,9 @@ impl<'a> Rows<'a> {
                     };
                     counts.0 += tile.primary_rays;
                     counts.1 += tile.nonfinite;
+                    if let Some(p) = self.progress {
+                        p.add(tile.pixels.len() as u64);
+                    }
                     for p in tile.pixels {
                         out[((p.y - y0) * w + p.x) as usize] = p.value;
                     }

@@ -30,7 +30,7 @@ fn bands_hold_the_whole_frame() {
         for min_pixels in [1, u64::from(w) * 40, u64::MAX / 2] {
             let mut pixels = Vec::new();
             let mut bands = 0;
-            let stats = render_world_in_bands(&s, &world, Passes::Colour, min_pixels, |b| {
+            let stats = render_world_in_bands(&s, &world, Passes::Colour, min_pixels, None, |b| {
                 assert_eq!(b.width, w);
                 pixels.extend_from_slice(&b.pixels);
                 bands += 1;
@@ -56,7 +56,7 @@ fn a_png_written_in_bands_is_the_whole_frame() {
     let (whole, _) = render_world_passes(&s, &world, Passes::Colour);
     let path = std::env::temp_dir().join(format!("rest-embree-bands-{}.png", std::process::id()));
     crate::output::write_png_in_bands(&path, (whole.width, whole.height), false, |put| {
-        render_world_in_bands(&s, &world, Passes::Colour, 1, |b: &Frame| put(b)).map(|_| ())
+        render_world_in_bands(&s, &world, Passes::Colour, 1, None, |b: &Frame| put(b)).map(|_| ())
     })
     .unwrap();
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
