@@ -264,6 +264,22 @@ fn header(
     attributes
 }
 
+/// The names of the scene's objects and materials for the Cryptomatte manifests: an object's
+/// `name`, or where it has none its group, kind and place in the file.
+fn matte_names(scene: &scene::Scene) -> output::cryptomatte::MatteNames {
+    let objects = scene
+        .objects
+        .iter()
+        .enumerate()
+        .map(|(i, o)| match &o.name {
+            Some(n) => n.clone(),
+            None => format!("{}/{}{i}", scene.groups[o.group].name, o.kind),
+        })
+        .collect();
+    let materials = scene.materials.iter().map(|m| m.name.clone()).collect();
+    output::cryptomatte::MatteNames { objects, materials }
+}
+
 /// Render to `args.output`: an EXR with every pass, whole; a PNG with colour alone (the passes,
 /// and with several samples their extra ray per pixel, are skipped), written band by band as it
 /// is rendered, so a large image is never held whole. A bar shows the progress when stderr is a
@@ -295,6 +311,7 @@ fn render_to_file(
                 compression: args.compression.unwrap_or_default(),
                 half: args.half,
                 attributes: header(scene, backend_name, args),
+                mattes: Some(matte_names(scene)),
             };
             output::write_with(&frame, &args.output, &exr)
         }

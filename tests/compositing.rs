@@ -32,8 +32,11 @@ fn channels_types_compression_and_header_as_openimageio_reads_them() {
     assert_eq!(code, Some(0), "{err}");
     let info = oiiotool(&["--info", "-v", plain.to_str().unwrap()]);
     for needle in [
-        "17 channel, float openexr",
-        "channel list: R, G, B, A, object_id, N.X, N.Y, N.Z, P.X, P.Y, P.Z, Pref.X, Pref.Y, Pref.Z, depth.Z, relativity.doppler, relativity.lookback",
+        "46 channel, float openexr",
+        "channel list: R, G, B, A, material_id, object_id, primitive_id, CryptoMaterial00.R, CryptoMaterial00.G, CryptoMaterial00.B, CryptoMaterial00.A, CryptoMaterial01.R",
+        "CryptoObject02.A, N.X, N.Y, N.Z, P.X, P.Y, P.Z, Pcam.X, Pcam.Y, Pcam.Z, Pref.X, Pref.Y, Pref.Z, depth.Z, relativity.doppler, relativity.lookback",
+        "/name: \"CryptoObject\"",
+        "/name: \"CryptoMaterial\"",
         "compression: \"zip\"",
         "software: \"rest-embree",
         "chromaticities: 0.64, 0.33, 0.3, 0.6, 0.15, 0.06, 0.3127, 0.329",
@@ -62,6 +65,7 @@ fn channels_types_compression_and_header_as_openimageio_reads_them() {
         "relativity.lookback (float)",
         "P.X (float)",
         "object_id (float)",
+        "CryptoObject00.R (float)",
         "compression: \"piz\"",
     ] {
         assert!(info.contains(needle), "`{needle}` in:\n{info}");
@@ -157,6 +161,14 @@ fn depth_is_the_distance_along_the_look_axis() {
                     "{backend}, {cube}/{camera}: depth {z}"
                 );
             }
+            for p in f.pixels.iter().filter(|p| p.alpha > 0.0) {
+                assert_eq!(p.camera_position[2], p.depth, "Pcam.Z is the depth");
+                assert_eq!(
+                    (p.material_id, p.primitive_id),
+                    (1, 1),
+                    "the default material"
+                );
+            }
             for p in f.pixels.iter().filter(|p| p.alpha == 0.0) {
                 assert_eq!(p.depth, rest_embree::render::DEPTH_FAR);
             }
@@ -188,5 +200,173 @@ fn png_chunks_and_alpha() {
     assert!(
         info.contains("4 channel") && info.contains("R, G, B, A"),
         "{info}"
+    );
+}
+
+/// The Cryptomatte layers, decoded by the specification (the layer found by its `name`
+/// attribute, ids looked up in its manifest, ranks summed per name), give each object its
+/// coverage: a whole pixel inside one object, and a pixel on the edge between two boxes split
+/// in proportion to their areas in it.
+#[test]
+fn cryptomatte_decodes_to_each_objects_coverage() {
+    use exr::prelude::*;
+    let d = Dir::new("cryptomatte");
+    // f = 100 px; the boxes meet at x = 0.03 at distance 10: 0.3 px right of the centre line
+    // (columns 19 | 20 of 40), so pixel column 20 is 30% left box, 70% right box.
+    let text = r#"
+[camera]
+position = [0, 0, 0]
+direction = [0, 1, 0]
+fov_y = 22.619864948
+[image]
+width = 40
+height = 40
+samples = 256
+[[group]]
+name = "g"
+[[group.object]]
+name = "left box"
+type = "box"
+min = [-2, 10, -1]
+max = [0.03, 11, 1]
+[[group.object]]
+name = "right box"
+type = "box"
+min = [0.03, 10, -1]
+max = [2, 11, 1]
+"#;
+    let scene = d.file("scene.toml", text);
+    let out = d.0.join("out.exr");
+    let (code, err) = status(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(&out)
+        .unwrap();
+    let text_attr = |name: &str| {
+        image
+            .layer_data
+            .attributes
+            .other
+            .iter()
+            .chain(&image.attributes.other)
+            .find(|(k, _)| *k == name)
+            .map(|(_, v)| match v {
+                AttributeValue::Text(t) => t.to_string(),
+                other => panic!("{name}: {other:?}"),
+            })
+    };
+    let key = image
+        .layer_data
+        .attributes
+        .other
+        .iter()
+        .find(|(k, v)| {
+            k.to_string().ends_with("/name")
+                && matches!(v, AttributeValue::Text(t) if t == "CryptoObject")
+        })
+        .map(|(k, _)| k.to_string().split('/').nth(1).unwrap().to_string())
+        .expect("a CryptoObject layer");
+    assert_eq!(
+        text_attr(&format!("cryptomatte/{key}/hash")).unwrap(),
+        "MurmurHash3_32"
+    );
+    let manifest: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_str(&text_attr(&format!("cryptomatte/{key}/manifest")).unwrap()).unwrap();
+    let name_of: std::collections::HashMap<u32, String> = manifest
+        .iter()
+        .map(|(n, h)| {
+            (
+                u32::from_str_radix(h.as_str().unwrap(), 16).unwrap(),
+                n.clone(),
+            )
+        })
+        .collect();
+    let channel = |name: &str| -> Vec<f32> {
+        let c = image
+            .layer_data
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+            .unwrap_or_else(|| panic!("channel {name}"));
+        c.sample_data.values_as_f32().collect()
+    };
+    let alpha = channel("A");
+    let mut coverage = vec![std::collections::HashMap::<String, f32>::new(); alpha.len()];
+    for level in 0..3 {
+        for (id, cov) in [("R", "G"), ("B", "A")] {
+            let ids = channel(&format!("CryptoObject{level:02}.{id}"));
+            let covs = channel(&format!("CryptoObject{level:02}.{cov}"));
+            for (p, (&i, &c)) in ids.iter().zip(&covs).enumerate() {
+                if c > 0.0 {
+                    let name = name_of.get(&i.to_bits()).expect("every id in the manifest");
+                    *coverage[p].entry(name.clone()).or_default() += c;
+                }
+            }
+        }
+    }
+    let at =
+        |x: usize, y: usize, name: &str| coverage[y * 40 + x].get(name).copied().unwrap_or(0.0);
+    for y in 12..28 {
+        let total: f32 = coverage[y * 40 + 20].values().sum();
+        assert!(
+            (total - alpha[y * 40 + 20]).abs() < 1e-6,
+            "coverage adds up to alpha"
+        );
+        assert!(
+            at(10, y, "left box") >= 0.99 && at(30, y, "right box") >= 0.99,
+            "row {y}"
+        );
+        let (l, r) = (at(20, y, "left box"), at(20, y, "right box"));
+        assert!(
+            (l - 0.3).abs() <= 0.05 && (r - 0.7).abs() <= 0.05,
+            "row {y}: {l} / {r}"
+        );
+    }
+}
+
+/// Ids per primitive tell a lattice's spheres and rods apart: (object_id, primitive_id) names
+/// one primitive, the same one from whichever backend.
+#[test]
+fn primitive_ids_tell_a_lattices_parts_apart() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/lattice.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let sets = [
+        ("--width 96".to_string(), "image.width=96".to_string()),
+        ("--height 64".to_string(), "image.height=64".to_string()),
+    ];
+    let s = rest_embree::scene::load_str("lattice.toml", &text, &sets).unwrap();
+    let frames: Vec<_> = backends().into_iter().map(|b| render_with(&s, b)).collect();
+    let ids = |f: &rest_embree::render::Frame| -> Vec<(u32, u32, u32)> {
+        let id = |p: &rest_embree::render::PixelValue| (p.object_id, p.material_id, p.primitive_id);
+        f.pixels.iter().map(id).collect()
+    };
+    let distinct: std::collections::BTreeSet<u32> = frames[0]
+        .pixels
+        .iter()
+        .map(|p| p.primitive_id)
+        .filter(|&i| i > 0)
+        .collect();
+    assert!(
+        distinct.len() > 50,
+        "many primitives seen: {}",
+        distinct.len()
+    );
+    let (a, b) = (ids(&frames[0]), ids(frames.last().unwrap()));
+    let same = a.iter().zip(&b).filter(|(x, y)| x == y).count();
+    assert!(
+        same as f64 >= 0.99 * a.len() as f64,
+        "{same} of {} pixels name the same primitive",
+        a.len()
     );
 }

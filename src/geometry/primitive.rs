@@ -85,6 +85,20 @@ impl Geometry {
         &self.parts[i]
     }
 
+    /// The index of primitive `prim` among its object's primitives (an object's parts are
+    /// contiguous, whatever groups were merged around them).
+    pub fn index_in_object(&self, prim: u32) -> u32 {
+        let i = self.parts.partition_point(|p| p.end <= prim);
+        let object = self.parts[i].object;
+        let earlier: u32 = self.parts[..i]
+            .iter()
+            .rev()
+            .take_while(|p| p.object == object)
+            .map(|p| p.end - p.start)
+            .sum();
+        earlier + prim - self.parts[i].start
+    }
+
     /// The box holding every primitive.
     pub fn bounds(&self) -> Aabb {
         self.prims

@@ -1,5 +1,5 @@
 use super::file::cause;
-use super::{Attribute, ExrOptions};
+use super::{cryptomatte, Attribute, ExrOptions};
 use crate::render::{Frame, CHANNELS};
 use crate::{Cause, Error};
 use exr::prelude::*;
@@ -22,7 +22,7 @@ const MAY_BE_HALF: [&str; 8] = [
 
 pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::Result<(), Cause> {
     let size = (frame.width as usize, frame.height as usize);
-    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = CHANNELS
+    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = CHANNELS
         .iter()
         .map(|&name| {
             let values = frame.channel(name).expect("known channel");
@@ -34,6 +34,23 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
             AnyChannel::new(name, samples)
         })
         .collect();
+    let mut extra = Vec::new();
+    if let (Some(names), false) = (&options.mattes, frame.mattes.is_empty()) {
+        let kinds: [(&str, cryptomatte::Pick, &[String]); 2] = [
+            ("CryptoObject", |m| &m.object, &names.objects),
+            ("CryptoMaterial", |m| &m.material, &names.materials),
+        ];
+        for (layer, pick, names) in kinds {
+            let (channels, attributes) = cryptomatte::layer(layer, &frame.mattes, pick, names);
+            // Ids are bit patterns: always full float.
+            list.extend(
+                channels
+                    .into_iter()
+                    .map(|(name, values)| AnyChannel::new(name.as_str(), FlatSamples::F32(values))),
+            );
+            extra.extend(attributes);
+        }
+    }
     let mut attrs = LayerAttributes {
         software_name: Some(Text::from(concat!(
             "rest-embree ",
@@ -41,7 +58,7 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
         ))),
         ..Default::default()
     };
-    for (name, value) in &options.attributes {
+    for (name, value) in options.attributes.iter().chain(&extra) {
         // The standard attributes the exr crate keeps in fields of their own.
         match (name.as_str(), value) {
             ("worldToCamera", Attribute::Matrix(m)) => {

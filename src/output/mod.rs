@@ -1,6 +1,7 @@
 //! Writing a rendered frame: EXR (linear float, with the extra passes) or PNG (tone-mapped
 //! sRGB), chosen by the file extension. Files are written whole or not at all.
 
+pub mod cryptomatte;
 mod exr_out;
 pub mod file;
 mod png_out;
@@ -41,13 +42,13 @@ impl Format {
     }
 }
 
-/// Write the frame; the file appears only when it is complete (see [`file`]). An EXR is
+/// Write the frame; the file appears only when it is complete (see [`mod@file`]). An EXR is
 /// written with [`ExrOptions::default`].
 pub fn write(frame: &Frame, path: &Path) -> crate::Result<()> {
     write_with(frame, path, &ExrOptions::default())
 }
 
-/// As [`write`], an EXR with `exr`'s compression, precision and header attributes.
+/// As [`write()`], an EXR with `exr`'s compression, precision and header attributes.
 pub fn write_with(frame: &Frame, path: &Path, exr: &ExrOptions) -> crate::Result<()> {
     let format = Format::for_path(path)?;
     file::write_whole(path, |tmp| match format {
@@ -66,6 +67,9 @@ pub struct ExrOptions {
     pub half: bool,
     /// Attributes of the header beside the standard ones, by name.
     pub attributes: Vec<(String, Attribute)>,
+    /// The names for Cryptomatte layers (`CryptoObject`, `CryptoMaterial`) of a frame that
+    /// has mattes; None: no such layers.
+    pub mattes: Option<cryptomatte::MatteNames>,
 }
 
 /// An EXR's lossless compressions.

@@ -17,7 +17,7 @@ mod tile;
 mod world;
 
 pub use band::needs_spectra;
-pub use frame::{Frame, PixelValue, CHANNELS, DEPTH_FAR};
+pub use frame::{Frame, Mattes, PixelValue, CHANNELS, DEPTH_FAR, MATTE_RANKS};
 pub use world::WorldOptions;
 
 pub(crate) use band::Seen;
@@ -243,12 +243,20 @@ impl<'a> Rows<'a> {
         let (scene, world, passes) = (self.scene, self.world, self.passes);
         let (w, _) = scene.image.frame_size();
         let mut frame = Frame::new(w, rows.end - rows.start);
-        let band = (w * TILE) as usize;
+        let band = ((w * TILE) as usize).max(1);
+        let bands = frame.pixels.len().div_ceil(band);
+        if passes == Passes::All {
+            frame.mattes = vec![Default::default(); frame.pixels.len()];
+        }
+        // Each band's mattes beside its pixels (none in a render of colour alone).
+        let mut mattes: Vec<&mut [Mattes]> = frame.mattes.chunks_mut(band).collect();
+        mattes.resize_with(bands, Default::default);
         let per_band: Vec<(u64, u64)> = frame
             .pixels
-            .par_chunks_mut(band.max(1))
+            .par_chunks_mut(band)
+            .zip(mattes.into_par_iter())
             .enumerate()
-            .map(|(b, out)| {
+            .map(|(b, (out, out_mattes))| {
                 let y0 = rows.start + b as u32 * TILE;
                 let (mut counts, mut scratch) = ((0, 0), tile::TileScratch::default());
                 for x0 in (0..w).step_by(TILE as usize) {
@@ -269,7 +277,11 @@ impl<'a> Rows<'a> {
                         p.add(tile.pixels.len() as u64);
                     }
                     for p in tile.pixels {
-                        out[((p.y - y0) * w + p.x) as usize] = p.value;
+                        let at = ((p.y - y0) * w + p.x) as usize;
+                        out[at] = p.value;
+                        if let Some(m) = out_mattes.get_mut(at) {
+                            *m = p.mattes;
+                        }
                     }
                 }
                 counts

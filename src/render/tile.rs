@@ -3,7 +3,7 @@
 
 use super::band::{Band, Seen};
 use super::camera::CameraRays;
-use super::frame::PixelValue;
+use super::frame::{Mattes, PixelValue, MATTE_RANKS};
 use super::sampler::sample_offset;
 use super::screen_cull::ScreenCull;
 use super::shade::Shader;
@@ -272,6 +272,8 @@ pub struct TilePixel {
     pub x: u32,
     pub y: u32,
     pub value: PixelValue,
+    /// Default where the passes are not rendered.
+    pub mattes: Mattes,
 }
 
 pub struct TileResult {
@@ -339,6 +341,12 @@ pub fn render_tile<B: Band>(
         Passes::All => Some(0),
     };
     let aov_pass = aov_sample == Some(n);
+    // Which objects and materials each pixel's samples saw, for the mattes (with the passes).
+    let mut seen: Vec<[Counts; 2]> = if aov_sample.is_some() {
+        vec![Default::default(); coords.len()]
+    } else {
+        Vec::new()
+    };
     for s in 0..n + u32::from(aov_pass) {
         let centre = s == n;
         let sample = if centre { None } else { Some((s, n)) };
@@ -354,6 +362,11 @@ pub fn render_tile<B: Band>(
             if !centre {
                 covered[k] += u32::from(primary.is_hit(j));
                 sum[k] += colors[j];
+                if let (Some(h), Some([objects, materials])) = (primary.hit(j), seen.get_mut(k)) {
+                    let part = world.groups[h.group].geometry.part_of(h.prim);
+                    count(objects, part.object + 1);
+                    count(materials, part.material + 1);
+                }
             }
             if Some(s) == aov_sample {
                 aov[k] = primary.hit(j).map(|hh| (primary.ray(j), hh));
@@ -390,18 +403,35 @@ pub fn render_tile<B: Band>(
                 let nrm = prim.normal(hit.point);
                 value.lookback = to_f32(hit.lambda);
                 value.doppler = to_f32(cam.lookback_factor(r.dir) / hit.s);
-                value.object_id = g.geometry.part_of(hit.prim).object + 1;
+                let part = g.geometry.part_of(hit.prim);
+                value.object_id = part.object + 1;
+                value.material_id = part.material + 1;
+                value.primitive_id = g.geometry.index_in_object(hit.prim) + 1;
                 value.normal = [nrm.x as f32, nrm.y as f32, nrm.z as f32];
                 let p = r.at(hit.lambda).x;
                 value.position = p.to_array().map(to_f32);
                 let q = hit.point;
                 value.rest_position = q.to_array().map(to_f32);
                 let seen_at = to_camera.event(r.at(hit.lambda) - eye).x;
-                value.depth = to_f32(seen_at.dot(scene.camera.forward));
+                let c = &scene.camera;
+                let on_axes = [c.right, c.up, c.forward].map(|a| to_f32(seen_at.dot(a)));
+                value.camera_position = on_axes;
+                value.depth = on_axes[2];
             } else if aov_sample.is_some() {
                 value.depth = super::DEPTH_FAR;
             }
-            TilePixel { x, y, value }
+            let mattes = seen
+                .get(k)
+                .map_or(Mattes::default(), |[objects, materials]| Mattes {
+                    object: ranked(objects, n),
+                    material: ranked(materials, n),
+                });
+            TilePixel {
+                x,
+                y,
+                value,
+                mattes,
+            }
         })
         .collect();
     TileResult {
@@ -415,4 +445,26 @@ pub fn render_tile<B: Band>(
 /// searchlight can exceed f32's range; an image holds no infinity).
 fn to_f32(v: f64) -> f32 {
     v.clamp(-f64::from(f32::MAX), f64::from(f32::MAX)) as f32
+}
+
+/// How many samples saw each id (index + 1), in the order first seen.
+type Counts = smallvec::SmallVec<[(u32, u32); 4]>;
+
+fn count(counts: &mut Counts, id: u32) {
+    match counts.iter_mut().find(|(i, _)| *i == id) {
+        Some((_, c)) => *c += 1,
+        None => counts.push((id, 1)),
+    }
+}
+
+/// The ids with the most samples, most first (ties by id, so the order is the same on every
+/// run), as (id, share of the `n` samples).
+fn ranked(counts: &Counts, n: u32) -> [(u32, f32); MATTE_RANKS] {
+    let mut sorted = counts.clone();
+    sorted.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    let mut out = [(0, 0.0); MATTE_RANKS];
+    for (slot, &(id, c)) in out.iter_mut().zip(&sorted) {
+        *slot = (id, c as f32 / n as f32);
+    }
+    out
 }
