@@ -189,99 +189,8 @@ fn report(r: crate::Result<()>) -> ExitCode {
     }
 }
 
-/// What an EXR's header says about its render, beside the standard attributes: the scene
-/// file, its overrides on the command line, the backend, samples, the camera's time and velocity, each group's
-/// velocity, and `worldToCamera`.
-fn header(
-    scene: &scene::Scene,
-    backend: &str,
-    args: &RenderArgs,
-) -> Vec<(String, output::Attribute)> {
-    use output::Attribute as A;
-    let cam = &scene.camera;
-    let beta = |v: &crate::spacetime::Velocity| v.beta_vec().to_array().map(|x| x as f32);
-    // OpenEXR's camera space: x right, y up, z the view direction, rows transform row vectors.
-    let (r, u, f, e) = (cam.right, cam.up, cam.forward, cam.position);
-    let world_to_camera = [
-        r.x,
-        u.x,
-        f.x,
-        0.0,
-        r.y,
-        u.y,
-        f.y,
-        0.0,
-        r.z,
-        u.z,
-        f.z,
-        0.0,
-        -e.dot(r),
-        -e.dot(u),
-        -e.dot(f),
-        1.0,
-    ]
-    .map(|x| x as f32);
-    const SHOWN_GROUPS: usize = 1000;
-    let mut groups: Vec<String> = scene
-        .groups
-        .iter()
-        .take(SHOWN_GROUPS)
-        .map(|g| {
-            // β to 12 significant digits: the rapidity it is kept as rounds 0.5 to 0.49999….
-            let b = g
-                .velocity
-                .beta_vec()
-                .to_array()
-                .map(|x| format!("{x:.12e}").parse::<f64>().unwrap_or(x));
-            format!("{}: beta = {b:?}", g.name)
-        })
-        .collect();
-    if scene.groups.len() > SHOWN_GROUPS {
-        groups.push(format!("and {} more", scene.groups.len() - SHOWN_GROUPS));
-    }
-    // What changed the scene on the command line (the flags that change nothing in the
-    // picture, such as --threads or -o, stay out: the same render makes the same file).
-    let overrides: Vec<String> = args
-        .overrides()
-        .into_iter()
-        .map(|(shown, _)| shown)
-        .collect();
-    let scene_file = args.scene.display().to_string();
-    let mut attributes = vec![
-        ("renderScene".into(), A::Text(scene_file)),
-        ("renderBackend".into(), A::Text(backend.into())),
-        ("renderSamples".into(), A::Int(scene.image.samples as i32)),
-        ("cameraTime".into(), A::Number(cam.time)),
-        ("cameraVelocity".into(), A::Vector(beta(&cam.velocity))),
-        ("worldToCamera".into(), A::Matrix(world_to_camera)),
-    ];
-    // OpenEXR has no empty list of strings.
-    for (name, list) in [("renderOverrides", overrides), ("groupVelocities", groups)] {
-        if !list.is_empty() {
-            attributes.push((name.into(), A::Texts(list)));
-        }
-    }
-    attributes
-}
-
-/// The names of the scene's objects and materials for the Cryptomatte manifests: an object's
-/// `name`, or where it has none its group, kind and place in the file.
-fn matte_names(scene: &scene::Scene) -> output::cryptomatte::MatteNames {
-    let objects = scene
-        .objects
-        .iter()
-        .enumerate()
-        .map(|(i, o)| match &o.name {
-            Some(n) => n.clone(),
-            None => format!("{}/{}{i}", scene.groups[o.group].name, o.kind),
-        })
-        .collect();
-    let materials = scene.materials.iter().map(|m| m.name.clone()).collect();
-    output::cryptomatte::MatteNames { objects, materials }
-}
-
 /// Render to `args.output`: an EXR with every pass, whole; a PNG with colour alone (the passes,
-/// and with several samples their extra ray per pixel, are skipped), written band by band as it
+/// and with several samples their extra ray per pixel, are skipped), written strip by strip as it
 /// is rendered, so a large image is never held whole. A bar shows the progress when stderr is a
 /// terminal (and not --quiet).
 fn render_to_file(
@@ -310,17 +219,29 @@ fn render_to_file(
             let exr = output::ExrOptions {
                 compression: args.compression.unwrap_or_default(),
                 half: args.half,
-                attributes: header(scene, backend_name, args),
-                mattes: Some(matte_names(scene)),
+                attributes: output::header::attributes(
+                    scene,
+                    backend_name,
+                    &args.scene.display().to_string(),
+                    // The flags that change nothing in the picture (--threads, -o) stay out:
+                    // the same render makes the same file.
+                    &args
+                        .overrides()
+                        .into_iter()
+                        .map(|(shown, _)| shown)
+                        .collect::<Vec<_>>(),
+                ),
+                mattes: Some(output::header::matte_names(scene)),
             };
             output::write_with(&frame, &args.output, &exr)
         }
         output::Format::Png => {
             let alpha = scene.image.is_transparent();
-            let written = output::write_png_in_bands(&args.output, (w, h), alpha, |put| {
-                let band = memory::BAND_PIXELS;
+            let written = output::write_png_in_strips(&args.output, (w, h), alpha, |put| {
+                let strip = memory::STRIP_PIXELS;
                 let colour = Passes::Colour;
-                stats = render::render_world_in_bands(scene, &world, colour, band, progress, put)?;
+                stats =
+                    render::render_world_in_strips(scene, &world, colour, strip, progress, put)?;
                 Ok(())
             });
             progress.inspect(|p| p.finish());
@@ -342,12 +263,14 @@ fn fits_in_memory(
 ) -> crate::Result<()> {
     let (w, h) = scene.image.frame_size();
     let pixels = u64::from(w) * u64::from(h);
-    // A PNG is written band by band: only a band is held at a time.
+    // A PNG is written strip by strip: only a strip is held at a time.
     let held = match format {
         output::Format::Exr => pixels.saturating_mul(memory::BYTES_PER_PIXEL_EXR),
         output::Format::Png => {
-            let band = memory::BAND_PIXELS + u64::from(w) * u64::from(render::TILE);
-            pixels.min(band).saturating_mul(memory::BYTES_PER_PIXEL_PNG)
+            let strip = memory::STRIP_PIXELS + u64::from(w) * u64::from(render::TILE);
+            pixels
+                .min(strip)
+                .saturating_mul(memory::BYTES_PER_PIXEL_PNG)
         }
     };
     let prims = scene.primitive_count() as u64;

@@ -5,8 +5,8 @@
 //!
 //! The estimates are upper bounds from the sizes of the structures: per pixel the frame's
 //! [`PixelValue`](crate::render::PixelValue) (92 bytes) and, for an EXR, the encoder's copy of
-//! its channels (a PNG is rendered and written a band of [`BAND_PIXELS`] at a time, so only a
-//! band counts); per primitive the f64 primitive, its share of the accelerator and the build's
+//! its channels (a PNG is rendered and written a strip of [`STRIP_PIXELS`] at a time, so only
+//! a strip counts); per primitive the f64 primitive, its share of the accelerator and the build's
 //! buffers (the bench's 100³ lattice, 4 million primitives, peaks near 270 bytes each).
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -16,11 +16,11 @@ pub const BYTES_PER_PRIMITIVE: u64 = 320;
 /// Bytes of memory per byte of a scene file while it is read (a file of numbers, such as an
 /// inline mesh, measured at about 45).
 pub const BYTES_PER_SCENE_BYTE: u64 = 64;
-/// Bytes per pixel of a PNG render's band: the frame's rows, and their 8-bit encoding.
+/// Bytes per pixel of a PNG render's strip: the frame's rows, and their 8-bit encoding.
 pub const BYTES_PER_PIXEL_PNG: u64 = 96;
-/// Pixels a PNG render holds at a time, at least (whole rows of tiles): it is written band by
-/// band as it is rendered.
-pub const BAND_PIXELS: u64 = 1 << 22;
+/// Pixels a PNG render holds at a time, at least (whole rows of tiles): it is written strip
+/// by strip as it is rendered.
+pub const STRIP_PIXELS: u64 = 1 << 22;
 /// Bytes per pixel of an EXR render: the frame (92), its mattes (96), and the encoder's 46
 /// channels of 4 bytes.
 pub const BYTES_PER_PIXEL_EXR: u64 = 380;

@@ -41,6 +41,7 @@ fn channels_types_compression_and_header_as_openimageio_reads_them() {
         "software: \"rest-embree",
         "chromaticities: 0.64, 0.33, 0.3, 0.6, 0.15, 0.06, 0.3127, 0.329",
         "worldToCamera:",
+        "worldToNDC:",
         "cameraTime: 10",
         "groupVelocities: \"cube: beta = [0.5, 0.0, 0.0]\"",
         "renderSamples: 1",

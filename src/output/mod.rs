@@ -4,6 +4,7 @@
 pub mod cryptomatte;
 mod exr_out;
 pub mod file;
+pub mod header;
 mod png_out;
 
 use crate::render::Frame;
@@ -127,16 +128,16 @@ pub enum Attribute {
     Matrix([f32; 16]),
 }
 
-/// Write a PNG of `width` × `height` whose rows `fill` hands on in bands, top to bottom, as it
-/// renders them (see [`crate::render`]'s banded rendering): the image is never held whole.
-pub(crate) fn write_png_in_bands(
+/// Write a PNG of `width` × `height` whose rows `fill` hands on in strips, top to bottom, as
+/// it renders them: the image is never held whole.
+pub(crate) fn write_png_in_strips(
     path: &Path,
     (width, height): (u32, u32),
     alpha: bool,
-    fill: impl FnOnce(&mut png_out::Bands) -> Result<(), Cause>,
+    fill: impl FnOnce(&mut png_out::Strips) -> Result<(), Cause>,
 ) -> crate::Result<()> {
     file::write_whole(path, |tmp| {
-        png_out::write_bands(tmp, width, height, alpha, fill)
+        png_out::write_strips(tmp, width, height, alpha, fill)
     })
 }
 

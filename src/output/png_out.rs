@@ -5,24 +5,24 @@ use crate::Cause;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-/// Bands of rows, top to bottom, handed to a sink that encodes them.
-pub type Bands<'a> = dyn FnMut(&Frame) -> Result<(), Cause> + 'a;
+/// Strips of rows, top to bottom, handed to a sink that encodes them.
+pub type Strips<'a> = dyn FnMut(&Frame) -> Result<(), Cause> + 'a;
 
-/// Write a whole frame (RGB; see [`write_bands`]).
+/// Write a whole frame (RGB; see [`write_strips`]).
 pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), Cause> {
-    write_bands(path, frame.width, frame.height, false, |put| put(frame))
+    write_strips(path, frame.width, frame.height, false, |put| put(frame))
 }
 
-/// Write a `width` × `height` image whose rows `fill` hands to its sink in bands, top to
+/// Write a `width` × `height` image whose rows `fill` hands to its sink in strips, top to
 /// bottom: the rows are encoded as they come, so the image is never held whole.
 /// With `alpha`, RGBA: PNG's alpha is straight, so the premultiplied colour is divided by it.
 /// sRGB, with gAMA and cHRM for readers that ignore the sRGB chunk, and a Software chunk.
-pub fn write_bands(
+pub fn write_strips(
     path: &Path,
     width: u32,
     height: u32,
     alpha: bool,
-    fill: impl FnOnce(&mut Bands) -> Result<(), Cause>,
+    fill: impl FnOnce(&mut Strips) -> Result<(), Cause>,
 ) -> std::result::Result<(), Cause> {
     let file = std::fs::File::create(path).map_err(cause)?;
     let mut enc = png::Encoder::new(BufWriter::new(file), width, height);
@@ -49,11 +49,12 @@ pub fn write_bands(
     let mut w = enc.write_header().map_err(cause)?;
     let mut stream = w.stream_writer().map_err(cause)?;
     let mut rows = 0u64;
-    fill(&mut |band: &Frame| {
-        debug_assert_eq!(band.width, width);
+    fill(&mut |strip: &Frame| {
+        debug_assert_eq!(strip.width, width);
         let byte = |c: f32| (srgb_encode(c) * 255.0 + 0.5) as u8;
         let data: Vec<u8> = if alpha {
-            band.pixels
+            strip
+                .pixels
                 .iter()
                 .flat_map(|p| {
                     let a = p.alpha;
@@ -63,9 +64,13 @@ pub fn write_bands(
                 })
                 .collect()
         } else {
-            band.pixels.iter().flat_map(|p| p.color.map(byte)).collect()
+            strip
+                .pixels
+                .iter()
+                .flat_map(|p| p.color.map(byte))
+                .collect()
         };
-        rows += u64::from(band.height);
+        rows += u64::from(strip.height);
         stream.write_all(&data).map_err(cause)
     })?;
     if rows != u64::from(height) {

@@ -147,7 +147,7 @@ pub(crate) fn primary_rays_by_tile(scene: &Scene) -> Vec<Vec<crate::spacetime::N
         .collect()
 }
 
-/// Render with acceleration structures already built. Each band of TILE rows is rendered tile
+/// Render with acceleration structures already built. Each row of tiles is rendered tile
 /// by tile straight into its rows of the frame (no second copy of the image in flight).
 pub(crate) fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
     render_world_passes(scene, world, Passes::All)
@@ -173,10 +173,10 @@ pub(crate) fn render_world_watched(
     Rows::new(scene, world, passes, progress).render(0..h)
 }
 
-/// Render the frame a band of at least `min_pixels` pixels at a time (whole rows of tiles), top
-/// to bottom, handing each band to `put`: a large image written as it is rendered never holds
-/// the whole frame. The bands hold the whole frame's pixels exactly.
-pub(crate) fn render_world_in_bands<E>(
+/// Render the frame a strip of at least `min_pixels` pixels at a time (whole rows of tiles),
+/// top to bottom, handing each strip to `put`: a large image written as it is rendered never
+/// holds the whole frame. The strips hold the whole frame's pixels exactly.
+pub(crate) fn render_world_in_strips<E>(
     scene: &Scene,
     world: &World,
     passes: Passes,
@@ -188,14 +188,14 @@ pub(crate) fn render_world_in_bands<E>(
     let tile_rows = min_pixels
         .div_ceil(u64::from(w.max(1)) * u64::from(TILE))
         .max(1);
-    let rows_per_band = u32::try_from(tile_rows * u64::from(TILE)).unwrap_or(u32::MAX);
+    let rows_per_strip = u32::try_from(tile_rows * u64::from(TILE)).unwrap_or(u32::MAX);
     let rows = Rows::new(scene, world, passes, progress);
     let mut stats = RenderStats::default();
     let mut y = 0;
     while y < h {
-        let end = y.saturating_add(rows_per_band).min(h);
-        let (band, s) = rows.render(y..end);
-        put(&band)?;
+        let end = y.saturating_add(rows_per_strip).min(h);
+        let (strip, s) = rows.render(y..end);
+        put(&strip)?;
         stats.primary_rays += s.primary_rays;
         stats.nonfinite_pixels += s.nonfinite_pixels;
         y = end;
@@ -236,24 +236,24 @@ impl<'a> Rows<'a> {
     }
 
     /// Rows `rows` of the frame (`rows.start` a multiple of TILE), as a frame of their own.
-    /// Each band of TILE rows is rendered tile by tile straight into its rows (no second copy
+    /// Each row of tiles is rendered tile by tile straight into its rows (no second copy
     /// of the image in flight).
     fn render(&self, rows: std::ops::Range<u32>) -> (Frame, RenderStats) {
         debug_assert!(rows.start.is_multiple_of(TILE));
         let (scene, world, passes) = (self.scene, self.world, self.passes);
         let (w, _) = scene.image.frame_size();
         let mut frame = Frame::new(w, rows.end - rows.start);
-        let band = ((w * TILE) as usize).max(1);
-        let bands = frame.pixels.len().div_ceil(band);
+        let row = ((w * TILE) as usize).max(1);
+        let rows_of_tiles = frame.pixels.len().div_ceil(row);
         if passes == Passes::All {
             frame.mattes = vec![Default::default(); frame.pixels.len()];
         }
-        // Each band's mattes beside its pixels (none in a render of colour alone).
-        let mut mattes: Vec<&mut [Mattes]> = frame.mattes.chunks_mut(band).collect();
-        mattes.resize_with(bands, Default::default);
-        let per_band: Vec<(u64, u64)> = frame
+        // Each row's mattes beside its pixels (none in a render of colour alone).
+        let mut mattes: Vec<&mut [Mattes]> = frame.mattes.chunks_mut(row).collect();
+        mattes.resize_with(rows_of_tiles, Default::default);
+        let per_row: Vec<(u64, u64)> = frame
             .pixels
-            .par_chunks_mut(band)
+            .par_chunks_mut(row)
             .zip(mattes.into_par_iter())
             .enumerate()
             .map(|(b, (out, out_mattes))| {
@@ -288,7 +288,7 @@ impl<'a> Rows<'a> {
             })
             .collect();
         let mut stats = RenderStats::default();
-        for (rays, nonfinite) in per_band {
+        for (rays, nonfinite) in per_row {
             stats.primary_rays += rays;
             stats.nonfinite_pixels += nonfinite;
         }

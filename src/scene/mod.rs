@@ -7,6 +7,7 @@ mod envelope;
 mod error;
 mod load;
 mod model;
+mod objects;
 mod procedural;
 mod reader;
 

@@ -5,9 +5,9 @@
 #[path = "../../tests/common/basics.rs"]
 mod common;
 
-mod bands;
 mod fused_primary;
 mod light_buffer;
 mod many_groups;
 mod screen_cull;
 mod shadow_batches;
+mod strips;

@@ -1,10 +1,10 @@
-//! Large PNGs are rendered and written a band of rows at a time: the bands hold exactly the
+//! Large PNGs are rendered and written a strip of rows at a time: the strips hold exactly the
 //! whole frame's pixels, and the PNG decodes to the whole frame's colours.
 
 use crate::accel::backend_by_name;
 use crate::bench::paper;
 use crate::output::srgb_encode;
-use crate::render::{render_world_in_bands, render_world_passes, Frame, Passes, World};
+use crate::render::{render_world_in_strips, render_world_passes, Frame, Passes, World};
 
 fn lattice(sets: &[&str]) -> crate::scene::Scene {
     let mut all: Vec<String> = vec![
@@ -17,7 +17,7 @@ fn lattice(sets: &[&str]) -> crate::scene::Scene {
 }
 
 #[test]
-fn bands_hold_the_whole_frame() {
+fn strips_hold_the_whole_frame() {
     for sets in [
         &[][..],
         &["image.samples=2"],
@@ -29,34 +29,34 @@ fn bands_hold_the_whole_frame() {
         let (w, _) = s.image.frame_size();
         for min_pixels in [1, u64::from(w) * 40, u64::MAX / 2] {
             let mut pixels = Vec::new();
-            let mut bands = 0;
-            let stats = render_world_in_bands(&s, &world, Passes::Colour, min_pixels, None, |b| {
+            let mut strips = 0;
+            let stats = render_world_in_strips(&s, &world, Passes::Colour, min_pixels, None, |b| {
                 assert_eq!(b.width, w);
                 pixels.extend_from_slice(&b.pixels);
-                bands += 1;
+                strips += 1;
                 Ok::<(), ()>(())
             })
             .unwrap();
             assert_eq!(
                 pixels, whole.pixels,
-                "{sets:?}, bands of {min_pixels} pixels"
+                "{sets:?}, strips of {min_pixels} pixels"
             );
             assert_eq!(stats.primary_rays, whole_stats.primary_rays);
             if min_pixels == 1 {
-                assert!(bands > 1, "several bands");
+                assert!(strips > 1, "several strips");
             }
         }
     }
 }
 
 #[test]
-fn a_png_written_in_bands_is_the_whole_frame() {
+fn a_png_written_in_strips_is_the_whole_frame() {
     let s = lattice(&[]);
     let world = World::build(&s, backend_by_name("bvh").unwrap().as_ref()).unwrap();
     let (whole, _) = render_world_passes(&s, &world, Passes::Colour);
-    let path = std::env::temp_dir().join(format!("rest-embree-bands-{}.png", std::process::id()));
-    crate::output::write_png_in_bands(&path, (whole.width, whole.height), false, |put| {
-        render_world_in_bands(&s, &world, Passes::Colour, 1, None, |b: &Frame| put(b)).map(|_| ())
+    let path = std::env::temp_dir().join(format!("rest-embree-strips-{}.png", std::process::id()));
+    crate::output::write_png_in_strips(&path, (whole.width, whole.height), false, |put| {
+        render_world_in_strips(&s, &world, Passes::Colour, 1, None, |b: &Frame| put(b)).map(|_| ())
     })
     .unwrap();
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
