@@ -410,7 +410,31 @@ fn run_bench(args: &BenchArgs) -> crate::Result<()> {
             )]
         }
     };
-    let rows = bench::run(&cases, args.repeat, |name| eprintln!("bench: {name}"))?;
+    // On a terminal a bar over the cases; otherwise a line per case.
+    let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
+        let bar = indicatif::ProgressBar::new(cases.len() as u64);
+        let style =
+            "bench [{bar:30}] {pos}/{len} cases, {elapsed} elapsed, about {eta} left: {msg}";
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(style)
+                .expect("a valid template")
+                .progress_chars("=> "),
+        );
+        bar
+    });
+    let mut started = 0;
+    let rows = bench::run(&cases, args.repeat, |name| match &bar {
+        Some(bar) => {
+            bar.set_position(started);
+            bar.set_message(name.to_string());
+            started += 1;
+        }
+        None => eprintln!("bench: {name}"),
+    });
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    let rows = rows?;
     let table = bench::table(&rows);
     let summary = bench::summary(&rows);
     println!(

@@ -398,4 +398,31 @@ fn a_progress_bar_on_a_terminal_only() {
         !err.contains("rendering [") && err.contains("out.png: 2000x2000"),
         "{err}"
     );
+    // The bench: a bar over its cases on a terminal, a line per case otherwise.
+    let out = d.0.join("bench");
+    let case = "lattice beta=0.9, no lights";
+    let bench = format!(
+        "{} bench --quick --repeat 1 --case '{case}' --out {}",
+        env!("CARGO_BIN_EXE_rest-embree"),
+        out.display()
+    );
+    let tty = std::process::Command::new("script")
+        .args(["-qec", &bench, "/dev/null"])
+        .output()
+        .unwrap();
+    let shown = String::from_utf8_lossy(&tty.stdout);
+    assert!(
+        shown.contains("bench [") && shown.contains("/1 cases") && shown.contains(case),
+        "{shown}"
+    );
+    let o = out.to_str().unwrap();
+    let quick = [
+        "bench", "--quick", "--repeat", "1", "--case", case, "--out", o,
+    ];
+    let (code, err) = status(&quick);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains(&format!("bench: {case}")) && !err.contains("bench ["),
+        "{err}"
+    );
 }
