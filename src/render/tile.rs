@@ -343,7 +343,10 @@ pub fn render_tile<B: Band>(
     let aov_pass = aov_sample == Some(n);
     // Which objects and materials each pixel's samples saw, for the mattes (with the passes).
     let mut seen: Vec<[Counts; 2]> = if aov_sample.is_some() {
-        vec![Default::default(); coords.len()]
+        // Made, not cloned: a clone of an empty SmallVec costs more than making one.
+        std::iter::repeat_with(Default::default)
+            .take(coords.len())
+            .collect()
     } else {
         Vec::new()
     };
@@ -421,7 +424,7 @@ pub fn render_tile<B: Band>(
                 value.depth = super::DEPTH_FAR;
             }
             let mattes = seen
-                .get(k)
+                .get_mut(k)
                 .map_or(Mattes::default(), |[objects, materials]| Mattes {
                     object: ranked(objects, n),
                     material: ranked(materials, n),
@@ -459,11 +462,10 @@ fn count(counts: &mut Counts, id: u32) {
 
 /// The ids with the most samples, most first (ties by id, so the order is the same on every
 /// run), as (id, share of the `n` samples).
-fn ranked(counts: &Counts, n: u32) -> [(u32, f32); MATTE_RANKS] {
-    let mut sorted = counts.clone();
-    sorted.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+fn ranked(counts: &mut Counts, n: u32) -> [(u32, f32); MATTE_RANKS] {
+    counts.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
     let mut out = [(0, 0.0); MATTE_RANKS];
-    for (slot, &(id, c)) in out.iter_mut().zip(&sorted) {
+    for (slot, &(id, c)) in out.iter_mut().zip(counts.iter()) {
         *slot = (id, c as f32 / n as f32);
     }
     out
