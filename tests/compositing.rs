@@ -371,3 +371,22 @@ fn primitive_ids_tell_a_lattices_parts_apart() {
         a.len()
     );
 }
+
+/// A frame written to PNG from code keeps what it is: a transparent render (the library's
+/// default) becomes RGBA, so its background is not turned black; an opaque one RGB.
+#[test]
+fn png_from_code_keeps_its_alpha() {
+    let d = Dir::new("png-from-code");
+    for (transparent, channels) in [(true, "4 channel"), (false, "3 channel")] {
+        let mut s = scene(GOOD);
+        s.image.transparent = Some(transparent);
+        let f = render_with(&s, backends()[0]);
+        let out = d.0.join(format!("{transparent}.png"));
+        rest_embree::output::write(&f, &out).unwrap();
+        let info = oiiotool(&["--info", out.to_str().unwrap()]);
+        assert!(
+            info.contains(channels),
+            "transparent = {transparent}: {info}"
+        );
+    }
+}

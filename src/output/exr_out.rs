@@ -126,7 +126,10 @@ fn sort_header_attributes(path: &Path) -> std::io::Result<()> {
             return Err(std::io::Error::other("an EXR header without its end"));
         }
     };
-    let (start, end) = (spans[0].start, spans.last().map_or(8, |s| s.end));
+    let (Some(first), Some(last)) = (spans.first(), spans.last()) else {
+        return Ok(());
+    };
+    let (start, end) = (first.start, last.end);
     let mut sorted = spans.clone();
     sorted.sort_by(|a, b| name_of(&header, a).cmp(name_of(&header, b)));
     let bytes: Vec<u8> = sorted

@@ -8,9 +8,12 @@ use std::path::Path;
 /// Strips of rows, top to bottom, handed to a sink that encodes them.
 pub type Strips<'a> = dyn FnMut(&Frame) -> Result<(), Cause> + 'a;
 
-/// Write a whole frame (RGB; see [`write_strips`]).
+/// Write a whole frame: RGB where every pixel is opaque, RGBA (straight alpha) where some are
+/// not, so that a transparent render keeps its coverage instead of going black (see
+/// [`write_strips`]).
 pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), Cause> {
-    write_strips(path, frame.width, frame.height, false, |put| put(frame))
+    let alpha = frame.pixels.iter().any(|p| p.alpha != 1.0);
+    write_strips(path, frame.width, frame.height, alpha, |put| put(frame))
 }
 
 /// Write a `width` × `height` image whose rows `fill` hands to its sink in strips, top to

@@ -146,15 +146,10 @@ impl<'a, B: Band> Shader<'a, B> {
         self.seen.any()
     }
 
-    /// Whether the background is black at every wavelength (then a miss needs no spectrum).
-    pub fn black_background(&self) -> bool {
-        self.scene.image.background.is_black()
-    }
-
-    /// Whether primary rays that meet nothing add nothing (a transparent image), or the
-    /// background (an opaque one).
+    /// Whether primary rays that meet nothing add nothing: a transparent image, or a black
+    /// background.
     pub fn primary_misses_add_nothing(&self) -> bool {
-        self.black_background() || self.scene.image.is_transparent()
+        self.scene.image.background.is_black() || self.scene.image.is_transparent()
     }
 
     /// What the ray tree below a primary hit may spend.
