@@ -25,6 +25,10 @@ pub(crate) enum Command {
     Bench(BenchArgs),
     /// List the intersection backends of this build.
     Backends,
+    /// The bench's own: read a generated scene file of one kind (`groups` or `mesh`) and size in
+    /// this fresh process, and print what it cost.
+    #[command(hide = true)]
+    BenchSceneFile { kind: String, size: usize },
 }
 
 #[derive(clap::Args, Debug)]
@@ -176,6 +180,10 @@ fn run(cli: Cli) -> ExitCode {
         }
         Command::Render(args) => report(run_render(&args)),
         Command::Bench(args) => report(run_bench(&args)),
+        Command::BenchSceneFile { kind, size } => {
+            println!("{}", bench::scene_file_here(&kind, size));
+            ExitCode::SUCCESS
+        }
     }
 }
 
@@ -422,6 +430,12 @@ fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         );
         bar
     });
+    // Measured first, while the process's heap is fresh.
+    let files = if args.scene.is_none() && args.cases.is_empty() {
+        bench::scene_files(args.quick)
+    } else {
+        String::new()
+    };
     let mut started = 0;
     let rows = bench::run(&cases, args.repeat, |name| match &bar {
         Some(bar) => {
@@ -436,7 +450,8 @@ fn run_bench(args: &BenchArgs) -> crate::Result<()> {
     }
     let rows = rows?;
     let table = bench::table(&rows);
-    let summary = bench::summary(&rows);
+    let mut summary = bench::summary(&rows);
+    summary.push_str(&files);
     println!(
         "threads: {}\n\n{table}\n{summary}",
         rayon::current_num_threads()

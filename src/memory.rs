@@ -13,9 +13,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Bytes per primitive: the scene's copy, the accelerator and its build.
 pub const BYTES_PER_PRIMITIVE: u64 = 320;
-/// Bytes of memory per byte of a scene file while it is read (a file of numbers, such as an
-/// inline mesh, measured at about 45).
-pub const BYTES_PER_SCENE_BYTE: u64 = 64;
+/// Bytes of memory per byte of a scene file while it is read: the text, the tokens of its
+/// longest expression and the tree (an inline mesh, the worst case, measured at about 19; a file
+/// of many small groups at about 12).
+pub const BYTES_PER_SCENE_BYTE: u64 = 24;
 /// Bytes per pixel of a PNG render's strip: the frame's rows, and their 8-bit encoding.
 pub const BYTES_PER_PIXEL_PNG: u64 = 96;
 /// Pixels a PNG render holds at a time, at least (whole rows of tiles): it is written strip

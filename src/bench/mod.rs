@@ -13,6 +13,7 @@ mod csv_table;
 mod memory;
 mod plot;
 pub mod probe;
+mod scene_files;
 mod suite;
 
 pub(crate) use suite::{cases, many_groups, paper};
@@ -625,3 +626,4 @@ pub(crate) fn summary(rows: &[Row]) -> String {
 
 pub(crate) use csv_table::csv;
 pub(crate) use plot::plot_svg;
+pub(crate) use scene_files::{scene_file_here, summary as scene_files};

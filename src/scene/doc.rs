@@ -2,15 +2,45 @@
 //! command-line flag. Overrides (`--set`) are applied to this tree before it is read, so every
 //! error can name its source whichever way a value arrived.
 
+use super::toml_tree;
 use super::SceneError;
-use toml_edit::{ImDocument, Item, Value};
 
-#[derive(Clone, Debug, PartialEq)]
-pub enum Origin {
-    /// 1-based line in the scene file.
-    Line(usize),
-    /// The flag that set the value, e.g. `--set camera.time=3`.
-    Flag(String),
+/// Where a value came from: a 1-based line of the scene file, or the n-th flag that set a
+/// value (`Doc::flags`). Four bytes, as there is one per value of the file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Origin(u32);
+
+const FLAG_BIT: u32 = 1 << 31;
+
+impl Origin {
+    pub fn line(line: usize) -> Origin {
+        Origin(line.min(FLAG_BIT as usize - 1) as u32)
+    }
+    fn flag(index: usize) -> Origin {
+        Origin(FLAG_BIT | index as u32)
+    }
+}
+
+/// How a table or array was made, which decides what TOML lets extend it (only meaningful while
+/// parsing): bits of `IMPLICIT` (made by a header's or a dotted key's path), `DOTTED` (by a
+/// dotted key), `INLINE` (`{ … }`, closed), `ARRAY_OF_TABLES` (`[[…]]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Form(u8);
+
+impl Form {
+    pub const VALUE: Form = Form(0);
+    pub const TABLE: Form = Form(0);
+    pub const IMPLICIT: Form = Form(1);
+    pub const DOTTED: Form = Form(2);
+    pub const INLINE: Form = Form(4);
+    pub const ARRAY_OF_TABLES: Form = Form(8);
+
+    pub fn has(self, f: Form) -> bool {
+        self.0 & f.0 != 0
+    }
+    pub fn with(self, f: Form) -> Form {
+        Form(self.0 | f.0)
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -25,10 +55,18 @@ pub enum Val {
     Other(&'static str),
 }
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct Node {
     pub val: Val,
     pub origin: Origin,
+    pub form: Form,
+}
+
+/// Nodes are equal when their values and origins are; how TOML made them does not count.
+impl PartialEq for Node {
+    fn eq(&self, other: &Node) -> bool {
+        self.val == other.val && self.origin == other.origin
+    }
 }
 
 impl Node {
@@ -66,93 +104,24 @@ impl Node {
 pub struct Doc {
     pub file: String,
     pub root: Node,
+    /// The flags that set values, as error messages name them.
+    flags: Vec<String>,
 }
 
-struct Lines(Vec<usize>);
+/// The byte each line of a text starts at.
+pub struct Lines(Vec<usize>);
 
 impl Lines {
-    fn new(text: &str) -> Self {
+    pub fn new(text: &str) -> Self {
         Lines(
             std::iter::once(0)
                 .chain(text.match_indices('\n').map(|(i, _)| i + 1))
                 .collect(),
         )
     }
-    fn line(&self, span: Option<std::ops::Range<usize>>) -> usize {
-        span.map(|s| self.0.partition_point(|&start| start <= s.start))
-            .unwrap_or(1)
-    }
-}
-
-fn convert_value(v: &Value, origin: Origin, lines: &Lines) -> Node {
-    let val = match v {
-        Value::String(s) => Val::Str(s.value().clone()),
-        Value::Integer(i) => Val::Int(*i.value()),
-        Value::Float(f) => Val::Float(*f.value()),
-        Value::Boolean(b) => Val::Bool(*b.value()),
-        Value::Datetime(_) => Val::Other("a date"),
-        Value::Array(a) => Val::Array(
-            a.iter()
-                .map(|e| convert_value(e, line_origin(lines, e.span(), &origin), lines))
-                .collect(),
-        ),
-        Value::InlineTable(t) => Val::Table(
-            t.iter()
-                .map(|(k, e)| {
-                    let o =
-                        line_origin(lines, t.key(k).and_then(|k| k.span()).or(e.span()), &origin);
-                    (k.to_string(), convert_value(e, o, lines))
-                })
-                .collect(),
-        ),
-    };
-    Node { val, origin }
-}
-
-fn line_origin(lines: &Lines, span: Option<std::ops::Range<usize>>, fallback: &Origin) -> Origin {
-    match (span, fallback) {
-        (Some(s), _) => Origin::Line(lines.line(Some(s))),
-        (None, f) => f.clone(),
-    }
-}
-
-fn convert_table(t: &toml_edit::Table, origin: Origin, lines: &Lines) -> Node {
-    let entries = t
-        .iter()
-        .map(|(k, item)| {
-            let o = line_origin(
-                lines,
-                t.key(k).and_then(|k| k.span()).or(item.span()),
-                &origin,
-            );
-            (k.to_string(), convert_item(item, o, lines))
-        })
-        .collect();
-    Node {
-        val: Val::Table(entries),
-        origin,
-    }
-}
-
-fn convert_item(item: &Item, origin: Origin, lines: &Lines) -> Node {
-    match item {
-        Item::Value(v) => convert_value(v, origin, lines),
-        Item::Table(t) => convert_table(t, origin, lines),
-        Item::ArrayOfTables(a) => Node {
-            val: Val::Array(
-                a.iter()
-                    .map(|t| {
-                        let o = line_origin(lines, t.span(), &origin);
-                        convert_table(t, o, lines)
-                    })
-                    .collect(),
-            ),
-            origin,
-        },
-        Item::None => Node {
-            val: Val::Other("nothing"),
-            origin,
-        },
+    /// The 1-based line of byte `at`.
+    pub fn line_of(&self, at: usize) -> usize {
+        self.0.partition_point(|&start| start <= at).max(1)
     }
 }
 
@@ -174,30 +143,31 @@ impl Doc {
     /// Parse a scene file's text; `file` names it in errors.
     pub fn parse(file: &str, text: &str) -> Result<Doc, SceneError> {
         let lines = Lines::new(text);
-        let doc = ImDocument::parse(text.to_string()).map_err(|e| {
-            let line = lines.line(e.span());
-            let message = e.message().trim().replace('\n', ", ");
-            let shown = e
-                .span()
-                .map(|s| pointed(text, &lines, line, s.start))
-                .unwrap_or_default();
+        let root = toml_tree::parse_document(text, &lines).map_err(|e| {
+            let line = e.at.map_or(1, |at| lines.line_of(at));
+            let shown =
+                e.at.map(|at| pointed(text, &lines, line, at))
+                    .unwrap_or_default();
             SceneError::new(
                 format!("{file}:{line}"),
                 "",
-                format!("not valid TOML: {message}{shown}"),
+                format!("not valid TOML: {}{shown}", e.message),
             )
         })?;
         Ok(Doc {
             file: file.to_string(),
-            root: convert_table(doc.as_table(), Origin::Line(1), &lines),
+            root,
+            flags: Vec::new(),
         })
     }
 
     /// Where a node came from, for an error message.
     pub fn locate(&self, origin: &Origin) -> String {
-        match origin {
-            Origin::Line(l) => format!("{}:{l}", self.file),
-            Origin::Flag(f) => f.clone(),
+        if origin.0 & FLAG_BIT == 0 {
+            format!("{}:{}", self.file, origin.0)
+        } else {
+            let i = (origin.0 & !FLAG_BIT) as usize;
+            self.flags.get(i).cloned().unwrap_or_default()
         }
     }
 
@@ -224,11 +194,9 @@ impl Doc {
                 "the key must be a dotted path like group.cube.velocity".into(),
             ));
         }
-        let origin = Origin::Flag(shown.clone());
-        let value = parse_set_value(text.trim())
-            .map(|v| convert_value(&v, origin.clone(), &Lines(vec![0])))
-            .map_err(|m| bad(key, m))?;
-        let value = reorigin(value, &origin);
+        let origin = Origin::flag(self.flags.len());
+        let value = parse_set_value(text.trim(), origin).map_err(|m| bad(key, m))?;
+        self.flags.push(shown.clone());
         let segs: Vec<&str> = key.split('.').collect();
         let mut cur = &mut self.root;
         for (i, seg) in segs.iter().enumerate() {
@@ -254,7 +222,8 @@ impl Doc {
                                 seg.to_string(),
                                 Node {
                                     val: Val::Table(Vec::new()),
-                                    origin: origin.clone(),
+                                    origin,
+                                    form: Form::TABLE,
                                 },
                             ));
                             entries.len() - 1
@@ -308,23 +277,13 @@ impl Doc {
     }
 }
 
-fn reorigin(mut n: Node, o: &Origin) -> Node {
-    n.origin = o.clone();
-    n.val = match n.val {
-        Val::Array(a) => Val::Array(a.into_iter().map(|e| reorigin(e, o)).collect()),
-        Val::Table(t) => Val::Table(t.into_iter().map(|(k, e)| (k, reorigin(e, o))).collect()),
-        v => v,
-    };
-    n
-}
-
 /// A `--set` value is TOML; a bare word that is not valid TOML is taken as a string, so
 /// `--set camera.projection=orthographic` works without shell-quoted quotes.
-fn parse_set_value(text: &str) -> Result<Value, String> {
+fn parse_set_value(text: &str, origin: Origin) -> Result<Node, String> {
     if text.is_empty() {
         return Err("the value is empty".into());
     }
-    match text.parse::<Value>() {
+    match toml_tree::parse_value(text, origin) {
         Ok(v) => Ok(v),
         Err(e) => {
             let word = text
@@ -336,12 +295,13 @@ fn parse_set_value(text: &str) -> Result<Value, String> {
                     .next()
                     .is_some_and(|c| c.is_ascii_digit() || c == '-')
             {
-                Ok(Value::from(text))
+                Ok(Node {
+                    val: Val::Str(text.to_string()),
+                    origin,
+                    form: Form::VALUE,
+                })
             } else {
-                Err(format!(
-                    "`{text}` is not a TOML value: {}",
-                    e.to_string().trim()
-                ))
+                Err(format!("`{text}` is not a TOML value: {}", e.message))
             }
         }
     }

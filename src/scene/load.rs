@@ -19,8 +19,8 @@ pub fn load_file(
     overrides: &[(String, String)],
 ) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
-    // Parsing keeps every value with its place in the file: about 45 bytes of memory per byte
-    // of a file of numbers (a mesh). Refused here rather than aborted halfway.
+    // Parsing keeps every value with its place in the file (`BYTES_PER_SCENE_BYTE`). Refused
+    // here rather than aborted halfway.
     if let Ok(m) = std::fs::metadata(path) {
         let need = m.len().saturating_mul(crate::memory::BYTES_PER_SCENE_BYTE);
         let what = format!("reading a scene file of {}", crate::memory::human(m.len()));

@@ -2,7 +2,7 @@
 //! loader with errors that name file, line and key, `--set` overrides, and procedural objects.
 
 mod colour;
-mod doc;
+pub(crate) mod doc;
 mod envelope;
 mod error;
 mod load;
@@ -10,6 +10,7 @@ mod model;
 mod objects;
 mod procedural;
 mod reader;
+pub(crate) mod toml_tree;
 
 pub use error::SceneError;
 pub use load::{load_file, load_str};

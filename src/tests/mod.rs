@@ -11,3 +11,4 @@ mod many_groups;
 mod screen_cull;
 mod shadow_batches;
 mod strips;
+mod toml_tree;
