@@ -24,7 +24,7 @@ pub(crate) use band::Seen;
 pub(crate) use camera::CameraRays;
 pub(crate) use progress::Progress;
 pub(crate) use screen_cull::ScreenCull;
-pub(crate) use world::World;
+pub(crate) use world::{RestGroups, World};
 // What the tests of the internals reach (src/tests/).
 #[cfg(test)]
 pub(crate) use {

@@ -81,8 +81,8 @@ pub struct WorldGroup {
     pub boost: Boost,
     pub bounds: Aabb,
     pub geometry: Arc<Geometry>,
-    /// None for groups intersected directly.
-    pub accel: Option<Box<dyn Accelerator>>,
+    /// None for groups intersected directly; shared by every frame of a film.
+    pub accel: Option<Arc<dyn Accelerator>>,
     /// Offset for spawning secondary rays off surfaces, in rest-frame length.
     pub epsilon: f64,
     /// The bounds as they move through the world frame: a test before the boost.
@@ -202,35 +202,31 @@ struct RestRay {
     s: f64,
 }
 
-/// Concatenate geometries that share one rest frame.
-fn merge(geos: &[&Arc<Geometry>]) -> Arc<Geometry> {
-    if geos.len() == 1 {
-        return geos[0].clone();
-    }
-    let mut g = Geometry::default();
-    for src in geos {
-        let off = g.prims.len() as u32;
-        g.prims.extend_from_slice(&src.prims);
-        g.parts.extend(src.parts.iter().map(|p| Part {
-            start: p.start + off,
-            end: p.end + off,
-            ..p.clone()
-        }));
-    }
-    Arc::new(g)
+/// A group of the world as it is in its rest frame, whatever the camera: its merged geometry
+/// and accelerator.
+struct RestGroup {
+    velocity: Velocity,
+    boost: Boost,
+    bounds: Aabb,
+    geometry: Arc<Geometry>,
+    accel: Option<Arc<dyn Accelerator>>,
+    epsilon: f64,
 }
 
-impl World {
-    pub fn build(scene: &Scene, backend: &dyn Backend) -> crate::Result<World> {
-        Self::build_with(scene, backend, WorldOptions::default())
-    }
+/// The world's groups, built once: the part of a world that a film's frames share (the
+/// accelerators are most of a world's build).
+pub struct RestGroups {
+    groups: Vec<RestGroup>,
+    options: WorldOptions,
+}
 
-    pub fn build_with(
+impl RestGroups {
+    /// Merge the scene's groups of one velocity and build each one's accelerator.
+    pub fn build(
         scene: &Scene,
         backend: &dyn Backend,
         options: WorldOptions,
-    ) -> crate::Result<World> {
-        let event = scene.camera.imaging_event();
+    ) -> crate::Result<RestGroups> {
         // Which scene groups share a rest frame, in file order.
         let mut sets: Vec<(Velocity, Vec<usize>)> = Vec::new();
         let mut index: std::collections::HashMap<[u64; 4], usize> =
@@ -262,28 +258,80 @@ impl World {
             let accel = if geometry.prims.len() <= options.direct_max {
                 None
             } else {
-                Some(backend.build(geometry.clone()).map_err(|e| {
+                Some(Arc::from(backend.build(geometry.clone()).map_err(|e| {
                     crate::Error::backend(format!(
                         "building the {} backend for group `{}`: {e}",
                         backend.name(),
                         names.join("`, `")
                     ))
-                })?)
+                })?))
             };
-            let boost = Boost::to_rest(&velocity);
-            groups.push(WorldGroup {
-                event_rest: boost.event(event).x,
+            groups.push(RestGroup {
                 velocity,
-                boost,
+                boost: Boost::to_rest(&velocity),
                 bounds,
                 geometry,
                 accel,
                 // Relative to the group's size and place alone, so that a scene scaled as a
                 // whole renders the same (tests/envelope.rs).
                 epsilon: 1e-7 * bounds.diagonal() + 1e-12 * bounds.max_abs(),
-                moving: MovingBounds::new(&bounds, &velocity, event.t),
             });
         }
+        Ok(RestGroups { groups, options })
+    }
+}
+
+/// Concatenate geometries that share one rest frame.
+fn merge(geos: &[&Arc<Geometry>]) -> Arc<Geometry> {
+    if geos.len() == 1 {
+        return geos[0].clone();
+    }
+    let mut g = Geometry::default();
+    for src in geos {
+        let off = g.prims.len() as u32;
+        g.prims.extend_from_slice(&src.prims);
+        g.parts.extend(src.parts.iter().map(|p| Part {
+            start: p.start + off,
+            end: p.end + off,
+            ..p.clone()
+        }));
+    }
+    Arc::new(g)
+}
+
+impl World {
+    pub fn build(scene: &Scene, backend: &dyn Backend) -> crate::Result<World> {
+        Self::build_with(scene, backend, WorldOptions::default())
+    }
+
+    pub fn build_with(
+        scene: &Scene,
+        backend: &dyn Backend,
+        options: WorldOptions,
+    ) -> crate::Result<World> {
+        let groups = RestGroups::build(scene, backend, options)?;
+        World::aim(scene, &groups, backend)
+    }
+
+    /// The world seen from `scene`'s imaging event, on groups built before (for a film, once):
+    /// what depends on the event is made here, the same way for every frame as for a still.
+    pub fn aim(scene: &Scene, rest: &RestGroups, backend: &dyn Backend) -> crate::Result<World> {
+        let event = scene.camera.imaging_event();
+        let options = rest.options;
+        let groups: Vec<WorldGroup> = rest
+            .groups
+            .iter()
+            .map(|g| WorldGroup {
+                event_rest: g.boost.event(event).x,
+                velocity: g.velocity,
+                boost: g.boost,
+                bounds: g.bounds,
+                geometry: g.geometry.clone(),
+                accel: g.accel.clone(),
+                epsilon: g.epsilon,
+                moving: MovingBounds::new(&g.bounds, &g.velocity, event.t),
+            })
+            .collect();
         let (tree, primary_tree, light_trees) =
             if options.group_tree && groups.len() >= GROUP_TREE_MIN {
                 let (k, a, l) = Self::group_trees(scene, &groups, backend)?;

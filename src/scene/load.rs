@@ -168,7 +168,10 @@ fn build(doc: &Doc) -> SceneResult<Scene> {
     for t in root.tables("light")? {
         lights.push(light(&t, &groups)?);
     }
-    root.finish(&["camera", "image", "render", "material", "light", "group"])?;
+    let film = root.table("film")?.map(|t| film(&t, &camera)).transpose()?;
+    root.finish(&[
+        "camera", "image", "render", "material", "light", "group", "film",
+    ])?;
     Ok(Scene {
         camera,
         image,
@@ -177,6 +180,7 @@ fn build(doc: &Doc) -> SceneResult<Scene> {
         lights,
         groups,
         objects,
+        film,
     })
 }
 
@@ -389,6 +393,47 @@ fn image(t: &Table) -> SceneResult<ImageSettings> {
         "transparent",
     ])?;
     Ok(s)
+}
+
+fn film(t: &Table, camera: &Camera) -> SceneResult<Film> {
+    let start = t.f64_or("start", camera.time)?;
+    let end = t.f64_where("end", None, |_| true, "the last frame's view time")?;
+    if end < start {
+        return Err(t.error(
+            "end",
+            format!("must not be before start ({start:?}); got {end:?}"),
+        ));
+    }
+    let positive = |v: f64| v > 0.0;
+    let spacing = match (t.has("fps"), t.has("step")) {
+        (true, true) => return Err(t.error("step", "give fps or step, not both")),
+        (true, false) => FrameSpacing::Fps(t.f64_where("fps", None, positive, "more than 0")?),
+        (false, true) => FrameSpacing::Step(t.f64_where("step", None, positive, "more than 0")?),
+        (false, false) => return Err(t.error(
+            "fps",
+            "missing: give fps (frames per unit of world time) or step (world time between frames)",
+        )),
+    };
+    let f = Film {
+        start,
+        end,
+        spacing,
+    };
+    let n = ((end - start)
+        * match spacing {
+            FrameSpacing::Fps(x) => x,
+            FrameSpacing::Step(x) => 1.0 / x,
+        })
+    .floor();
+    if !(n < MAX_FRAMES as f64) {
+        let key = if t.has("fps") { "fps" } else { "step" };
+        return Err(t.error(
+            key,
+            format!("the film would have {n:.0} frames; at most {MAX_FRAMES} are allowed"),
+        ));
+    }
+    t.finish(&["start", "end", "fps", "step"])?;
+    Ok(f)
 }
 
 fn render_settings(t: &Table) -> SceneResult<RenderSettings> {

@@ -15,6 +15,6 @@ pub(crate) mod toml_tree;
 pub use error::SceneError;
 pub use load::{load_file, load_str};
 pub use model::{
-    Camera, Group, ImageSettings, Light, Material, ObjectInfo, Projection, RenderSettings, Scene,
-    MAX_RAYS,
+    Camera, Film, FrameSpacing, Group, ImageSettings, Light, Material, ObjectInfo, Projection,
+    RenderSettings, Scene, MAX_FRAMES, MAX_RAYS,
 };

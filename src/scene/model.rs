@@ -46,6 +46,60 @@ impl Camera {
     pub fn imaging_event(&self) -> Event {
         Event::new(self.time, self.position)
     }
+
+    /// The same camera at world time `t` on its worldline: it moves with its velocity from
+    /// where it is at `self.time`.
+    pub fn at_time(&self, t: f64) -> Camera {
+        let mut c = self.clone();
+        c.position = self.position + self.velocity.beta_vec() * (t - self.time);
+        c.time = t;
+        c
+    }
+}
+
+/// A film (`[film]`): frames at view times from `start` to `end` (inclusive, where the
+/// spacing lands on it), `1 / fps` or `step` apart, in world time; frame k is the camera at
+/// `start + k · spacing` on its worldline.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    /// The first frame's view time.
+    pub start: f64,
+    /// The last view time a frame may have.
+    pub end: f64,
+    /// The spacing of the frames.
+    pub spacing: FrameSpacing,
+}
+
+/// How far apart a film's frames are in world time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FrameSpacing {
+    /// Frames per unit of world time.
+    Fps(f64),
+    /// World time between frames.
+    Step(f64),
+}
+
+/// The most frames a film may have.
+pub const MAX_FRAMES: u64 = 1_000_000;
+
+impl Film {
+    /// The number of frames: every k from 0 with `time(k) <= end` (a rounding error of a part
+    /// in 1e9 of the film's length does not drop the last).
+    pub fn frame_count(&self) -> u64 {
+        let per_unit = match self.spacing {
+            FrameSpacing::Fps(f) => f,
+            FrameSpacing::Step(s) => 1.0 / s,
+        };
+        ((self.end - self.start) * per_unit * (1.0 + 1e-9)).floor() as u64 + 1
+    }
+
+    /// The view time of frame `k`.
+    pub fn time(&self, k: u64) -> f64 {
+        match self.spacing {
+            FrameSpacing::Fps(f) => self.start + k as f64 / f,
+            FrameSpacing::Step(s) => self.start + k as f64 * s,
+        }
+    }
 }
 
 /// The image: its size, samples, background and crop.
@@ -218,9 +272,20 @@ pub struct Scene {
     pub groups: Vec<Group>,
     /// Every `[[group.object]]` in file order; `object_id` in the output is index + 1.
     pub objects: Vec<ObjectInfo>,
+    /// The film, if the scene is one.
+    pub film: Option<Film>,
 }
 
 impl Scene {
+    /// The scene as frame `k` of its film sees it: the camera at the frame's view time on its
+    /// worldline. None if the scene is not a film.
+    pub fn film_frame(&self, k: u64) -> Option<Scene> {
+        let film = self.film.as_ref()?;
+        let mut s = self.clone();
+        s.camera = self.camera.at_time(film.time(k));
+        Some(s)
+    }
+
     /// The whole scene, camera and lights moved by a spacetime translation `shift` (world
     /// frame). Physics is translation-invariant, so the image must not change; each group's
     /// rest-frame geometry moves by the spatial part of the shift as that group measures it.

@@ -1,4 +1,7 @@
-//! The command line: `rest-embree render SCENE -o OUT.{exr,png} [options]`.
+//! The command line: `rest-embree render SCENE -o OUT.{exr,png} [options]`, films
+//! (`film.rs`), and the bench.
+
+mod film;
 
 use crate::render::Passes;
 use crate::{accel, bench, memory, output, render, scene, Error};
@@ -100,6 +103,14 @@ pub(crate) struct RenderArgs {
     /// memory); a render that would need more is refused before it starts.
     #[arg(long, value_name = "SIZE", value_parser = memory::parse_size)]
     pub max_memory: Option<u64>,
+    /// Render only these frames of the scene's film: A..B (both included) or one frame N,
+    /// counted from 0.
+    #[arg(long, value_name = "A..B", value_parser = film::parse_frames)]
+    pub frames: Option<(u64, u64)>,
+    /// Skip the frames of a film whose files exist already (a frame's file appears only when it
+    /// is written whole, so an existing one is complete).
+    #[arg(long)]
+    pub resume: bool,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -203,15 +214,13 @@ fn report(r: crate::Result<()>) -> ExitCode {
 /// terminal (and not --quiet).
 fn render_to_file(
     scene: &scene::Scene,
-    backend: &dyn accel::Backend,
+    world: &render::World,
     backend_name: &str,
     format: output::Format,
     args: &RenderArgs,
+    path: &Path,
 ) -> crate::Result<render::RenderStats> {
     use std::io::IsTerminal;
-    let t0 = std::time::Instant::now();
-    let world = render::World::build(scene, backend)?;
-    let build_time = t0.elapsed();
     let t1 = std::time::Instant::now();
     let (w, h) = scene.image.frame_size();
     let watching = !args.quiet && std::io::stderr().is_terminal();
@@ -221,7 +230,7 @@ fn render_to_file(
     let written = match format {
         output::Format::Exr => {
             let frame;
-            (frame, stats) = render::render_world_watched(scene, &world, Passes::All, progress);
+            (frame, stats) = render::render_world_watched(scene, world, Passes::All, progress);
             progress.inspect(|p| p.finish());
             stats.trace_time = t1.elapsed();
             let exr = output::ExrOptions {
@@ -241,15 +250,14 @@ fn render_to_file(
                 ),
                 mattes: Some(output::header::matte_names(scene)),
             };
-            output::write_with(&frame, &args.output, &exr)
+            output::write_with(&frame, path, &exr)
         }
         output::Format::Png => {
             let alpha = scene.image.is_transparent();
-            let written = output::write_png_in_strips(&args.output, (w, h), alpha, |put| {
+            let written = output::write_png_in_strips(path, (w, h), alpha, |put| {
                 let strip = memory::STRIP_PIXELS;
                 let colour = Passes::Colour;
-                stats =
-                    render::render_world_in_strips(scene, &world, colour, strip, progress, put)?;
+                stats = render::render_world_in_strips(scene, world, colour, strip, progress, put)?;
                 Ok(())
             });
             progress.inspect(|p| p.finish());
@@ -259,7 +267,6 @@ fn render_to_file(
         }
     };
     written?;
-    stats.build_time = build_time;
     Ok(stats)
 }
 
@@ -500,13 +507,15 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         scene.image.transparent.get_or_insert(false);
     }
     fits_in_memory(&scene, format, args)?;
-    let stats = render_to_file(&scene, backend.as_ref(), &backend_name, format, args)?;
-    if stats.nonfinite_pixels > 0 {
-        eprintln!(
-            "warning: {} pixels came out NaN or infinite and were set to black; please report this scene",
-            stats.nonfinite_pixels
-        );
+    if scene.film.is_some() || args.frames.is_some() {
+        return film::run(&scene, backend.as_ref(), &backend_name, format, args);
     }
+    let t0 = std::time::Instant::now();
+    let world = render::World::build(&scene, backend.as_ref())?;
+    let build_time = t0.elapsed();
+    let mut stats = render_to_file(&scene, &world, &backend_name, format, args, &args.output)?;
+    stats.build_time = build_time;
+    warn_nonfinite(&stats);
     if !args.quiet {
         let secs = stats.trace_time.as_secs_f64();
         eprintln!(
@@ -523,6 +532,15 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         );
     }
     Ok(())
+}
+
+fn warn_nonfinite(stats: &render::RenderStats) {
+    if stats.nonfinite_pixels > 0 {
+        eprintln!(
+            "warning: {} pixels came out NaN or infinite and were set to black; please report this scene",
+            stats.nonfinite_pixels
+        );
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,225 @@
+//! Films (`[film]`, `--frames`, `--resume`): frame k is, bit for bit, the still rendered at its
+//! view time and camera position; a killed film resumed gives the files of an uninterrupted one;
+//! bad ranges and patterns are clear errors.
+
+mod common;
+use common::cli::*;
+use std::path::Path;
+
+/// The command-line tests' cube scene with its camera moving at `camera_beta` toward the cube.
+fn still(camera_beta: f64) -> String {
+    GOOD.replace(
+        "time = 10\n",
+        &format!("time = 10\nvelocity = [0, {camera_beta}, 0]\n"),
+    )
+}
+
+fn film(camera_beta: f64, tail: &str) -> String {
+    format!(
+        "{}\n[film]\nstart = 8.0\nend = 9.0\nfps = 4\n{tail}",
+        still(camera_beta)
+    )
+}
+
+fn channels(path: &Path) -> Vec<(String, Vec<u32>)> {
+    let (_, _, ch) = rest_embree::output::read_exr_channels(path).unwrap();
+    let mut v: Vec<(String, Vec<u32>)> = ch
+        .into_iter()
+        .map(|(k, vals)| (k, vals.iter().map(|x| x.to_bits()).collect()))
+        .collect();
+    v.sort();
+    v
+}
+
+fn render(args: &[&str]) {
+    let (ok, err) = run(args);
+    assert!(ok, "{args:?}: {err}");
+}
+
+#[test]
+fn a_frame_is_the_still_at_its_view_time_and_camera_position() {
+    for beta in [0.0, 0.6] {
+        let d = Dir::new(&format!("film-still-{beta}"));
+        let scene = d.file("film.toml", &film(beta, ""));
+        let pattern = d.0.join("f-##.exr");
+        render(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            pattern.to_str().unwrap(),
+            "--frames",
+            "1..3",
+        ]);
+        let files = d.entries();
+        for k in 1..=3u64 {
+            assert!(files.contains(&format!("f-0{k}.exr")), "{files:?}");
+        }
+        assert!(!files.contains(&"f-00.exr".to_string()), "--frames 1..3");
+        assert!(!files.contains(&"f-04.exr".to_string()), "--frames 1..3");
+        let still_scene = d.file("still.toml", &still(beta));
+        for k in [1u64, 3] {
+            let t = 8.0 + k as f64 / 4.0;
+            // The camera is at the origin at world time 10 and moves with it.
+            let y = beta * (t - 10.0);
+            let out = d.0.join(format!("still-{k}.exr"));
+            render(&[
+                "render",
+                still_scene.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--time",
+                &format!("{t:?}"),
+                "--set",
+                &format!("camera.position=[0.0, {y:?}, 0.0]"),
+            ]);
+            let a = channels(&d.0.join(format!("f-0{k}.exr")));
+            let b = channels(&out);
+            assert!(a.len() >= 12, "{} channels", a.len());
+            let alpha = &a.iter().find(|(n, _)| n == "A").unwrap().1;
+            assert!(alpha.iter().any(|&x| x != 0), "the cube is in view");
+            assert!(
+                a == b,
+                "beta {beta}, frame {k}: the frame differs from the still"
+            );
+        }
+        // Frames differ from one another where the camera or the cube moved.
+        if beta > 0.0 {
+            assert!(channels(&d.0.join("f-01.exr")) != channels(&d.0.join("f-03.exr")));
+        }
+    }
+}
+
+#[test]
+fn a_killed_film_resumed_gives_the_files_of_an_uninterrupted_one() {
+    let d = Dir::new("film-resume");
+    // Enough frames, and slow enough ones, that the film is still running when it is killed.
+    let text = film(0.3, "").replace("end = 9.0", "end = 14.0").replace(
+        "width = 48\nheight = 32",
+        "width = 160\nheight = 120\nsamples = 4",
+    );
+    let scene = d.file("film.toml", &text);
+    let whole = d.0.join("whole");
+    let cut = d.0.join("cut");
+    let out = |dir: &Path| dir.join("frame-###.exr").to_str().unwrap().to_string();
+    render(&["render", scene.to_str().unwrap(), "-o", &out(&whole)]);
+    let frames = std::fs::read_dir(&whole).unwrap().count();
+    assert_eq!(frames, 25);
+
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args(["render", scene.to_str().unwrap(), "-o", &out(&cut), "-q"])
+        .spawn()
+        .unwrap();
+    let finished = |dir: &Path| {
+        std::fs::read_dir(dir).map_or(0, |r| {
+            r.filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .path()
+                    .extension()
+                    .is_some_and(|x| x == "exr")
+            })
+            .count()
+        })
+    };
+    while finished(&cut) < 3 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let before = finished(&cut);
+    assert!(
+        before < 25,
+        "the film was killed before its end ({before} frames)"
+    );
+    // A frame already there is not rendered again: mark one and see it kept.
+    std::fs::write(cut.join("frame-000.exr"), b"kept").unwrap();
+    let (ok, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        &out(&cut),
+        "--resume",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains(&format!(
+            "{} frames rendered, {before} already there",
+            25 - before
+        )),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(cut.join("frame-000.exr")).unwrap(), b"kept");
+    std::fs::copy(whole.join("frame-000.exr"), cut.join("frame-000.exr")).unwrap();
+    let mut names: Vec<String> = std::fs::read_dir(&cut)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names.len(), 25, "no partial file left: {names:?}");
+    for n in &names {
+        assert_eq!(
+            std::fs::read(cut.join(n)).unwrap(),
+            std::fs::read(whole.join(n)).unwrap(),
+            "{n}"
+        );
+    }
+}
+
+#[test]
+fn bad_films_are_clear_errors() {
+    let f = film(0.0, "");
+    fails(
+        "frames-outside",
+        &f,
+        &["--frames", "3..9"],
+        &["--frames 3..9", "frames 0..4"],
+    );
+    fails(
+        "frames-reversed",
+        &f,
+        &["--frames", "3..1"],
+        &["--frames", "empty"],
+    );
+    fails(
+        "frames-no-film",
+        GOOD,
+        &["--frames", "0..1"],
+        &["--frames", "not a film"],
+    );
+    // `fails` renders to out.png: no frame pattern.
+    fails("no-pattern", &f, &[], &["-o", "frame pattern"]);
+    let bad = |name: &str, from: &str, to: &str, needles: &[&str]| {
+        fails(name, &f.replace(from, to), &[], needles)
+    };
+    bad(
+        "end-before",
+        "end = 9.0",
+        "end = 7.0",
+        &["film.end", "before start"],
+    );
+    bad(
+        "fps-and-step",
+        "fps = 4",
+        "fps = 4\nstep = 0.5",
+        &["film.step", "not both"],
+    );
+    bad("no-spacing", "fps = 4\n", "", &["film.fps", "missing"]);
+    bad(
+        "zero-fps",
+        "fps = 4",
+        "fps = 0",
+        &["film.fps", "more than 0"],
+    );
+    bad(
+        "too-many",
+        "fps = 4",
+        "fps = 1e9",
+        &["film.fps", "at most 1000000"],
+    );
+    bad(
+        "unknown",
+        "fps = 4",
+        "fps = 4\nspeed = 2",
+        &["film.speed", "unknown key"],
+    );
+}
