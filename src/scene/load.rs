@@ -425,7 +425,7 @@ fn film(t: &Table, camera: &Camera) -> SceneResult<Film> {
             FrameSpacing::Step(x) => 1.0 / x,
         })
     .floor();
-    if !(n < MAX_FRAMES as f64) {
+    if n >= MAX_FRAMES as f64 {
         let key = if t.has("fps") { "fps" } else { "step" };
         return Err(t.error(
             key,
