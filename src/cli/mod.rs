@@ -1,7 +1,9 @@
 //! The command line: `rest-embree render SCENE -o OUT.{exr,png} [options]`, films
 //! (`film.rs`), and the bench.
 
+mod farm;
 mod film;
+mod tiles;
 
 use crate::render::Passes;
 use crate::{accel, bench, memory, output, render, scene, Error};
@@ -28,6 +30,20 @@ pub(crate) enum Command {
     Bench(BenchArgs),
     /// List the intersection backends of this build.
     Backends,
+    /// Join EXR tiles (from `render --tiles NxM --tile I`) into the EXR of the whole image.
+    Assemble {
+        /// The whole image (EXR).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// The tiles, in any order.
+        #[arg(required = true)]
+        tiles: Vec<PathBuf>,
+    },
+    /// Render on a cluster through its scheduler: `farm slurm SCENE -o OUT ...`.
+    Farm {
+        #[command(subcommand)]
+        scheduler: farm::Scheduler,
+    },
     /// The bench's own: read a generated scene file of one kind (`groups` or `mesh`) and size in
     /// this fresh process, and print what it cost.
     #[command(hide = true)]
@@ -111,6 +127,13 @@ pub(crate) struct RenderArgs {
     /// is written whole, so an existing one is complete).
     #[arg(long)]
     pub resume: bool,
+    /// Render one tile of a grid of N columns and M rows over the image (with --tile), to an
+    /// EXR that `rest-embree assemble` joins with the others.
+    #[arg(long, value_name = "NxM", value_parser = tiles::parse_grid, requires = "tile")]
+    pub tiles: Option<(u32, u32)>,
+    /// Which tile of --tiles: 0 is the top left, counted row by row.
+    #[arg(long, value_name = "I", requires = "tiles")]
+    pub tile: Option<u32>,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -191,6 +214,8 @@ fn run(cli: Cli) -> ExitCode {
         }
         Command::Render(args) => report(run_render(&args)),
         Command::Bench(args) => report(run_bench(&args)),
+        Command::Assemble { output, tiles } => report(run_assemble(&output, &tiles)),
+        Command::Farm { scheduler } => report(farm::run(&scheduler)),
         Command::BenchSceneFile { kind, size } => {
             println!("{}", bench::scene_file_here(&kind, size));
             ExitCode::SUCCESS
@@ -249,6 +274,7 @@ fn render_to_file(
                         .collect::<Vec<_>>(),
                 ),
                 mattes: Some(output::header::matte_names(scene)),
+                placement: output::Placement::of(&scene.image),
             };
             output::write_with(&frame, path, &exr)
         }
@@ -506,6 +532,30 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
     if format == output::Format::Png {
         scene.image.transparent.get_or_insert(false);
     }
+    if let (Some(grid), Some(index)) = (args.tiles, args.tile) {
+        let shown = format!("--tiles {}x{} --tile {index}", grid.0, grid.1);
+        if format != output::Format::Exr {
+            return Err(Error::flag(
+                &shown,
+                "tiles are written as EXRs, for `rest-embree assemble`: give -o a .exr",
+            ));
+        }
+        if scene.image.crop.is_some() {
+            return Err(Error::flag(
+                &shown,
+                "the scene has an [image] crop already; tiles divide the whole image",
+            ));
+        }
+        if scene.film.is_some() {
+            return Err(Error::flag(
+                &shown,
+                "tiles divide a still; the scene is a film (render its frames, one per task)",
+            ));
+        }
+        let size = (scene.image.width, scene.image.height);
+        scene.image.crop =
+            Some(tiles::crop(size, grid, index).map_err(|m| Error::flag(&shown, m))?);
+    }
     fits_in_memory(&scene, format, args)?;
     if scene.film.is_some() || args.frames.is_some() {
         return film::run(&scene, backend.as_ref(), &backend_name, format, args);
@@ -532,6 +582,22 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         );
     }
     Ok(())
+}
+
+fn run_assemble(output: &Path, tiles: &[PathBuf]) -> crate::Result<()> {
+    if output::Format::for_path(output).map_err(|e| e.on_flag("-o"))? != output::Format::Exr {
+        return Err(Error::flag(
+            "-o",
+            "the assembled image is an EXR: give a .exr",
+        ));
+    }
+    if tiles.iter().any(|t| same_file(t, output)) {
+        return Err(Error::flag(
+            "-o",
+            "is one of the tiles; it was left as it is",
+        ));
+    }
+    output::assemble(tiles, output)
 }
 
 fn warn_nonfinite(stats: &render::RenderStats) {

@@ -91,8 +91,15 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
         blocks: Blocks::ScanLines,
         line_order: LineOrder::Increasing,
     };
+    if let Some(p) = options.placement {
+        attrs.layer_position = Vec2(p.origin.0 as i32, p.origin.1 as i32);
+    }
     let layer = Layer::new(size, attrs, encoding, AnyChannels::sort(list));
     let mut image = Image::from_layer(layer);
+    if let Some(p) = options.placement {
+        image.attributes.display_window =
+            IntegerBounds::new((0, 0), (p.full.0 as usize, p.full.1 as usize));
+    }
     // R, G, B are linear sRGB / Rec. 709 (the camera's CIE XYZ through IEC 61966-2-1's matrix).
     let [r, g, b, w] = crate::spectrum::camera::SRGB_CHROMATICITIES.map(|[x, y]| Vec2(x, y));
     image.attributes.chromaticities = Some(attribute::Chromaticities {
@@ -108,7 +115,7 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
 /// Put the header's attributes in the order of their names. The exr crate keeps custom
 /// attributes in a `HashMap`, whose order changes from process to process, and the same render
 /// would make a different file. The header keeps its length, so the offsets after it hold.
-fn sort_header_attributes(path: &Path) -> std::io::Result<()> {
+pub(super) fn sort_header_attributes(path: &Path) -> std::io::Result<()> {
     use std::io::{Read, Seek, SeekFrom, Write};
     let mut file = std::fs::OpenOptions::new()
         .read(true)

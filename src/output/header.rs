@@ -35,20 +35,14 @@ pub fn world_to_camera(cam: &Camera) -> [f64; 16] {
     ]
 }
 
-/// OpenEXR's normalized device coordinates: (0, 0) at the top left corner of the image held in
-/// the file (the frame, a crop of the full image where there is one), (1, 1) at the bottom
+/// OpenEXR's normalized device coordinates: (0, 0) at the top left corner of the display
+/// window, which is the full image (a crop is a data window inside it), (1, 1) at the bottom
 /// right, y down; a row vector `[x y z 1]` times the matrix, divided by its last component.
 /// None for projections no matrix gives (equirectangular).
 pub fn world_to_ndc(cam: &Camera, image: &ImageSettings) -> Option<[f64; 16]> {
     let (w, h) = (f64::from(image.width), f64::from(image.height));
-    let (fw, fh) = image.frame_size();
-    let (fw, fh) = (f64::from(fw), f64::from(fh));
-    let (ox, oy) = image.frame_offset();
-    // The full image's centre in the frame's NDC.
-    let (cx, cy) = (
-        (w / 2.0 - f64::from(ox)) / fw,
-        (h / 2.0 - f64::from(oy)) / fh,
-    );
+    let (fw, fh) = (w, h);
+    let (cx, cy) = (0.5, 0.5);
     let camera_to_ndc = match cam.projection {
         Projection::Pinhole { fov_y } => {
             let f = h / 2.0 / (fov_y / 2.0).tan();
@@ -190,7 +184,7 @@ mod tests {
 
     /// Points land where the renderer's pixels see them: the view's centre at (0.5, 0.5), a
     /// point f px right and up of it one pixel per unit of NDC over the width and height, and
-    /// a crop moves and scales the frame.
+    /// a crop changes nothing (NDC are the display window's, the full image's).
     #[test]
     fn world_to_ndc_puts_points_on_their_pixels() {
         let text = "[camera]\nposition = [1, 2, 3]\ndirection = [0, 1, 0]\nfov_y = 90\n\
@@ -206,6 +200,6 @@ mod tests {
         s.image.crop = Some([100, 0, 50, 50]);
         let m = world_to_ndc(&s.camera, &s.image).unwrap();
         let (x, y) = ndc(&m, DVec3::new(2.0, 12.0, 4.0));
-        assert!((x - 5.0 / 50.0).abs() < 1e-12 && (y - 45.0 / 50.0).abs() < 1e-12);
+        assert!((x - 105.0 / 200.0).abs() < 1e-12 && (y - 45.0 / 100.0).abs() < 1e-12);
     }
 }

@@ -1,6 +1,7 @@
 //! Writing a rendered frame: EXR (linear float, with the extra passes) or PNG (tone-mapped
 //! sRGB), chosen by the file extension. Files are written whole or not at all.
 
+mod assemble;
 pub mod cryptomatte;
 mod exr_out;
 pub mod file;
@@ -71,6 +72,29 @@ pub struct ExrOptions {
     /// The names for Cryptomatte layers (`CryptoObject`, `CryptoMaterial`) of a frame that
     /// has mattes; None: no such layers.
     pub mattes: Option<cryptomatte::MatteNames>,
+    /// Where a cropped frame sits in the full image; None: the frame is the full image.
+    pub placement: Option<Placement>,
+}
+
+/// A crop's place: the full image's size (OpenEXR's display window) and the frame's top left
+/// pixel in it (the origin of the data window), so compositors put it where it belongs and
+/// `rest-embree assemble` can join tiles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Placement {
+    /// Width and height of the full image.
+    pub full: (u32, u32),
+    /// The frame's top left pixel in the full image.
+    pub origin: (u32, u32),
+}
+
+impl Placement {
+    /// The placement of a frame rendered with `image`'s settings (None without a crop).
+    pub fn of(image: &crate::scene::ImageSettings) -> Option<Placement> {
+        image.crop.map(|_| Placement {
+            full: (image.width, image.height),
+            origin: image.frame_offset(),
+        })
+    }
 }
 
 /// An EXR's lossless compressions.
@@ -155,4 +179,5 @@ pub fn srgb_encode(linear: f32) -> f32 {
     }
 }
 
+pub use assemble::assemble;
 pub use exr_out::read_channels as read_exr_channels;

@@ -1,0 +1,295 @@
+//! Tiles and farms without a cluster: tiles rendered with `--tiles NxM --tile I` and joined by
+//! `rest-embree assemble` make the whole render's EXR, byte for byte; `farm slurm` writes job
+//! arrays that, run as SLURM runs them (a stand-in `sbatch` on PATH records the submissions, and
+//! each task's script is run with its SLURM_ARRAY_TASK_ID), make the same files as local renders.
+//! A real one-node SLURM cluster runs the same in scripts/slurm-test.sh.
+
+mod common;
+use common::cli::*;
+use std::path::Path;
+use std::process::Command;
+
+fn render(args: &[&str]) {
+    let (ok, err) = run(args);
+    assert!(ok, "{args:?}: {err}");
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn assembled_tiles_are_the_whole_render() {
+    let d = Dir::new("tiles");
+    let scene = d.file("scene.toml", GOOD);
+    let size = ["--width", "45", "--height", "31", "--samples", "2"];
+    let whole = d.0.join("whole.exr");
+    render(&[&["render", s(&scene), "-o", s(&whole)][..], &size].concat());
+    let mut tiles = Vec::new();
+    for i in 0..6 {
+        let t = d.0.join(format!("t{i}.exr"));
+        render(
+            &[
+                &[
+                    "render",
+                    s(&scene),
+                    "-o",
+                    s(&t),
+                    "--tiles",
+                    "3x2",
+                    "--tile",
+                    &i.to_string(),
+                ][..],
+                &size,
+            ]
+            .concat(),
+        );
+        tiles.push(t);
+    }
+    let (w, h, _) = rest_embree::output::read_exr_channels(&tiles[4]).unwrap();
+    assert_eq!((w, h), (15, 16), "tile 4: columns 15..30, rows 15..31");
+    tiles.reverse();
+    let joined = d.0.join("joined.exr");
+    let mut args = vec!["assemble", "-o", s(&joined)];
+    args.extend(tiles.iter().map(|t| s(t)));
+    render(&args);
+    assert!(
+        std::fs::read(&joined).unwrap() == std::fs::read(&whole).unwrap(),
+        "the assembled tiles are the whole render's file"
+    );
+    // Missing and doubled tiles are refused, and nothing is written.
+    let bad = d.0.join("bad.exr");
+    let (ok, err) = run(&["assemble", "-o", s(&bad), s(&tiles[0]), s(&tiles[1])]);
+    assert!(!ok && err.contains("uncovered"), "{err}");
+    let (ok, err) = run(&["assemble", "-o", s(&bad), s(&tiles[0]), s(&tiles[0])]);
+    assert!(!ok && err.contains("overlaps"), "{err}");
+    assert!(!bad.exists());
+}
+
+#[test]
+fn bad_tiles_are_clear_errors() {
+    fails(
+        "tiles-png",
+        GOOD,
+        &["--tiles", "2x2", "--tile", "1"],
+        &["--tiles 2x2 --tile 1", ".exr"],
+    );
+    for (grid, tile, needle) in [
+        ("2x2", "4", "tiles are 0..3"),
+        ("49x1", "0", "does not fit"),
+        ("0x2", "0", "count of tiles"),
+    ] {
+        let d = Dir::new(&format!("bad-tile-{grid}"));
+        let scene = d.file("scene.toml", GOOD);
+        let out = d.0.join("out.exr");
+        let (code, err) = status(&[
+            "render",
+            s(&scene),
+            "-o",
+            s(&out),
+            "--tiles",
+            grid,
+            "--tile",
+            tile,
+        ]);
+        assert_eq!(code, Some(1), "{err}");
+        assert!(err.contains(needle), "{grid} {tile}: {err}");
+        assert!(!out.exists());
+    }
+}
+
+/// A stand-in `sbatch` that records each submission and answers with a job id.
+fn fake_sbatch(dir: &Path) -> std::path::PathBuf {
+    let bin = dir.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let path = bin.join("sbatch");
+    std::fs::write(
+        &path,
+        format!(
+            "#!/bin/bash\necho \"$@\" >> {}\nn=$(wc -l < {})\necho \"$((4000 + n))\"\n",
+            dir.join("submitted").display(),
+            dir.join("submitted").display()
+        ),
+    )
+    .unwrap();
+    Command::new("chmod")
+        .args(["+x", s(&path)])
+        .status()
+        .unwrap();
+    bin
+}
+
+fn farm(dir: &Path, args: &[&str]) -> (bool, String) {
+    let path = format!(
+        "{}:{}",
+        fake_sbatch(dir).display(),
+        std::env::var("PATH").unwrap()
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args(args)
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!err.contains("panicked"), "{err}");
+    (out.status.success(), err)
+}
+
+/// Run a job script as SLURM would run task `task` of it.
+fn run_task(script: &Path, task: u64) {
+    let st = Command::new("bash")
+        .arg(script)
+        .env("SLURM_ARRAY_TASK_ID", task.to_string())
+        .status()
+        .unwrap();
+    assert!(st.success(), "{} task {task}", script.display());
+}
+
+#[test]
+fn farm_scripts_make_the_local_renders() {
+    let d = Dir::new("farm");
+    let film = format!("{GOOD}\n[film]\nstart = 9.0\nend = 10.0\nfps = 2\n");
+    let scene = d.file("film.toml", &film);
+    let pattern = d.0.join("frames").join("f-###.exr");
+    let (ok, err) = farm(
+        &d.0,
+        &[
+            "farm",
+            "slurm",
+            s(&scene),
+            "-o",
+            s(&pattern),
+            "--sbatch-arg=--time=5",
+            "--set",
+            "image.samples=2",
+        ],
+    );
+    assert!(ok, "{err}");
+    let submitted = std::fs::read_to_string(d.0.join("submitted")).unwrap();
+    assert_eq!(submitted.lines().count(), 1, "{submitted}");
+    assert!(submitted.starts_with("--parsable --time=5 "), "{submitted}");
+    let script = d.0.join("frames/rest-embree-farm/f-frames.sbatch");
+    let text = std::fs::read_to_string(&script).unwrap();
+    assert!(text.contains("#SBATCH --array=0-2"), "{text}");
+    for task in 0..3 {
+        run_task(&script, task);
+    }
+    let local = d.0.join("local").join("f-###.exr");
+    render(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&local),
+        "-q",
+        "--set",
+        "image.samples=2",
+    ]);
+    for k in 0..3 {
+        let name = format!("f-00{k}.exr");
+        assert!(
+            std::fs::read(d.0.join("frames").join(&name)).unwrap()
+                == std::fs::read(d.0.join("local").join(&name)).unwrap(),
+            "{name}"
+        );
+    }
+
+    // A still in 2x2 tiles: the array, then the assembly after it.
+    let still = d.file("still.toml", GOOD);
+    let out = d.0.join("still.exr");
+    let (ok, err) = farm(
+        &d.0,
+        &["farm", "slurm", s(&still), "-o", s(&out), "--tiles", "2x2"],
+    );
+    assert!(ok, "{err}");
+    let submitted = std::fs::read_to_string(d.0.join("submitted")).unwrap();
+    let lines: Vec<&str> = submitted.lines().collect();
+    assert_eq!(lines.len(), 3, "{submitted}");
+    assert!(
+        lines[2].contains("--dependency=afterok:4002"),
+        "{submitted}"
+    );
+    let logs = d.0.join("rest-embree-farm");
+    for task in 0..4 {
+        run_task(&logs.join("still-tiles.sbatch"), task);
+    }
+    run_task(&logs.join("still-assemble.sbatch"), 0);
+    let whole = d.0.join("whole.exr");
+    render(&["render", s(&still), "-o", s(&whole), "-q"]);
+    assert!(std::fs::read(&out).unwrap() == std::fs::read(&whole).unwrap());
+    assert!(
+        !d.0.join("still.tile-0.exr").exists(),
+        "tiles removed once assembled"
+    );
+}
+
+#[test]
+fn bad_farms_are_clear_errors() {
+    let d = Dir::new("farm-bad");
+    let film = d.file(
+        "film.toml",
+        &format!("{GOOD}\n[film]\nstart = 9.0\nend = 10.0\nfps = 2\n"),
+    );
+    let still = d.file("still.toml", GOOD);
+    let out = d.0.join("f-##.exr");
+    for (args, needle) in [
+        (
+            vec![s(&film), "-o", s(&out), "--frames", "1..7"],
+            "frames 0..2",
+        ),
+        (vec![s(&film), "-o", s(&out), "--tiles", "2x2"], "is a film"),
+        (
+            vec![s(&still), "-o", s(&out), "--frames", "0..1"],
+            "not a film",
+        ),
+        (vec![s(&still), "-o", "x.png", "--tiles", "2x2"], ".exr"),
+        (
+            vec![s(&still), "-o", "x.exr", "--tiles", "100x1"],
+            "does not fit",
+        ),
+        (vec![s(&film), "-o", "x.exr"], "frame pattern"),
+    ] {
+        let mut all = vec!["farm", "slurm"];
+        all.extend(args);
+        let (code, err) = status(&all);
+        assert_eq!(code, Some(1), "{all:?}: {err}");
+        assert!(err.contains(needle), "{all:?}: {err}");
+    }
+    // Without sbatch on PATH: an error that says so (a PATH with nothing on it).
+    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args(["farm", "slurm", s(&still), "-o", s(&d.0.join("x.exr"))])
+        .env("PATH", d.0.join("nothing"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("sbatch is not on PATH") && err.contains("--dry-run"),
+        "{err}"
+    );
+    // --dry-run prints the scripts and submits nothing.
+    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args([
+            "farm",
+            "slurm",
+            s(&film),
+            "-o",
+            s(&out_pattern(&d.0)),
+            "--dry-run",
+        ])
+        .env("PATH", d.0.join("nothing"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("#SBATCH --array=0-2"),
+        "{text}"
+    );
+    assert!(
+        !d.0.join("rest-embree-farm").exists(),
+        "a dry run writes nothing"
+    );
+}
+
+fn out_pattern(dir: &Path) -> std::path::PathBuf {
+    dir.join("g-##.exr")
+}
