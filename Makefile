@@ -4,7 +4,7 @@
 CARGO ?= cargo
 OUT ?= out
 
-.PHONY: setup demo test bench images docs
+.PHONY: setup demo test bench images docs film
 
 setup:
 	@scripts/setup.sh
@@ -19,10 +19,20 @@ demo: setup
 	./target/release/rest-embree render scenes/passing_spheres.toml -o $(OUT)/passing-spheres.png
 	@echo "demo: wrote $(OUT)/lattice-0.9.png, $(OUT)/lattice-0.9.exr and $(OUT)/passing-spheres.png"
 
-# Every test, optimised (Cargo.toml's test profile), with the Embree backend and without it.
+# Every test, optimised (Cargo.toml's test profile), with the Embree backend and without it;
+# between them, a real one-node SLURM cluster runs a film and a tiled still through
+# `rest-embree farm slurm` (scripts/slurm-test.sh; it needs root, and says so when skipped).
 test: setup
 	$(CARGO) test --workspace
+	scripts/slurm-test.sh target/debug/rest-embree
 	$(CARGO) test --no-default-features
+
+# A film's frames as an MP4 (ffmpeg): make film FRAMES='film/frame-%04d.png' FPS=24 MP4=film.mp4
+FRAMES ?= film/frame-%04d.png
+FPS ?= 24
+MP4 ?= film.mp4
+film:
+	ffmpeg -y -framerate $(FPS) -i '$(FRAMES)' -pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' $(MP4)
 
 bench: setup
 	$(CARGO) build --release

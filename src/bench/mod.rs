@@ -10,6 +10,7 @@
 //! primitive tests), so the relativistic layer's overhead is a ratio measured in the same run.
 
 mod csv_table;
+mod film_cost;
 mod memory;
 mod plot;
 pub mod probe;
@@ -625,5 +626,6 @@ pub(crate) fn summary(rows: &[Row]) -> String {
 }
 
 pub(crate) use csv_table::csv;
+pub(crate) use film_cost::summary as film_cost;
 pub(crate) use plot::plot_svg;
 pub(crate) use scene_files::{scene_file_here, summary as scene_files};

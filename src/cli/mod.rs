@@ -485,6 +485,11 @@ fn run_bench(args: &BenchArgs) -> crate::Result<()> {
     let table = bench::table(&rows);
     let mut summary = bench::summary(&rows);
     summary.push_str(&files);
+    if args.scene.is_none() && args.cases.is_empty() {
+        for b in accel::backend_names() {
+            summary.push_str(&bench::film_cost(args.quick, b)?);
+        }
+    }
     println!(
         "threads: {}\n\n{table}\n{summary}",
         rayon::current_num_threads()
