@@ -1,0 +1,107 @@
+//! The part of a world that does not depend on the camera: the scene's groups merged by
+//! velocity, each with its rest-frame geometry and accelerator. Built once, it serves every
+//! frame of a film (`World::aim`).
+
+use super::WorldOptions;
+use crate::accel::{Accelerator, Backend};
+use crate::geometry::{Aabb, Geometry, Part};
+use crate::scene::Scene;
+use crate::spacetime::{Boost, Velocity};
+use std::sync::Arc;
+
+/// A group of the world as it is in its rest frame, whatever the camera: its merged geometry
+/// and accelerator.
+pub(super) struct RestGroup {
+    pub velocity: Velocity,
+    pub boost: Boost,
+    pub bounds: Aabb,
+    pub geometry: Arc<Geometry>,
+    pub accel: Option<Arc<dyn Accelerator>>,
+    pub epsilon: f64,
+}
+
+/// The world's groups, built once: the part of a world that a film's frames share (the
+/// accelerators are most of a world's build).
+pub struct RestGroups {
+    pub(super) groups: Vec<RestGroup>,
+    pub(super) options: WorldOptions,
+}
+
+impl RestGroups {
+    /// Merge the scene's groups of one velocity and build each one's accelerator.
+    pub fn build(
+        scene: &Scene,
+        backend: &dyn Backend,
+        options: WorldOptions,
+    ) -> crate::Result<RestGroups> {
+        // Which scene groups share a rest frame, in file order.
+        let mut sets: Vec<(Velocity, Vec<usize>)> = Vec::new();
+        let mut index: std::collections::HashMap<[u64; 4], usize> =
+            std::collections::HashMap::new();
+        for (i, g) in scene.groups.iter().enumerate() {
+            if g.geometry.is_empty() {
+                continue;
+            }
+            let v = g.velocity;
+            let key = v.identity_key();
+            match index.get(&key).filter(|_| options.merge_equal_velocities) {
+                Some(&k) => sets[k].1.push(i),
+                None => {
+                    index.insert(key, sets.len());
+                    sets.push((v, vec![i]));
+                }
+            }
+        }
+        let mut groups = Vec::with_capacity(sets.len());
+        for (velocity, members) in sets {
+            let geos: Vec<&Arc<Geometry>> =
+                members.iter().map(|&i| &scene.groups[i].geometry).collect();
+            let geometry = merge(&geos);
+            let bounds = geometry.bounds();
+            let names: Vec<&str> = members
+                .iter()
+                .map(|&i| scene.groups[i].name.as_str())
+                .collect();
+            let accel = if geometry.prims.len() <= options.direct_max {
+                None
+            } else {
+                Some(Arc::from(backend.build(geometry.clone()).map_err(|e| {
+                    crate::Error::backend(format!(
+                        "building the {} backend for group `{}`: {e}",
+                        backend.name(),
+                        names.join("`, `")
+                    ))
+                })?))
+            };
+            groups.push(RestGroup {
+                velocity,
+                boost: Boost::to_rest(&velocity),
+                bounds,
+                geometry,
+                accel,
+                // Relative to the group's size and place alone, so that a scene scaled as a
+                // whole renders the same (tests/envelope.rs).
+                epsilon: 1e-7 * bounds.diagonal() + 1e-12 * bounds.max_abs(),
+            });
+        }
+        Ok(RestGroups { groups, options })
+    }
+}
+
+/// Concatenate geometries that share one rest frame.
+fn merge(geos: &[&Arc<Geometry>]) -> Arc<Geometry> {
+    if geos.len() == 1 {
+        return geos[0].clone();
+    }
+    let mut g = Geometry::default();
+    for src in geos {
+        let off = g.prims.len() as u32;
+        g.prims.extend_from_slice(&src.prims);
+        g.parts.extend(src.parts.iter().map(|p| Part {
+            start: p.start + off,
+            end: p.end + off,
+            ..p.clone()
+        }));
+    }
+    Arc::new(g)
+}
