@@ -3,7 +3,7 @@
 use super::Row;
 
 pub(crate) fn csv(rows: &[Row]) -> String {
-    const HEADER: [&str; 18] = [
+    const HEADER: [&str; 21] = [
         "case",
         "setting",
         "spp",
@@ -17,6 +17,9 @@ pub(crate) fn csv(rows: &[Row]) -> String {
         "mrays_per_s",
         "render_s",
         "first_render_s",
+        "load_s",
+        "write_s",
+        "whole_s",
         "peak_mib",
         "differing_share_same_spp",
         "rms_same_spp",
@@ -47,6 +50,9 @@ pub(crate) fn csv(rows: &[Row]) -> String {
             format!("{:.4}", r.mrays_per_s()),
             c(Some(r.render_s)),
             c(Some(r.first_render_s)),
+            c(Some(r.load_s)),
+            c(Some(r.write_s)),
+            c(Some(r.whole_s())),
             c(r.peak_mib),
             c(r.vs_same.as_ref().map(|x| x.differing_share())),
             c(r.vs_same.as_ref().map(|x| x.rms)),
@@ -78,6 +84,8 @@ mod tests {
             render_s: 1.0,
             first_render_s: 1.5,
             peak_mib: None,
+            load_s: 0.1,
+            write_s: 0.2,
             vs_same: None,
             vs_hi: None,
             beside: None,

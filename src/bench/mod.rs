@@ -74,6 +74,8 @@ pub(crate) struct Case {
     /// A scene measured beside this one (`beside`), with what it is: the same boxes in one
     /// group beside many groups, or the same scene with the Doppler and searchlight effects off.
     pub beside: Option<(String, Scene)>,
+    /// How long making the scene took (set by `run`).
+    pub load_s: f64,
 }
 
 impl Case {
@@ -86,6 +88,7 @@ impl Case {
             bare: false,
             hi_reference: true,
             beside: None,
+            load_s: 0.0,
         }
     }
     /// Measure `scene`, which is `what`, beside this case (`beside`).
@@ -123,6 +126,11 @@ pub(crate) struct Row {
     /// The first render (fastest is `render_s`): it also builds what is built on first use.
     pub first_render_s: f64,
     pub peak_mib: Option<f64>,
+    /// Making the scene (parsing its file, or generating it).
+    pub load_s: f64,
+    /// Writing the first render's frame as the command line would: an EXR with every pass,
+    /// or a PNG of the colour alone (`colour-only` settings).
+    pub write_s: f64,
     /// Against the f64 BVH at the same samples per pixel.
     pub vs_same: Option<Comparison>,
     /// Against the f64 BVH at 16 samples per pixel.
@@ -142,6 +150,11 @@ pub(crate) struct Beside {
 }
 
 impl Row {
+    /// The whole command's time: load, build, the first render, write.
+    pub fn whole_s(&self) -> f64 {
+        self.load_s + self.build_s + self.first_render_s + self.write_s
+    }
+
     pub fn mrays_per_s(&self) -> f64 {
         self.primary_rays as f64 / self.primary_s.max(1e-12) / 1e6
     }
@@ -215,6 +228,35 @@ fn fastest(repeat: usize, mut f: impl FnMut()) -> f64 {
     best
 }
 
+/// Write `frame` to a file of this process's own in the temporary folder, as `render` would
+/// write it (an EXR with every pass and its header; a PNG for colour alone), and remove it;
+/// the time it took.
+fn write_like_the_command(
+    scene: &Scene,
+    backend_name: &str,
+    passes: Passes,
+    frame: &Frame,
+) -> crate::Result<f64> {
+    use crate::output;
+    let ext = if passes == Passes::Colour {
+        "png"
+    } else {
+        "exr"
+    };
+    let path = std::env::temp_dir().join(format!("rest-embree-bench-{}.{ext}", std::process::id()));
+    let t = Instant::now();
+    let exr = output::ExrOptions {
+        attributes: output::header::attributes(scene, backend_name, "bench", &[]),
+        mattes: Some(output::header::matte_names(scene)),
+        placement: output::Placement::of(&scene.image),
+        ..Default::default()
+    };
+    let written = output::write_with(frame, &path, &exr);
+    let secs = t.elapsed().as_secs_f64();
+    let _ = std::fs::remove_file(&path);
+    written.map(|()| secs)
+}
+
 fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result<(Row, Frame)> {
     let (backend_name, options, passes) = parse_setting(setting)?;
     let backend = backend_by_name(backend_name)?;
@@ -250,6 +292,7 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result
         render_world_passes(&scene, &world, passes);
     }));
     let peak_mib = memory::peak_mib();
+    let write_s = write_like_the_command(&scene, backend_name, passes, &frame)?;
     let (w, h) = scene.image.frame_size();
     Ok((
         Row {
@@ -266,6 +309,8 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result
             render_s,
             first_render_s,
             peak_mib,
+            load_s: case.load_s,
+            write_s,
             vs_same: None,
             vs_hi: None,
             beside: None,
@@ -427,7 +472,10 @@ pub(crate) fn run(
     let mut rows = Vec::new();
     for lazy in cases {
         progress(&lazy.name);
-        let case = &lazy.build()?;
+        let t = Instant::now();
+        let mut case = lazy.build()?;
+        case.load_s = t.elapsed().as_secs_f64();
+        let case = &case;
         let mut refs: Vec<(u32, Frame)> = Vec::new();
         let hi = if case.hi_reference {
             Some(reference(&case.scene, 16)?)
@@ -483,6 +531,8 @@ pub(crate) fn run(
                     render_s: f64::NAN,
                     first_render_s: f64::NAN,
                     peak_mib: None,
+                    load_s: f64::NAN,
+                    write_s: f64::NAN,
                     vs_same: None,
                     vs_hi: None,
                     beside: None,
@@ -504,13 +554,13 @@ pub(crate) fn table(rows: &[Row]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| case | setting | spp | image | prims | groups | build s | primary Mrays/s | render s | peak MiB | differing px vs f64 (same spp) | RMS vs f64 16 spp |"
+        "| case | setting | spp | image | prims | groups | build s | primary Mrays/s | render s | whole s | peak MiB | differing px vs f64 (same spp) | RMS vs f64 16 spp |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {}x{} | {} | {} | {:.3} | {:.2} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {}x{} | {} | {} | {:.3} | {:.2} | {} | {} | {} | {} | {} |",
             r.case,
             r.setting,
             r.spp,
@@ -521,6 +571,7 @@ pub(crate) fn table(rows: &[Row]) -> String {
             r.build_s,
             r.mrays_per_s(),
             opt(Some(r.render_s), |x| format!("{x:.3}")),
+            opt(Some(r.whole_s()), |x| format!("{x:.3}")),
             opt(r.peak_mib, |x| format!("{x:.0}")),
             opt(
                 r.vs_same.as_ref().map(|c| c.differing_share()),

@@ -22,8 +22,9 @@ const MAY_BE_HALF: [&str; 8] = [
 
 pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::Result<(), Cause> {
     let size = (frame.width as usize, frame.height as usize);
-    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = CHANNELS
-        .iter()
+    use rayon::prelude::*;
+    let channels: Vec<AnyChannel<FlatSamples>> = CHANNELS
+        .par_iter()
         .map(|&name| {
             let values = frame.channel(name).expect("known channel");
             let samples = if options.half && MAY_BE_HALF.contains(&name) {
@@ -34,6 +35,7 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
             AnyChannel::new(name, samples)
         })
         .collect();
+    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels.into_iter().collect();
     let mut extra = Vec::new();
     if let (Some(names), false) = (&options.mattes, frame.mattes.is_empty()) {
         let kinds: [(&str, cryptomatte::Pick, &[String]); 2] = [

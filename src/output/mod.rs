@@ -7,6 +7,8 @@ mod exr_out;
 pub mod file;
 pub mod header;
 mod png_out;
+mod srgb8;
+pub(crate) use srgb8::srgb8;
 
 use crate::render::Frame;
 use crate::{Cause, Error};

@@ -1,5 +1,5 @@
 use super::file::cause;
-use super::srgb_encode;
+use super::srgb8;
 use crate::render::Frame;
 use crate::Cause;
 use std::io::{BufWriter, Write};
@@ -54,7 +54,7 @@ pub fn write_strips(
     let mut rows = 0u64;
     fill(&mut |strip: &Frame| {
         debug_assert_eq!(strip.width, width);
-        let byte = |c: f32| (srgb_encode(c) * 255.0 + 0.5) as u8;
+        let byte = srgb8;
         let data: Vec<u8> = if alpha {
             strip
                 .pixels

@@ -1,0 +1,76 @@
+//! The 8-bit sRGB code of a linear value, `round(255 · srgb_encode(c))`, found by a binary
+//! search over the 255 values where the code steps up, instead of a `powf` per channel. The
+//! steps are found once, by bisection over f32s with `srgb_encode` itself, so each code is the
+//! one the formula gives (tested against it around every step and at random values).
+
+use super::srgb_encode;
+use std::sync::OnceLock;
+
+/// The code the formula gives.
+fn direct(c: f32) -> u8 {
+    (srgb_encode(c) * 255.0 + 0.5) as u8
+}
+
+/// `steps[k - 1]` is the least f32 in [0, 1] whose code is at least k.
+fn steps() -> &'static [f32; 255] {
+    static STEPS: OnceLock<[f32; 255]> = OnceLock::new();
+    STEPS.get_or_init(|| {
+        std::array::from_fn(|i| {
+            let k = i as u8 + 1;
+            // Bisection on the bit patterns of non-negative floats, which order as the floats.
+            let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                if direct(f32::from_bits(mid)) >= k {
+                    hi = mid;
+                } else {
+                    lo = mid + 1;
+                }
+            }
+            f32::from_bits(lo)
+        })
+    })
+}
+
+/// The 8-bit sRGB code of linear `c` (clamped to [0, 1]; NaN and infinities are 0, as
+/// `srgb_encode` has them).
+pub fn srgb8(c: f32) -> u8 {
+    if !(c > 0.0 && c.is_finite()) {
+        return 0;
+    }
+    steps().partition_point(|&s| s <= c) as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_are_the_formulas() {
+        for (k, &s) in steps().iter().enumerate() {
+            let bits = s.to_bits();
+            for b in bits.saturating_sub(64)..=bits + 64 {
+                let c = f32::from_bits(b);
+                assert_eq!(srgb8(c), direct(c), "around step {}: {c:e}", k + 1);
+            }
+        }
+        let mut rng = crate::rng::Rng(5);
+        for _ in 0..2_000_000 {
+            let c = f32::from_bits((rng.next_u64() % (1.0f32.to_bits() as u64 + 1)) as u32);
+            assert_eq!(srgb8(c), direct(c), "{c:e}");
+        }
+        for c in [
+            0.0,
+            -0.0,
+            -1.0,
+            1.0,
+            2.0,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            1e-40,
+        ] {
+            assert_eq!(srgb8(c), direct(c), "{c:e}");
+        }
+    }
+}
