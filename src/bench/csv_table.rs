@@ -96,7 +96,11 @@ mod tests {
         let record = reader.records().next().unwrap().unwrap();
         assert_eq!(header.len(), record.len());
         assert_eq!(&record[0], r#"my "scene", at 0.9"#);
-        assert_eq!(&record[13], "", "no peak memory measured: an empty field");
+        assert_eq!(&record[16], "", "no peak memory measured: an empty field");
+        assert_eq!(
+            &record[15], "2.300000e0",
+            "whole = load + build + first render + write"
+        );
         assert_eq!(&record[8], "2048");
     }
 }
