@@ -242,11 +242,22 @@ impl<'a> Rows<'a> {
         debug_assert!(rows.start.is_multiple_of(TILE));
         let (scene, world, passes) = (self.scene, self.world, self.passes);
         let (w, _) = scene.image.frame_size();
-        let mut frame = Frame::new(w, rows.end - rows.start);
+        // The frame's memory is first touched by the threads (a frame of every pass is about
+        // 190 bytes a pixel: made on one thread, its page faults are a serial part of the
+        // render).
+        let n = (w as usize) * (rows.end - rows.start) as usize;
+        let mut frame = Frame {
+            pixels: (0..n)
+                .into_par_iter()
+                .map(|_| PixelValue::default())
+                .collect(),
+            ..Frame::new(w, 0)
+        };
+        frame.height = rows.end - rows.start;
         let row = ((w * TILE) as usize).max(1);
         let rows_of_tiles = frame.pixels.len().div_ceil(row);
         if passes == Passes::All {
-            frame.mattes = vec![Default::default(); frame.pixels.len()];
+            frame.mattes = (0..n).into_par_iter().map(|_| Default::default()).collect();
         }
         // Each row's mattes beside its pixels (none in a render of colour alone).
         let mut mattes: Vec<&mut [Mattes]> = frame.mattes.chunks_mut(row).collect();
