@@ -245,6 +245,15 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
             },
         ));
     }
+    // Issue 24's row: 100,000 groups at 1024², against the same boxes in one group.
+    if !quick {
+        let name = "100000 boxes in 100000 groups at 1024^2";
+        out.push(LazyCase::new(name, move || {
+            Ok(Case::new(name, many_groups(100_000, false, 1024)?, &["embree"])
+                .without_hi_reference()
+                .beside("the same boxes in one group", many_groups(100_000, true, 1024)?))
+        }));
+    }
     // Merging groups of one velocity: 121 bars, 121 groups.
     out.push(LazyCase::new("121 bars as 121 groups, beta=0.9", || {
         Ok(Case::new(
