@@ -16,6 +16,7 @@ mod plot;
 pub mod probe;
 mod scene_files;
 mod suite;
+mod threads;
 
 pub(crate) use suite::{cases, many_groups, paper};
 
@@ -617,9 +618,10 @@ pub(crate) fn summary(rows: &[Row]) -> String {
         if let (Some(e), Some(b)) = (find(c, "embree"), find(c, "bvh")) {
             let _ = writeln!(
                 s,
-                "- {c}: embree / bvh primary throughput = {:.2}x (render time {:.2}x)",
+                "- {c}: embree / bvh primary throughput = {:.2}x (render time {:.2}x, whole command {:.2}x)",
                 e.mrays_per_s() / b.mrays_per_s(),
-                b.render_s / e.render_s
+                b.render_s / e.render_s,
+                b.whole_s() / e.whole_s()
             );
         }
     }
@@ -680,3 +682,4 @@ pub(crate) use csv_table::csv;
 pub(crate) use film_cost::summary as film_cost;
 pub(crate) use plot::plot_svg;
 pub(crate) use scene_files::{scene_file_here, summary as scene_files};
+pub(crate) use threads::summary as thread_scaling;

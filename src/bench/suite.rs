@@ -249,9 +249,14 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
     if !quick {
         let name = "100000 boxes in 100000 groups at 1024^2";
         out.push(LazyCase::new(name, move || {
-            Ok(Case::new(name, many_groups(100_000, false, 1024)?, &["embree"])
-                .without_hi_reference()
-                .beside("the same boxes in one group", many_groups(100_000, true, 1024)?))
+            Ok(
+                Case::new(name, many_groups(100_000, false, 1024)?, &["embree"])
+                    .without_hi_reference()
+                    .beside(
+                        "the same boxes in one group",
+                        many_groups(100_000, true, 1024)?,
+                    ),
+            )
         }));
     }
     // Merging groups of one velocity: 121 bars, 121 groups.

@@ -489,6 +489,10 @@ fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         for b in accel::backend_names() {
             summary.push_str(&bench::film_cost(args.quick, b)?);
         }
+        summary.push_str(&bench::thread_scaling(
+            args.quick,
+            accel::default_backend_name(),
+        )?);
     }
     println!(
         "threads: {}\n\n{table}\n{summary}",
