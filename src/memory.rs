@@ -4,9 +4,9 @@
 //! on a failed allocation halfway.
 //!
 //! The estimates are upper bounds from the sizes of the structures: per pixel the frame's
-//! [`PixelValue`](crate::render::PixelValue) (92 bytes) and, for an EXR, the encoder's copy of
-//! its channels (a PNG is rendered and written a strip of [`STRIP_PIXELS`] at a time, so only
-//! a strip counts); per primitive the f64 primitive, its share of the accelerator and the build's
+//! [`PixelValue`](crate::render::PixelValue) (92 bytes) and, for an EXR, its mattes and the
+//! encoder's copy of its channels (images are rendered and written a strip at a time,
+//! [`STRIP_PIXELS`] for a PNG, [`EXR_STRIP_PIXELS`] for an EXR, so only a strip counts); per primitive the f64 primitive, its share of the accelerator and the build's
 //! buffers (the bench's 100³ lattice, 4 million primitives, peaks near 270 bytes each).
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -22,9 +22,13 @@ pub const BYTES_PER_PIXEL_PNG: u64 = 96;
 /// Pixels a PNG render holds at a time, at least (whole rows of tiles): it is written strip
 /// by strip as it is rendered.
 pub const STRIP_PIXELS: u64 = 1 << 22;
-/// Bytes per pixel of an EXR render: the frame (92), its mattes (96), and the encoder's 46
-/// channels of 4 bytes.
+/// Bytes per pixel of an EXR render's strip: the frame (92), its mattes (96), and the
+/// encoder's 46 channels of 4 bytes.
 pub const BYTES_PER_PIXEL_EXR: u64 = 380;
+/// Pixels an EXR render holds at a time, at least (whole pairs of rows of tiles, 32-row
+/// blocks): it is written strip by strip as it is rendered, each strip's blocks compressed in
+/// parallel.
+pub const EXR_STRIP_PIXELS: u64 = 1 << 18;
 
 /// The limit set by [`set_limit`]; 0 for the machine's available memory.
 static LIMIT: AtomicU64 = AtomicU64::new(0);

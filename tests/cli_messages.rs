@@ -275,7 +275,7 @@ fn renders_beyond_the_memory_limit_are_refused() {
     ]);
     assert_eq!(code, Some(1), "{err}");
     assert!(
-        err.contains("--width") && err.contains("GiB of memory") && err.contains("64 MiB"),
+        err.contains("--width") && err.contains("MiB of memory") && err.contains("64 MiB"),
         "{err}"
     );
     let (code, err) = status(&["render", s, "-o", o, "--max-memory", "lots"]);

@@ -254,10 +254,6 @@ fn render_to_file(
     let mut stats = render::RenderStats::default();
     let written = match format {
         output::Format::Exr => {
-            let frame;
-            (frame, stats) = render::render_world_watched(scene, world, Passes::All, progress);
-            progress.inspect(|p| p.finish());
-            stats.trace_time = t1.elapsed();
             let exr = output::ExrOptions {
                 compression: args.compression.unwrap_or_default(),
                 half: args.half,
@@ -276,7 +272,22 @@ fn render_to_file(
                 mattes: Some(output::header::matte_names(scene)),
                 placement: output::Placement::of(&scene.image),
             };
-            output::write_with(&frame, path, &exr)
+            let written = output::write_exr_in_strips(path, (w, h), true, &exr, |put| {
+                let strip = memory::EXR_STRIP_PIXELS;
+                stats = render::render_world_in_strips(
+                    scene,
+                    world,
+                    Passes::All,
+                    strip,
+                    progress,
+                    put,
+                )?;
+                Ok(())
+            });
+            progress.inspect(|p| p.finish());
+            // Rendering and writing are one here.
+            stats.trace_time = t1.elapsed();
+            written
         }
         output::Format::Png => {
             let alpha = scene.image.is_transparent();
@@ -304,15 +315,16 @@ fn fits_in_memory(
 ) -> crate::Result<()> {
     let (w, h) = scene.image.frame_size();
     let pixels = u64::from(w) * u64::from(h);
-    // A PNG is written strip by strip: only a strip is held at a time.
+    // Images are written strip by strip: only a strip (whole pairs of rows of tiles) is held
+    // at a time.
+    let strip = |least: u64| least + u64::from(w) * u64::from(2 * render::TILE);
     let held = match format {
-        output::Format::Exr => pixels.saturating_mul(memory::BYTES_PER_PIXEL_EXR),
-        output::Format::Png => {
-            let strip = memory::STRIP_PIXELS + u64::from(w) * u64::from(render::TILE);
-            pixels
-                .min(strip)
-                .saturating_mul(memory::BYTES_PER_PIXEL_PNG)
-        }
+        output::Format::Exr => pixels
+            .min(strip(memory::EXR_STRIP_PIXELS))
+            .saturating_mul(memory::BYTES_PER_PIXEL_EXR),
+        output::Format::Png => pixels
+            .min(strip(memory::STRIP_PIXELS))
+            .saturating_mul(memory::BYTES_PER_PIXEL_PNG),
     };
     let prims = scene.primitive_count() as u64;
     let need = held.saturating_add(prims.saturating_mul(memory::BYTES_PER_PRIMITIVE));

@@ -20,8 +20,24 @@ const MAY_BE_HALF: [&str; 8] = [
     "relativity.doppler",
 ];
 
+/// Strips of rows, top to bottom, handed to a sink that encodes them.
+pub type Strips<'a> = dyn FnMut(&Frame) -> std::result::Result<(), Cause> + 'a;
+
+/// Write a whole frame (see [`write_strips`]).
 pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::Result<(), Cause> {
-    let size = (frame.width as usize, frame.height as usize);
+    let mattes = !frame.mattes.is_empty();
+    write_strips(path, (frame.width, frame.height), mattes, options, |put| {
+        put(frame)
+    })
+}
+
+/// The channels of `frame` as the file holds them, sorted by name (every pass, and the
+/// Cryptomatte layers when `mattes`), made in parallel, with the Cryptomatte attributes.
+fn channels(
+    frame: &Frame,
+    mattes: bool,
+    options: &ExrOptions,
+) -> (AnyChannels<FlatSamples>, Vec<(String, Attribute)>) {
     use rayon::prelude::*;
     let channels: Vec<AnyChannel<FlatSamples>> = CHANNELS
         .par_iter()
@@ -37,7 +53,7 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
         .collect();
     let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels.into_iter().collect();
     let mut extra = Vec::new();
-    if let (Some(names), false) = (&options.mattes, frame.mattes.is_empty()) {
+    if let (Some(names), true) = (&options.mattes, mattes) {
         let kinds: [(&str, cryptomatte::Pick, &[String]); 2] = [
             ("CryptoObject", |m| &m.object, &names.objects),
             ("CryptoMaterial", |m| &m.material, &names.materials),
@@ -53,6 +69,17 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
             extra.extend(attributes);
         }
     }
+    (AnyChannels::sort(list), extra)
+}
+
+/// The file's header, for an image of `size` whose channels are those of `template` (its
+/// samples unused) and whose extra attributes are `extra`.
+fn headers(
+    size: (u32, u32),
+    template: AnyChannels<FlatSamples>,
+    extra: &[(String, Attribute)],
+    options: &ExrOptions,
+) -> exr::meta::Headers {
     let mut attrs = LayerAttributes {
         software_name: Some(Text::from(concat!(
             "rest-embree ",
@@ -60,7 +87,7 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
         ))),
         ..Default::default()
     };
-    for (name, value) in options.attributes.iter().chain(&extra) {
+    for (name, value) in options.attributes.iter().chain(extra) {
         // The standard attributes the exr crate keeps in fields of their own.
         match (name.as_str(), value) {
             ("worldToCamera", Attribute::Matrix(m)) => {
@@ -85,9 +112,7 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
         };
         attrs.other.insert(Text::from(name.as_str()), value);
     }
-    // Scanlines, which compositors stream; blocks in increasing order: compressed in
-    // parallel, they are otherwise written as they finish, and the same image would make a
-    // different file from run to run.
+    // Scanlines, which compositors stream, in increasing order.
     let encoding = Encoding {
         compression: options.compression.exr(),
         blocks: Blocks::ScanLines,
@@ -96,7 +121,12 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
     if let Some(p) = options.placement {
         attrs.layer_position = Vec2(p.origin.0 as i32, p.origin.1 as i32);
     }
-    let layer = Layer::new(size, attrs, encoding, AnyChannels::sort(list));
+    let layer = Layer::new(
+        (size.0 as usize, size.1 as usize),
+        attrs,
+        encoding,
+        template,
+    );
     let mut image = Image::from_layer(layer);
     if let Some(p) = options.placement {
         image.attributes.display_window =
@@ -110,7 +140,93 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
         blue: b,
         white: w,
     });
-    image.write().to_file(path).map_err(cause)?;
+    image.write().infer_meta_data()
+}
+
+/// Write a `width` × `height` EXR whose rows `fill` hands to its sink in strips, top to
+/// bottom (every strip but the last a whole number of 32-row blocks): each strip's blocks are
+/// compressed in parallel and written as it comes, so the image is never held whole. `mattes`:
+/// whether the strips carry Cryptomatte mattes (and the file their layers).
+pub fn write_strips(
+    path: &Path,
+    (width, height): (u32, u32),
+    mattes: bool,
+    options: &ExrOptions,
+    fill: impl FnOnce(&mut Strips) -> std::result::Result<(), Cause>,
+) -> std::result::Result<(), Cause> {
+    use exr::block::{
+        enumerate_ordered_header_block_indices, writer::ChunksWriter, UncompressedBlock,
+    };
+    use rayon::prelude::*;
+    // The header from the channels of an empty frame: the same names and sample types.
+    let empty = Frame {
+        mattes: if mattes {
+            vec![Default::default()]
+        } else {
+            Vec::new()
+        },
+        ..Frame::new(1, 1)
+    };
+    let (template, extra) = channels(&empty, mattes, options);
+    let headers = headers((width, height), template, &extra, options);
+    let file = std::io::BufWriter::new(std::fs::File::create(path).map_err(cause)?);
+    let mut failed: Option<Cause> = None;
+    let written = exr::block::write(file, headers, true, |meta, writer| {
+        let blocks: Vec<_> = enumerate_ordered_header_block_indices(&meta.headers).collect();
+        let list = &meta.headers[0].channels;
+        let (mut next, mut y0) = (0usize, 0usize);
+        let result = fill(&mut |strip: &Frame| {
+            if strip.width != width {
+                return Err(cause(std::io::Error::other("a strip of another width")));
+            }
+            let (channels, _) = channels(strip, mattes, options);
+            let y1 = y0 + strip.height as usize;
+            let mine = blocks[next..]
+                .iter()
+                .take_while(|(_, b)| b.pixel_position.y() + b.pixel_size.height() <= y1)
+                .count();
+            let w = width as usize;
+            let chunks: Vec<_> = blocks[next..next + mine]
+                .par_iter()
+                .map(|&(index, block)| {
+                    let data = UncompressedBlock::from_lines(list, block, |line| {
+                        let at = (line.location.position.y() - y0) * w + line.location.position.x();
+                        let n = line.location.sample_count;
+                        let samples = &channels.list[line.location.channel].sample_data;
+                        let done = match samples {
+                            FlatSamples::F16(v) => line.write_samples_from_slice(&v[at..at + n]),
+                            FlatSamples::F32(v) => line.write_samples_from_slice(&v[at..at + n]),
+                            FlatSamples::U32(v) => line.write_samples_from_slice(&v[at..at + n]),
+                        };
+                        done.expect("a line of the block's own size");
+                    });
+                    data.compress_to_chunk(&meta.headers).map(|c| (index, c))
+                })
+                .collect();
+            for chunk in chunks {
+                let (index, chunk) = chunk.map_err(cause)?;
+                writer.write_chunk(index, chunk).map_err(cause)?;
+            }
+            next += mine;
+            y0 = y1;
+            Ok(())
+        });
+        if let Err(e) = result {
+            failed = Some(e);
+            return Err(exr::error::Error::Aborted);
+        }
+        if next != blocks.len() {
+            failed = Some(cause(std::io::Error::other(format!(
+                "{y0} rows of {height} were rendered"
+            ))));
+            return Err(exr::error::Error::Aborted);
+        }
+        Ok(())
+    });
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    written.map_err(cause)?;
     sort_header_attributes(path).map_err(cause)
 }
 

@@ -167,6 +167,21 @@ pub(crate) fn write_png_in_strips(
     })
 }
 
+/// Write an EXR of `width` × `height` whose rows `fill` hands on in strips, top to bottom (each
+/// but the last a whole number of 32-row blocks), as it renders them: the image is never held
+/// whole. `mattes`: whether the strips carry Cryptomatte mattes.
+pub(crate) fn write_exr_in_strips(
+    path: &Path,
+    size: (u32, u32),
+    mattes: bool,
+    exr: &ExrOptions,
+    fill: impl FnOnce(&mut exr_out::Strips) -> Result<(), Cause>,
+) -> crate::Result<()> {
+    file::write_whole(path, |tmp| {
+        exr_out::write_strips(tmp, size, mattes, exr, fill)
+    })
+}
+
 /// Linear to sRGB-encoded, after clamping to [0, 1].
 pub fn srgb_encode(linear: f32) -> f32 {
     let c = if linear.is_finite() {
