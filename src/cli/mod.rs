@@ -1,5 +1,6 @@
-//! The command line: `rest-embree render SCENE -o OUT.{exr,png} [options]`, films
-//! (`film.rs`), and the bench.
+//! The command line: `rest-embree render SCENE -o OUT.{exr,png} [options]` (a still, a tile of
+//! one: `tiles.rs`, or a film's frames: `film.rs`), `assemble`, `farm slurm` (`farm.rs`),
+//! `backends` and `bench`.
 
 mod farm;
 mod film;

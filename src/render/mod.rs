@@ -249,13 +249,14 @@ impl<'a> Rows<'a> {
         // render).
         let n = (w as usize) * (rows.end - rows.start) as usize;
         let mut frame = Frame {
+            width: w,
+            height: rows.end - rows.start,
             pixels: (0..n)
                 .into_par_iter()
                 .map(|_| PixelValue::default())
                 .collect(),
-            ..Frame::new(w, 0)
+            mattes: Vec::new(),
         };
-        frame.height = rows.end - rows.start;
         let row = ((w * TILE) as usize).max(1);
         let rows_of_tiles = frame.pixels.len().div_ceil(row);
         if passes == Passes::All {
