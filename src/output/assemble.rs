@@ -129,16 +129,30 @@ pub fn assemble(tiles: &[PathBuf], output: &Path) -> crate::Result<()> {
     }
     let mut attributes = first.layer_data.attributes.clone();
     attributes.layer_position = Vec2(display.position.0, display.position.1);
-    let layer = Layer::new(
-        (w, h),
-        attributes,
-        first.layer_data.encoding,
-        AnyChannels::sort(channels.into_iter().collect()),
-    );
+    // The header from the channels' names and types alone; the samples go through the same
+    // block writer as a render's, so the file is the whole render's.
+    let channels = AnyChannels::sort(channels.into_iter().collect());
+    let template = AnyChannels {
+        list: channels
+            .list
+            .iter()
+            .map(|c| AnyChannel {
+                name: c.name.clone(),
+                sample_data: match &c.sample_data {
+                    FlatSamples::F16(_) => FlatSamples::F16(Vec::new()),
+                    FlatSamples::F32(_) => FlatSamples::F32(Vec::new()),
+                    FlatSamples::U32(_) => FlatSamples::U32(Vec::new()),
+                },
+                quantize_linearly: c.quantize_linearly,
+                sampling: c.sampling,
+            })
+            .collect(),
+    };
+    let layer = Layer::new((w, h), attributes, first.layer_data.encoding, template);
     let mut image = Image::from_layer(layer);
     image.attributes = first.attributes.clone();
+    let headers = image.write().infer_meta_data();
     super::file::write_whole(output, |tmp| {
-        image.write().to_file(tmp).map_err(super::file::cause)?;
-        super::exr_out::sort_header_attributes(tmp).map_err(super::file::cause)
+        super::exr_out::write_blocks(tmp, headers, |put| put(&channels, h))
     })
 }
