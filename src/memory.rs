@@ -6,8 +6,9 @@
 //! The estimates are upper bounds from the sizes of the structures: per pixel the frame's
 //! [`PixelValue`](crate::render::PixelValue) (92 bytes) and, for an EXR, its mattes and the
 //! encoder's copy of its channels (images are rendered and written a strip at a time,
-//! [`STRIP_PIXELS`] for a PNG, [`EXR_STRIP_PIXELS`] for an EXR, so only a strip counts); per primitive the f64 primitive, its share of the accelerator and the build's
-//! buffers (the bench's 100³ lattice, 4 million primitives, peaks near 270 bytes each).
+//! [`STRIP_PIXELS`] or more, so only a strip counts); per primitive the f64 primitive, its
+//! share of the accelerator and the build's buffers (the bench's 100³ lattice, 4 million
+//! primitives, peaks near 270 bytes each).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -19,16 +20,13 @@ pub const BYTES_PER_PRIMITIVE: u64 = 320;
 pub const BYTES_PER_SCENE_BYTE: u64 = 24;
 /// Bytes per pixel of a PNG render's strip: the frame's rows, and their 8-bit encoding.
 pub const BYTES_PER_PIXEL_PNG: u64 = 96;
-/// Pixels a PNG render holds at a time, at least (whole rows of tiles): it is written strip
-/// by strip as it is rendered.
-pub const STRIP_PIXELS: u64 = 1 << 22;
+/// Pixels a render to a file holds at a time, at least (whole pairs of rows of tiles, four
+/// rows per thread or more): a PNG or EXR is written strip by strip as it is rendered, an EXR
+/// strip's blocks compressed in parallel.
+pub const STRIP_PIXELS: u64 = 1 << 18;
 /// Bytes per pixel of an EXR render's strip: the frame (92), its mattes (96), and the
 /// encoder's 46 channels of 4 bytes.
 pub const BYTES_PER_PIXEL_EXR: u64 = 380;
-/// Pixels an EXR render holds at a time, at least (whole pairs of rows of tiles, 32-row
-/// blocks): it is written strip by strip as it is rendered, each strip's blocks compressed in
-/// parallel.
-pub const EXR_STRIP_PIXELS: u64 = 1 << 18;
 
 /// The limit set by [`set_limit`]; 0 for the machine's available memory.
 static LIMIT: AtomicU64 = AtomicU64::new(0);

@@ -274,7 +274,7 @@ fn render_to_file(
                 placement: output::Placement::of(&scene.image),
             };
             let written = output::write_exr_in_strips(path, (w, h), true, &exr, |put| {
-                let strip = memory::EXR_STRIP_PIXELS;
+                let strip = memory::STRIP_PIXELS;
                 stats = render::render_world_in_strips(
                     scene,
                     world,
@@ -318,10 +318,11 @@ fn fits_in_memory(
     let pixels = u64::from(w) * u64::from(h);
     // Images are written strip by strip: only a strip (whole pairs of rows of tiles) is held
     // at a time.
-    let strip = |least: u64| least + u64::from(w) * u64::from(2 * render::TILE);
+    let row = u64::from(w) * u64::from(render::TILE);
+    let strip = |least: u64| least.max(4 * rayon::current_num_threads() as u64 * row) + 2 * row;
     let held = match format {
         output::Format::Exr => pixels
-            .min(strip(memory::EXR_STRIP_PIXELS))
+            .min(strip(memory::STRIP_PIXELS))
             .saturating_mul(memory::BYTES_PER_PIXEL_EXR),
         output::Format::Png => pixels
             .min(strip(memory::STRIP_PIXELS))

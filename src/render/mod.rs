@@ -185,10 +185,11 @@ pub(crate) fn render_world_in_strips<E>(
     mut put: impl FnMut(&Frame) -> Result<(), E>,
 ) -> Result<RenderStats, E> {
     let (w, h) = scene.image.frame_size();
-    // An even number of rows of tiles: whole 32-row blocks of an EXR (PIZ's).
+    // At least four rows of tiles per thread, so that every thread has work to the strip's
+    // end; an even number: whole 32-row blocks of an EXR (PIZ's).
     let tile_rows = min_pixels
         .div_ceil(u64::from(w.max(1)) * u64::from(TILE))
-        .max(1)
+        .max(4 * rayon::current_num_threads() as u64)
         .next_multiple_of(2);
     let rows_per_strip = u32::try_from(tile_rows * u64::from(TILE)).unwrap_or(u32::MAX);
     let rows = Rows::new(scene, world, passes, progress);
