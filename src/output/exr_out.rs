@@ -292,14 +292,23 @@ fn compress(
 /// ones; each byte then replaced by its difference from the one before plus 128 (mod 256); then a
 /// zlib stream of that (read back by any inflate).
 pub(super) fn zip_bytes(data: &[u8]) -> Vec<u8> {
-    let mut t: Vec<u8> = data
-        .iter()
-        .step_by(2)
-        .chain(data.iter().skip(1).step_by(2))
-        .copied()
-        .collect();
-    for i in (1..t.len()).rev() {
-        t[i] = t[i].wrapping_sub(t[i - 1]).wrapping_add(128);
+    let half = data.len().div_ceil(2);
+    let mut split = vec![0; data.len()];
+    let (even, odd) = split.split_at_mut(half);
+    for ((e, o), pair) in even
+        .iter_mut()
+        .zip(odd.iter_mut())
+        .zip(data.chunks_exact(2))
+    {
+        (*e, *o) = (pair[0], pair[1]);
+    }
+    if data.len() % 2 == 1 {
+        even[half - 1] = data[data.len() - 1];
+    }
+    // Differences from a second buffer, so that the loop has no dependence to carry.
+    let mut t = split.clone();
+    for (d, w) in t[1..].iter_mut().zip(split.windows(2)) {
+        *d = w[1].wrapping_sub(w[0]).wrapping_add(128);
     }
     let mut z = libdeflater::Compressor::new(libdeflater::CompressionLvl::new(4).expect("level 4"));
     let mut out = vec![0; z.zlib_compress_bound(t.len())];
