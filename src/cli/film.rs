@@ -95,7 +95,8 @@ pub(super) fn run(
     }
     let pattern = FramePattern::parse(&args.output).map_err(|m| Error::flag("-o", m))?;
     if let Some(dir) = pattern.dir.to_str().filter(|d| !d.is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| Error::flag("-o", e))?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::flag("-o", format!("cannot make the folder {dir}: {e}")))?;
     }
     let t0 = std::time::Instant::now();
     let rest = render::RestGroups::build(scene, backend, render::WorldOptions::default())?;
