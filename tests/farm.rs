@@ -247,6 +247,7 @@ fn bad_farms_are_clear_errors() {
             "does not fit",
         ),
         (vec![s(&film), "-o", "x.exr"], "frame pattern"),
+        (vec![s(&still), "-o", "my renders/x.exr"], "has a space"),
     ] {
         let mut all = vec!["farm", "slurm"];
         all.extend(args);

@@ -103,6 +103,15 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
         crate::accel::backend_by_name(b).map_err(|e| e.on_flag("--backend"))?;
     }
     let output = absolute(&args.output)?;
+    if output.to_string_lossy().contains(char::is_whitespace) {
+        return Err(Error::flag(
+            "-o",
+            format!(
+                "`{}` has a space, which the job script's #SBATCH --output line cannot hold: choose a path without spaces",
+                output.display()
+            ),
+        ));
+    }
     let dir = output.parent().map(Path::to_path_buf).unwrap_or_default();
     let stem = output
         .file_stem()
