@@ -246,12 +246,7 @@ fn write_like_the_command(
     };
     let path = std::env::temp_dir().join(format!("rest-embree-bench-{}.{ext}", std::process::id()));
     let t = Instant::now();
-    let exr = output::ExrOptions {
-        attributes: output::header::attributes(scene, backend_name, "bench", &[]),
-        mattes: Some(output::header::matte_names(scene)),
-        placement: output::Placement::of(&scene.image),
-        ..Default::default()
-    };
+    let exr = output::ExrOptions::for_render(scene, backend_name, "bench", &[]);
     let written = output::write_with(frame, &path, &exr);
     let secs = t.elapsed().as_secs_f64();
     let _ = std::fs::remove_file(&path);

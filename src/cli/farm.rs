@@ -143,22 +143,9 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
 
     let mut jobs = Vec::new();
     match (&scene.film, args.tiles) {
-        (Some(_), Some(_)) => {
-            return Err(Error::flag(
-                "--tiles",
-                "tiles divide a still; the scene is a film (its frames are the tasks)",
-            ))
-        }
         (Some(f), None) => {
             film::FramePattern::parse(&args.output).map_err(|m| Error::flag("-o", m))?;
-            let count = f.frame_count();
-            let (first, last) = args.frames.unwrap_or((0, count - 1));
-            if last >= count {
-                return Err(Error::flag(
-                    &format!("--frames {first}..{last}"),
-                    format!("the film has frames 0..{}", count - 1),
-                ));
-            }
+            let (first, last) = film::frame_range(f, args.frames)?;
             let frames = last - first + 1;
             let per = frames.div_ceil(MAX_TASKS);
             let tasks = frames.div_ceil(per);
@@ -174,27 +161,16 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
                 tasks,
             });
         }
-        (None, grid) => {
+        (_, grid) => {
+            let (columns, rows) = grid.unwrap_or((1, 1));
+            if grid.is_some() {
+                let shown = format!("--tiles {columns}x{rows}");
+                tiles::tile_crop(&scene, format, (columns, rows), 0, &shown)?;
+            }
             if args.frames.is_some() {
                 return Err(Error::flag(
                     "--frames",
                     "the scene is not a film: add a [film] table",
-                ));
-            }
-            let (columns, rows) = grid.unwrap_or((1, 1));
-            let size = (scene.image.width, scene.image.height);
-            let shown = format!("--tiles {columns}x{rows}");
-            tiles::crop(size, (columns, rows), 0).map_err(|m| Error::flag(&shown, m))?;
-            if grid.is_some() && format != output::Format::Exr {
-                return Err(Error::flag(
-                    &shown,
-                    "tiles are assembled as an EXR: give -o a .exr",
-                ));
-            }
-            if grid.is_some() && scene.image.crop.is_some() {
-                return Err(Error::flag(
-                    &shown,
-                    "the scene has an [image] crop already; tiles divide the whole image",
                 ));
             }
             let tasks = u64::from(columns) * u64::from(rows);

@@ -66,6 +66,27 @@ impl FramePattern {
     }
 }
 
+/// The frames `requested` (all by default), or why the film has no such frames.
+pub(super) fn frame_range(
+    film: &scene::Film,
+    requested: Option<(u64, u64)>,
+) -> crate::Result<(u64, u64)> {
+    let count = film.frame_count();
+    let (first, last) = requested.unwrap_or((0, count - 1));
+    if last >= count {
+        return Err(Error::flag(
+            &format!("--frames {first}..{last}"),
+            format!(
+                "the film has frames 0..{} (view times {:?} to {:?})",
+                count - 1,
+                film.time(0),
+                film.time(count - 1)
+            ),
+        ));
+    }
+    Ok((first, last))
+}
+
 /// Render the film's frames in order, each to its own file.
 pub(super) fn run(
     scene: &scene::Scene,
@@ -80,19 +101,7 @@ pub(super) fn run(
             "the scene is not a film: add a [film] table (start, end, fps or step) or --set film.end=... --set film.fps=...",
         ));
     };
-    let count = film.frame_count();
-    let (first, last) = args.frames.unwrap_or((0, count - 1));
-    if last >= count {
-        return Err(Error::flag(
-            &format!("--frames {first}..{last}"),
-            format!(
-                "the film has frames 0..{} (view times {:?} to {:?})",
-                count - 1,
-                film.time(0),
-                film.time(count - 1)
-            ),
-        ));
-    }
+    let (first, last) = frame_range(film, args.frames)?;
     let pattern = FramePattern::parse(&args.output).map_err(|m| Error::flag("-o", m))?;
     if let Some(dir) = pattern.dir.to_str().filter(|d| !d.is_empty()) {
         std::fs::create_dir_all(dir)

@@ -258,20 +258,18 @@ fn render_to_file(
             let exr = output::ExrOptions {
                 compression: args.compression.unwrap_or_default(),
                 half: args.half,
-                attributes: output::header::attributes(
+                // The flags that change nothing in the picture (--threads, -o) stay out of the
+                // header: the same render makes the same file.
+                ..output::ExrOptions::for_render(
                     scene,
                     backend_name,
                     &args.scene.display().to_string(),
-                    // The flags that change nothing in the picture (--threads, -o) stay out:
-                    // the same render makes the same file.
                     &args
                         .overrides()
                         .into_iter()
                         .map(|(shown, _)| shown)
                         .collect::<Vec<_>>(),
-                ),
-                mattes: Some(output::header::matte_names(scene)),
-                placement: output::Placement::of(&scene.image),
+                )
             };
             let written = output::write_exr_in_strips(path, (w, h), true, &exr, |put| {
                 let strip = memory::STRIP_PIXELS;
@@ -557,27 +555,7 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
     }
     if let (Some(grid), Some(index)) = (args.tiles, args.tile) {
         let shown = format!("--tiles {}x{} --tile {index}", grid.0, grid.1);
-        if format != output::Format::Exr {
-            return Err(Error::flag(
-                &shown,
-                "tiles are written as EXRs, for `rest-embree assemble`: give -o a .exr",
-            ));
-        }
-        if scene.image.crop.is_some() {
-            return Err(Error::flag(
-                &shown,
-                "the scene has an [image] crop already; tiles divide the whole image",
-            ));
-        }
-        if scene.film.is_some() {
-            return Err(Error::flag(
-                &shown,
-                "tiles divide a still; the scene is a film (render its frames, one per task)",
-            ));
-        }
-        let size = (scene.image.width, scene.image.height);
-        scene.image.crop =
-            Some(tiles::crop(size, grid, index).map_err(|m| Error::flag(&shown, m))?);
+        scene.image.crop = Some(tiles::tile_crop(&scene, format, grid, index, &shown)?);
     }
     fits_in_memory(&scene, format, args)?;
     if scene.film.is_some() || args.frames.is_some() {

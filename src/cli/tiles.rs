@@ -2,6 +2,33 @@
 //! that knows its place (its data window inside the full display window), for
 //! `rest-embree assemble` to join with the others.
 
+use crate::{output, scene, Error};
+
+/// The crop of tile `index` of `grid` over `scene`'s image, or why `scene` and `format` cannot
+/// be tiled (tiles divide a still's whole image and are EXRs); `shown` names the flags.
+pub(super) fn tile_crop(
+    scene: &scene::Scene,
+    format: output::Format,
+    grid: (u32, u32),
+    index: u32,
+    shown: &str,
+) -> crate::Result<[u32; 4]> {
+    let why = if format != output::Format::Exr {
+        Some("tiles are EXRs, assembled by `rest-embree assemble`: give -o a .exr")
+    } else if scene.image.crop.is_some() {
+        Some("the scene has an [image] crop already; tiles divide the whole image")
+    } else if scene.film.is_some() {
+        Some("tiles divide a still; the scene is a film (its frames are rendered one per task)")
+    } else {
+        None
+    };
+    if let Some(why) = why {
+        return Err(Error::flag(shown, why));
+    }
+    let size = (scene.image.width, scene.image.height);
+    crop(size, grid, index).map_err(|m| Error::flag(shown, m))
+}
+
 /// `NxM`: N columns, M rows.
 pub(super) fn parse_grid(text: &str) -> Result<(u32, u32), String> {
     let (a, b) = text

@@ -2,21 +2,13 @@
 //! window) joined into the one EXR of the whole image: every channel, sample type, attribute
 //! and the compression of the tiles, the pixels copied bit for bit.
 
-use exr::image::read::read;
 use exr::prelude::*;
 use std::path::{Path, PathBuf};
 
 type Tile = Image<Layer<AnyChannels<FlatSamples>>>;
 
 fn read_tile(path: &Path) -> crate::Result<Tile> {
-    read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .map_err(|e| bad(path, format!("cannot read the tile: {e}")))
+    super::exr_out::read_layer(path).map_err(|e| bad(path, format!("cannot read the tile: {e}")))
 }
 
 fn bad(path: &Path, why: impl Into<String>) -> crate::Error {

@@ -386,19 +386,25 @@ fn name_of<'a>(header: &'a [u8], span: &std::ops::Range<usize>) -> &'a [u8] {
 /// Width, height and every channel by name (f32, row-major) of an EXR file's first layer.
 pub type Channels = (usize, usize, HashMap<String, Vec<f32>>);
 
-/// Every channel of the first layer of an EXR file.
-pub fn read_channels(path: &Path) -> crate::Result<Channels> {
-    let image = read()
+/// The first layer of an EXR file with every channel and attribute, as stored.
+pub(super) fn read_layer(
+    path: &Path,
+) -> exr::error::Result<Image<Layer<AnyChannels<FlatSamples>>>> {
+    read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .first_valid_layer()
         .all_attributes()
         .from_file(path)
-        .map_err(|e| {
-            let message = format!("cannot read `{}`: {e}", path.display());
-            Error::image(path, message, Some(cause(e)))
-        })?;
+}
+
+/// Every channel of the first layer of an EXR file.
+pub fn read_channels(path: &Path) -> crate::Result<Channels> {
+    let image = read_layer(path).map_err(|e| {
+        let message = format!("cannot read `{}`: {e}", path.display());
+        Error::image(path, message, Some(cause(e)))
+    })?;
     let layer = &image.layer_data;
     let map = layer
         .channel_data

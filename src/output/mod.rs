@@ -78,6 +78,25 @@ pub struct ExrOptions {
     pub placement: Option<Placement>,
 }
 
+impl ExrOptions {
+    /// The EXR of a render of `scene` on `backend` from `scene_file` with the command line's
+    /// `overrides`: the header's camera, scene and render attributes, the Cryptomatte names, the
+    /// crop's place; the default compression, full floats.
+    pub fn for_render(
+        scene: &crate::scene::Scene,
+        backend: &str,
+        scene_file: &str,
+        overrides: &[String],
+    ) -> ExrOptions {
+        ExrOptions {
+            attributes: header::attributes(scene, backend, scene_file, overrides),
+            mattes: Some(header::matte_names(scene)),
+            placement: Placement::of(&scene.image),
+            ..Default::default()
+        }
+    }
+}
+
 /// A crop's place: the full image's size (OpenEXR's display window) and the frame's top left
 /// pixel in it (the origin of the data window), so compositors put it where it belongs and
 /// `rest-embree assemble` can join tiles.
