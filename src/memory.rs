@@ -14,6 +14,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Bytes per primitive: the scene's copy, the accelerator and its build.
 pub const BYTES_PER_PRIMITIVE: u64 = 320;
+/// Bytes per block of an instanced lattice: an Embree instance (or the f64 BVH's leaf) and its
+/// share of the tree over the blocks.
+pub const BYTES_PER_BLOCK: u64 = 1024;
 /// Bytes of memory per byte of a scene file while it is read: the text, the tokens of its
 /// longest expression and the tree (an inline mesh, the worst case, measured at about 19; a file
 /// of many small groups at about 12).
@@ -27,6 +30,17 @@ pub const STRIP_PIXELS: u64 = 1 << 18;
 /// Bytes per pixel of an EXR render's strip: the frame (92), its mattes (96), and the
 /// encoder's 46 channels of 4 bytes.
 pub const BYTES_PER_PIXEL_EXR: u64 = 380;
+
+/// The memory a lattice costs rendered: its primitives', listed, or when it is instanced
+/// (more than [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) of them) one block's and a
+/// placement per block.
+pub fn lattice_bytes(l: &crate::geometry::Lattice) -> u64 {
+    if l.len() <= crate::render::INSTANCE_OVER {
+        return l.len().saturating_mul(BYTES_PER_PRIMITIVE);
+    }
+    let blocks = crate::geometry::Blocks::of(l);
+    4 * u64::from(blocks.nodes()) * BYTES_PER_PRIMITIVE + blocks.count() * BYTES_PER_BLOCK
+}
 
 /// The limit set by [`set_limit`]; 0 for the machine's available memory.
 static LIMIT: AtomicU64 = AtomicU64::new(0);

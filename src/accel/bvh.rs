@@ -2,14 +2,18 @@
 //! with its nodes in f32 (bvh32.rs), the benchmark's f32-against-f64 BVH.
 
 use super::bvh32::Nodes32;
+use super::lattice_tree::LatticeTree;
 use super::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, BoxTree, Geometry, TreeNode};
 use std::sync::Arc;
 
 pub struct Bvh {
     geometry: Arc<Geometry>,
+    /// Over the primitives held one by one.
     nodes: Nodes,
     indices: Vec<u32>,
+    /// The lattices held as themselves, each in two levels.
+    lattices: Vec<LatticeTree>,
 }
 
 /// The tree's nodes in f64, or in f32 about the geometry's centre.
@@ -33,10 +37,12 @@ impl Bvh {
     pub fn build(geometry: Arc<Geometry>) -> Bvh {
         let boxes: Vec<Aabb> = geometry.prims.iter().map(|p| p.bounds()).collect();
         let BoxTree { nodes, indices } = BoxTree::build(&boxes);
+        let lattices = geometry.lattices.iter().map(LatticeTree::build).collect();
         Bvh {
             geometry,
             nodes: Nodes::F64(nodes),
             indices,
+            lattices,
         }
     }
 
@@ -50,6 +56,18 @@ impl Bvh {
     }
 
     fn traverse(&self, ray: &Ray, any: bool) -> Option<Hit> {
+        let mut best = self.traverse_held(ray, any);
+        for l in &self.lattices {
+            if any && best.is_some() {
+                break;
+            }
+            let tmax = best.map_or(ray.tmax, |h| h.t);
+            best = l.traverse(ray, tmax, any).or(best);
+        }
+        best
+    }
+
+    fn traverse_held(&self, ray: &Ray, any: bool) -> Option<Hit> {
         match &self.nodes {
             Nodes::F64(nodes) => {
                 let inv = ray.dir.recip();

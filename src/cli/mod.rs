@@ -327,7 +327,7 @@ fn fits_in_memory(
             .saturating_mul(memory::BYTES_PER_PIXEL_PNG),
     };
     let prims = scene.primitive_count() as u64;
-    let need = held.saturating_add(prims.saturating_mul(memory::BYTES_PER_PRIMITIVE));
+    let need = held.saturating_add(scene.primitive_bytes());
     let what = format!("a {w}x{h} render of {prims} primitives");
     let Some(why) = memory::too_much(need, &what) else {
         return Ok(());

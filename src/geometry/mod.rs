@@ -5,14 +5,16 @@
 
 mod aabb;
 mod box_tree;
+mod lattice;
 mod light_buffer;
 mod primitive;
 mod real;
 
 pub use aabb::Aabb;
 pub(crate) use box_tree::{walk, BoxTree, TreeNode, PACKET};
+pub use lattice::{Blocks, Lattice};
 pub(crate) use light_buffer::LightBuffer;
 #[cfg(feature = "embree")]
 pub(crate) use primitive::{ball_crossings, capsule_hit, cuboid_hit, cylinder_crossings, AxisRod};
-pub use primitive::{Geometry, Part, Primitive};
+pub use primitive::{Geometry, LatticeRun, Part, Primitive};
 pub(crate) use real::Real;

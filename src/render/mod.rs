@@ -18,7 +18,7 @@ mod world;
 
 pub use band::needs_spectra;
 pub use frame::{Frame, Mattes, PixelValue, CHANNELS, DEPTH_FAR, MATTE_RANKS};
-pub use world::WorldOptions;
+pub use world::{WorldOptions, INSTANCE_OVER};
 
 pub(crate) use band::Seen;
 pub(crate) use camera::CameraRays;

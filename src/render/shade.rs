@@ -174,7 +174,7 @@ impl<'a, B: Band> Shader<'a, B> {
     ) -> Lit<'a> {
         let scene = self.scene;
         let g = &self.world.groups[hit.group];
-        let prim = &g.geometry.prims[hit.prim as usize];
+        let prim = g.geometry.prim(hit.prim);
         let mat = &scene.materials[g.geometry.part_of(hit.prim).material as usize];
         let v = hit.dir / hit.s;
         let n = prim.normal(hit.point);

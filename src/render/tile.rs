@@ -402,7 +402,7 @@ pub fn render_tile<B: Band>(
             };
             if let Some((r, hit)) = aov[k] {
                 let g = &world.groups[hit.group];
-                let prim = &g.geometry.prims[hit.prim as usize];
+                let prim = g.geometry.prim(hit.prim);
                 let nrm = prim.normal(hit.point);
                 value.lookback = to_f32(hit.lambda);
                 value.doppler = to_f32(cam.lookback_factor(r.dir) / hit.s);

@@ -39,6 +39,10 @@ const LIGHT_SLICES: usize = 128;
 /// structure (and a call into it) costs more than the primitives themselves.
 pub const DIRECT_MAX: usize = 4;
 
+/// Lattices of more primitives than this are instanced by default (`WorldOptions`): the
+/// paper's 100³ lattice, 3.97 million, and smaller are listed.
+pub const INSTANCE_OVER: u64 = 4_000_000;
+
 /// The largest distance from `p` to a corner of `b`.
 fn corner_distance(b: &Aabb, p: DVec3) -> f64 {
     (b.min - p).abs().max((b.max - p).abs()).length()
@@ -61,6 +65,9 @@ pub struct WorldOptions {
     /// Let the backend make a packet's primary rays itself where it can (`primary_hits`): the
     /// same rays and hits to the bit, made several at a time.
     pub fused_primary: bool,
+    /// Lattices of more primitives than this (in one rest frame) are built from one block
+    /// placed many times (instanced), not listed primitive by primitive.
+    pub instance_over: u64,
 }
 
 impl Default for WorldOptions {
@@ -71,6 +78,7 @@ impl Default for WorldOptions {
             group_tree: true,
             direct_max: DIRECT_MAX,
             fused_primary: true,
+            instance_over: INSTANCE_OVER,
         }
     }
 }
@@ -103,10 +111,11 @@ impl WorldGroup {
             if !r.is_active() {
                 continue;
             }
-            for (i, p) in self.geometry.prims.iter().enumerate() {
+            for i in 0..self.geometry.len() {
                 let tmax = h.map_or(r.tmax, |b| b.t);
+                let p = self.geometry.prim(i);
                 if let Some(t) = p.intersect(r.origin, r.dir, r.tmin, tmax) {
-                    *h = Some(Hit { t, prim: i as u32 });
+                    *h = Some(Hit { t, prim: i });
                 }
             }
         }
@@ -119,11 +128,10 @@ impl WorldGroup {
         }
         for (r, o) in rays.iter().zip(out.iter_mut()) {
             *o = r.is_active()
-                && self
-                    .geometry
-                    .prims
-                    .iter()
-                    .any(|p| p.intersect(r.origin, r.dir, r.tmin, r.tmax).is_some());
+                && (0..self.geometry.len()).any(|i| {
+                    let p = self.geometry.prim(i);
+                    p.intersect(r.origin, r.dir, r.tmin, r.tmax).is_some()
+                });
         }
     }
 

@@ -116,14 +116,15 @@ fn build(doc: &Doc) -> SceneResult<Scene> {
         let mut geometry = Geometry::default();
         for o in t.tables("object")? {
             let id = objects.len() as u32;
-            let first = geometry.prims.len();
+            let (first, lattices) = (geometry.prims.len(), geometry.lattices.len());
             let kind = add_object(&o, id, &material_ids, &mut geometry, &mut total)?;
-            let reach = geometry.prims[first..]
+            let held = geometry.prims[first..].iter().map(|p| p.bounds());
+            let implicit = geometry.lattices[lattices..]
                 .iter()
-                .map(|p| {
-                    let b = p.bounds();
-                    b.min.abs().max(b.max.abs()).max_element()
-                })
+                .map(|r| r.lattice.bounds());
+            let reach = held
+                .chain(implicit)
+                .map(|b| b.min.abs().max(b.max.abs()).max_element())
                 .fold(0.0, f64::max);
             if reach > super::envelope::MAX_MAGNITUDE {
                 return Err(o.error("type", super::envelope::reaches_too_far(&kind, reach)));

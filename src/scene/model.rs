@@ -303,8 +303,26 @@ impl Scene {
         s
     }
 
+    /// The memory the groups' primitives cost rendered (`memory`): listed ones one by one,
+    /// instanced lattices by their blocks.
+    pub fn primitive_bytes(&self) -> u64 {
+        self.groups
+            .iter()
+            .map(|g| {
+                let held = g.geometry.prims.len() as u64 * crate::memory::BYTES_PER_PRIMITIVE;
+                let lattices: u64 = g
+                    .geometry
+                    .lattices
+                    .iter()
+                    .map(|r| crate::memory::lattice_bytes(&r.lattice))
+                    .sum();
+                held.saturating_add(lattices)
+            })
+            .fold(0, u64::saturating_add)
+    }
+
     /// How many primitives all groups hold.
     pub fn primitive_count(&self) -> usize {
-        self.groups.iter().map(|g| g.geometry.prims.len()).sum()
+        self.groups.iter().map(|g| g.geometry.len() as usize).sum()
     }
 }

@@ -3,6 +3,7 @@
 
 use super::procedural::{BarArray, Lattice};
 use super::reader::{SceneResult, Table};
+use crate::geometry::Blocks;
 use crate::geometry::{Geometry, Primitive};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -77,6 +78,25 @@ fn budget(t: &Table, key: &str, total: &mut u64, add: u64) -> SceneResult<()> {
     let need = total.saturating_mul(crate::memory::BYTES_PER_PRIMITIVE);
     if let Some(why) = crate::memory::too_much(need, &what) {
         return Err(t.error(key, why));
+    }
+    Ok(())
+}
+
+/// A lattice is held as itself, whatever its size: rendered, one of more than
+/// [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) primitives is built from one block of them
+/// (`Blocks`), costing the block's primitives and one placement per block; a smaller one is
+/// listed primitive by primitive, counting against the scene's limit as any object does.
+fn lattice_budget(t: &Table, total: &mut u64, l: &Lattice) -> SceneResult<()> {
+    if l.len() <= crate::render::INSTANCE_OVER {
+        return budget(t, "counts", total, l.len());
+    }
+    let what = format!(
+        "a lattice of {} primitives in {} blocks",
+        l.len(),
+        Blocks::of(l).count()
+    );
+    if let Some(why) = crate::memory::too_much(crate::memory::lattice_bytes(l), &what) {
+        return Err(t.error("counts", why));
     }
     Ok(())
 }
@@ -183,18 +203,11 @@ pub(super) fn add_object(
                     "rod_radius and sphere_radius are both 0: the lattice would be empty",
                 ));
             }
-            budget(
-                t,
-                "counts",
-                total,
-                l.sphere_count().saturating_add(l.rod_count()),
-            )?;
+            lattice_budget(t, total, &l)?;
             let sm = material_ref(t, "sphere_material", mats, mat)?;
             let rm = material_ref(t, "rod_material", mats, mat)?;
-            geo.prims
-                .reserve((l.sphere_count() + l.rod_count()) as usize);
-            geo.push_part(id, sm, l.spheres());
-            geo.push_part(id, rm, l.rods());
+            geo.push_lattice(id, sm, rm, l)
+                .map_err(|why| t.error("counts", why))?;
         }
         "bar_array" => {
             let counts = t

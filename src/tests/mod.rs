@@ -6,6 +6,7 @@
 mod common;
 
 mod fused_primary;
+mod instanced_lattice;
 mod light_buffer;
 mod many_groups;
 mod screen_cull;

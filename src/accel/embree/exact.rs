@@ -142,6 +142,11 @@ impl<'a> ExactContext<'a> {
         (self as *mut Self).cast()
     }
 
+    /// Whether the rays are bare: Embree's own f32 rays, tested as they are.
+    pub fn is_bare(&self) -> bool {
+        self.rays.is_empty()
+    }
+
     /// The exact t of the user-geometry hit in `lane` (valid when Embree reports one there).
     pub fn exact_t(&self, lane: usize) -> f64 {
         self.best[lane].get()
@@ -151,11 +156,11 @@ impl<'a> ExactContext<'a> {
 /// Field k of lane i of an N-wide SoA ray (`RTCRayN` / `RTCRayHitN`: 12 ray fields, then the
 /// hit's Ng_x, Ng_y, Ng_z, u, v, primID, geomID, instID, each N floats wide).
 use super::rtc::field::{DIR, ORG, TFAR, TNEAR};
-const NG: usize = 12;
-const U: usize = 15;
-const PRIM_ID: usize = 17;
-const GEOM_ID: usize = 18;
-const INST_ID: usize = 19;
+pub(super) const NG: usize = 12;
+pub(super) const U: usize = 15;
+pub(super) const PRIM_ID: usize = 17;
+pub(super) const GEOM_ID: usize = 18;
+pub(super) const INST_ID: usize = 19;
 
 /// # Safety
 /// `user` is the pointer registered for a live `Shapes<S>`, `prim` below its length.
@@ -186,19 +191,23 @@ pub(super) unsafe extern "C" fn bounds<S: Shape>(args: *const RTCBoundsFunctionA
     unsafe {
         let args = &*args;
         let (lo, hi) = shape::<S>(args.geometryUserPtr, args.primID).bounds();
-        // Rounded outward so the f32 box contains the f64 primitive.
-        let down = |x: f64| (x as f32).next_down();
-        let up = |x: f64| (x as f32).next_up();
-        *args.bounds_o = RTCBounds {
-            lower_x: down(lo.x),
-            lower_y: down(lo.y),
-            lower_z: down(lo.z),
-            align0: 0.0,
-            upper_x: up(hi.x),
-            upper_y: up(hi.y),
-            upper_z: up(hi.z),
-            align1: 0.0,
-        };
+        *args.bounds_o = outward(lo, hi);
+    }
+}
+
+/// The f32 box holding the f64 box (lo, hi): rounded outward.
+pub(super) fn outward(lo: DVec3, hi: DVec3) -> RTCBounds {
+    let down = |x: f64| (x as f32).next_down();
+    let up = |x: f64| (x as f32).next_up();
+    RTCBounds {
+        lower_x: down(lo.x),
+        lower_y: down(lo.y),
+        lower_z: down(lo.z),
+        align0: 0.0,
+        upper_x: up(hi.x),
+        upper_y: up(hi.y),
+        upper_z: up(hi.z),
+        align1: 0.0,
     }
 }
 
@@ -210,15 +219,32 @@ pub(super) unsafe extern "C" fn bounds<S: Shape>(args: *const RTCBoundsFunctionA
 /// `ctx` is an `ExactContext` (every query of this backend passes one); `base` points to an
 /// N-wide SoA ray and `valid` to its N entries.
 #[inline(always)]
-unsafe fn lane_hits<S: Shape>(
+pub(super) unsafe fn lane_hits<S: Shape>(
     ctx: &ExactContext,
     prim: &S,
     valid: *const i32,
     base: *const f32,
     n: usize,
+    found: impl FnMut(usize, f32),
+) {
+    unsafe { lane_hits_within(ctx, prim, prim.bounds(), valid, base, n, found) }
+}
+
+/// `lane_hits` with the lanes culled by `cull` (min, max), a box in the coordinates of
+/// Embree's rays (an instance's own), holding the primitive moved there.
+///
+/// # Safety
+/// As for `lane_hits`.
+#[inline(always)]
+pub(super) unsafe fn lane_hits_within<S: Shape>(
+    ctx: &ExactContext,
+    prim: &S,
+    (lo, hi): (DVec3, DVec3),
+    valid: *const i32,
+    base: *const f32,
+    n: usize,
     mut found: impl FnMut(usize, f32),
 ) {
-    let (lo, hi) = prim.bounds();
     let near = unsafe { lanes_near(valid, base, n, lo, hi) };
     if n == 1 || !S::SEVERAL {
         // Embree's single-ray traversal, or a shape tested one ray at a time: nothing to share.

@@ -19,6 +19,7 @@ mod f64x4;
 mod fan_kernel;
 mod lane_cull;
 mod lane_hits;
+mod lattice_blocks;
 mod packet;
 mod rtc;
 mod scene;
@@ -199,7 +200,7 @@ impl EmbreeAccel {
         }
         let t = (t_embree as f64 - self.pullback) / k;
         let slack = 1e-4 * t.abs().max(self.pullback / k) + 4.0 * self.pullback / k;
-        let p = &self.geometry.prims[prim as usize];
+        let p = self.geometry.prim(prim);
         let refined = p.intersect(
             r.origin,
             r.dir,

@@ -230,6 +230,11 @@ impl EmbreeAccel {
         rays: &'a [Ray],
         lanes: &'a Lanes<N>,
     ) -> ExactContext<'a> {
+        // Embree 3.13's coherent packet traversal can fail to return from an occlusion query
+        // into instances once a coherent closest-hit query has run on the thread (found on
+        // the instanced lattice: the call spun in Embree's traversal); scenes with instances
+        // trace their packets as incoherent.
+        let coherent = coherent && self.scene.coherent_packets;
         ExactContext::new(coherent, rays, lanes, self.scene.center, self.pullback)
     }
 

@@ -3,7 +3,7 @@
 //!
 //! - [`Device`]: the Embree device, with an error callback whose messages are checked after
 //!   building and committing (never per ray).
-//! - [`Geometry`]: a geometry being made (triangles or user geometry).
+//! - [`Geometry`]: a geometry being made (triangles, user geometry or an instance).
 //! - [`SceneBuilder`]: a scene being made, which geometries are attached to; committing it
 //!   gives a [`CommittedScene`], the only kind that is shared between threads and traced.
 //! - [`field`]: where Embree's SoA rays keep each field, for the user-geometry callbacks.
@@ -169,6 +169,25 @@ impl Geometry {
         }
     }
 
+    /// Make this (instance) geometry `scene` moved by `translation`. The instance keeps its
+    /// own reference to the scene.
+    pub fn set_instance(&mut self, scene: &CommittedScene, translation: [f32; 3]) {
+        let [x, y, z] = translation;
+        // Column-major 3x4: the identity, then the translation.
+        let xfm: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, x, y, z];
+        // SAFETY: a live instance geometry and a live committed scene; Embree copies the
+        // transform.
+        unsafe {
+            rtcSetGeometryInstancedScene(self.raw, scene.raw);
+            rtcSetGeometryTransform(
+                self.raw,
+                0,
+                RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR,
+                xfm.as_ptr() as *const c_void,
+            );
+        }
+    }
+
     /// A new buffer of `count` items of T (of Embree format `format`), to fill before the
     /// geometry is attached.
     pub fn new_buffer<T: Copy>(
@@ -236,6 +255,16 @@ impl SceneBuilder {
         let id = unsafe { rtcAttachGeometry(self.raw, g.raw) };
         self.device.check("attaching a geometry")?;
         Ok(id)
+    }
+
+    /// Commit `g` and attach it as geomID `id` (which no geometry of the scene has).
+    pub fn attach_as(&mut self, g: Geometry, id: u32) -> Result<()> {
+        // SAFETY: a live geometry and scene.
+        unsafe { rtcCommitGeometry(g.raw) };
+        self.device.check("committing a geometry")?;
+        // SAFETY: as above; the scene takes its own reference, ours goes with `g`.
+        unsafe { rtcAttachGeometryByID(self.raw, g.raw, id) };
+        self.device.check("attaching a geometry")
     }
 
     /// Build the scene's BVH; from now on it is only read.

@@ -1,19 +1,39 @@
 //! One Embree scene per rest-frame geometry, in f32 about the geometry's centre (so f32 never
 //! sees large coordinates): Embree's triangles for meshes, while spheres, rods and boxes are
-//! user geometry running the exact f64 tests (exact.rs).
+//! user geometry running the exact f64 tests (exact.rs), and lattices held as themselves are
+//! instances of one block (lattice_blocks.rs).
 
 use super::exact::{self, Round, Shape, Shapes};
+use super::lattice_blocks::{self, BlockScene};
 use super::rtc::{CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
-use crate::geometry::{Aabb, Geometry as SceneGeometry, Primitive};
+use crate::geometry::{Aabb, Blocks, Geometry as SceneGeometry, Primitive};
 use embree_sys::*;
 use glam::DVec3;
 use std::sync::Arc;
 
-/// Which scene primitive an Embree (geomID, primID) is: `prims[primID]`.
+/// Which scene primitive an Embree (geomID, primID) is.
 pub struct PrimMap {
-    pub prims: Vec<u32>,
+    pub prims: Prims,
     /// User geometry whose hits are already exact f64 (the context carries their t).
     pub exact: bool,
+}
+
+/// The scene primitives of one geomID, by primID.
+pub enum Prims {
+    /// `list[primID]`.
+    Listed(Vec<u32>),
+    /// `first + primID`: a lattice held as itself, whose callbacks report its own numbers.
+    From(u32),
+}
+
+impl PrimMap {
+    /// The scene primitive `prim` names.
+    fn get(&self, prim: u32) -> Option<u32> {
+        match &self.prims {
+            Prims::Listed(list) => list.get(prim as usize).copied(),
+            Prims::From(first) => Some(first + prim),
+        }
+    }
 }
 
 /// The scene primitives of an Embree scene whose every geometry is user geometry with exact
@@ -31,10 +51,13 @@ impl ExactRuns {
 
     /// The runs of these maps, if they are such.
     fn of(maps: &[PrimMap]) -> Option<ExactRuns> {
-        let run = |m: &PrimMap| {
-            let first = *m.prims.first()?;
-            let consecutive = (first..).zip(&m.prims).all(|(want, &p)| p == want);
-            (m.exact && consecutive).then_some(first)
+        let run = |m: &PrimMap| match &m.prims {
+            Prims::Listed(list) => {
+                let first = *list.first()?;
+                let consecutive = (first..).zip(list).all(|(want, &p)| p == want);
+                (m.exact && consecutive).then_some(first)
+            }
+            Prims::From(first) => m.exact.then_some(*first),
         };
         let mut firsts = [0; ExactRuns::MAX];
         if maps.is_empty() || maps.len() > ExactRuns::MAX {
@@ -65,12 +88,16 @@ pub struct EmbreeScene {
     pub exact_runs: Option<ExactRuns>,
     /// Embree coordinates are rest-frame coordinates minus this.
     pub center: DVec3,
+    /// Whether packets may be traced with Embree's coherent flag (not into instances).
+    pub coherent_packets: bool,
     /// What Embree's user geometry points into; dropped after the scene is released.
     _rounds: Option<Box<Shapes<Round>>>,
     _cuboids: Option<Box<Shapes<Aabb>>>,
+    /// The lattices' block scenes (and what their callbacks read), likewise.
+    _blocks: Vec<BlockScene>,
 }
 
-fn f3(p: DVec3) -> [f32; 3] {
+pub(super) fn f3(p: DVec3) -> [f32; 3] {
     [p.x as f32, p.y as f32, p.z as f32]
 }
 
@@ -145,21 +172,43 @@ impl EmbreeScene {
             let g = user_geometry(&device, shapes)?;
             attach(&mut builder, &mut maps, g, cuboid_map, true)?;
         }
+        // Each lattice held as itself: a slot for its hits' geomID after the geometries
+        // above, and its instances' geomIDs after every slot.
+        let mut first_instance = (maps.len() + geo.lattices.len()) as u32;
+        let mut blocks = Vec::with_capacity(geo.lattices.len());
+        for run in &geo.lattices {
+            let slot = maps.len() as u32;
+            maps.push(PrimMap {
+                prims: Prims::From(run.first),
+                exact: true,
+            });
+            blocks.push(lattice_blocks::attach(
+                &device,
+                &mut builder,
+                run,
+                center,
+                slot,
+                first_instance,
+            )?);
+            first_instance += Blocks::of(&run.lattice).count() as u32;
+        }
         let exact_runs = ExactRuns::of(&maps);
         Ok(EmbreeScene {
             rtc: builder.commit()?,
             maps,
             exact_runs,
             center,
+            coherent_packets: geo.lattices.is_empty(),
             _rounds: rounds,
             _cuboids: cuboids,
+            _blocks: blocks,
         })
     }
 
     /// The scene primitive an Embree hit names, and whether its t is exact already.
     pub fn prim(&self, geom: u32, prim: u32) -> Option<(u32, bool)> {
         let m = self.maps.get(geom as usize)?;
-        Some((*m.prims.get(prim as usize)?, m.exact))
+        Some((m.get(prim)?, m.exact))
     }
 }
 
@@ -189,11 +238,14 @@ fn attach(
     let id = builder.attach(g)? as usize;
     if maps.len() <= id {
         maps.resize_with(id + 1, || PrimMap {
-            prims: Vec::new(),
+            prims: Prims::Listed(Vec::new()),
             exact: false,
         });
     }
-    maps[id] = PrimMap { prims, exact };
+    maps[id] = PrimMap {
+        prims: Prims::Listed(prims),
+        exact,
+    };
     Ok(())
 }
 
@@ -203,7 +255,7 @@ mod tests {
 
     fn map(prims: &[u32], exact: bool) -> PrimMap {
         PrimMap {
-            prims: prims.to_vec(),
+            prims: Prims::Listed(prims.to_vec()),
             exact,
         }
     }

@@ -4,7 +4,7 @@
 
 use super::WorldOptions;
 use crate::accel::{Accelerator, Backend};
-use crate::geometry::{Aabb, Geometry, Part};
+use crate::geometry::{Aabb, Geometry};
 use crate::scene::Scene;
 use crate::spacetime::{Boost, Velocity};
 use std::sync::Arc;
@@ -56,13 +56,17 @@ impl RestGroups {
         for (velocity, members) in sets {
             let geos: Vec<&Arc<Geometry>> =
                 members.iter().map(|&i| &scene.groups[i].geometry).collect();
-            let geometry = merge(&geos);
+            let mut geometry = merge(&geos);
+            if geometry.implicit_len() > 0 && geometry.implicit_len() <= options.instance_over {
+                // Small lattices as lists of primitives, as every backend traces best.
+                geometry = Arc::new(geometry.flattened());
+            }
             let bounds = geometry.bounds();
             let names: Vec<&str> = members
                 .iter()
                 .map(|&i| scene.groups[i].name.as_str())
                 .collect();
-            let accel = if geometry.prims.len() <= options.direct_max {
+            let accel = if geometry.len() as usize <= options.direct_max {
                 None
             } else {
                 Some(Arc::from(backend.build(geometry.clone()).map_err(|e| {
@@ -95,13 +99,7 @@ fn merge(geos: &[&Arc<Geometry>]) -> Arc<Geometry> {
     }
     let mut g = Geometry::default();
     for src in geos {
-        let off = g.prims.len() as u32;
-        g.prims.extend_from_slice(&src.prims);
-        g.parts.extend(src.parts.iter().map(|p| Part {
-            start: p.start + off,
-            end: p.end + off,
-            ..p.clone()
-        }));
+        g.append(src);
     }
     Arc::new(g)
 }
