@@ -6,88 +6,87 @@
 //! bit wherever both trees reach the primitive (the local boxes are padded so that they do).
 
 use super::{Hit, Ray};
-use crate::geometry::{Aabb, Blocks, BoxTree, LatticeRun};
+use crate::geometry::{Aabb, Blocks, BoxTree, LatticeRun, Member};
+use glam::DVec3;
 
 pub(super) struct LatticeTree {
     run: LatticeRun,
     blocks: Blocks,
     /// Over the blocks, by number, in the lattice's coordinates.
     top: BoxTree,
-    /// Over one block's primitives in its local coordinates; items index `codes`.
+    /// Each block's first node and corner, by number.
+    firsts: Vec<([u32; 3], DVec3)>,
+    /// Over one block's primitives in its local coordinates; items index `members`.
     bottom: BoxTree,
-    /// A block's primitives: below `blocks.nodes()` the sphere at that local node, else the
-    /// rod numbered `code - nodes` (`Blocks::rod`).
-    codes: Vec<u32>,
+    members: Vec<Member>,
 }
 
 impl LatticeTree {
     pub fn build(run: &LatticeRun) -> LatticeTree {
         let l = &run.lattice;
         let blocks = Blocks::of(l);
+        let firsts: Vec<([u32; 3], DVec3)> = (0..blocks.count())
+            .map(|b| {
+                let b = blocks.block(b);
+                (blocks.first_of(b), blocks.corner(l, b))
+            })
+            .collect();
         let boxes: Vec<Aabb> = (0..blocks.count())
             .map(|b| blocks.bounds(l, blocks.block(b)))
             .collect();
         let nodes = blocks.nodes();
         let spheres = (l.sphere_count() > 0).then_some(0..nodes);
-        let rods = (l.rod_count() > 0).then_some(nodes..4 * nodes);
-        let codes: Vec<u32> = spheres.into_iter().chain(rods).flatten().collect();
-        let pad = glam::DVec3::splat(blocks.local_slack(l));
-        let local: Vec<Aabb> = codes
-            .iter()
-            .map(|&c| {
-                let b = if c < nodes {
-                    blocks.local_sphere(l, c)
-                } else {
-                    blocks.local_rod(l, c - nodes)
-                };
-                Aabb::new(b.min - pad, b.max + pad)
-            })
-            .collect();
+        let rods = (l.rod_count() > 0).then_some(0..3 * nodes);
+        let pad = DVec3::splat(blocks.local_slack(l));
+        let padded = |b: Aabb| Aabb::new(b.min - pad, b.max + pad);
+        let mut members = Vec::new();
+        let mut local = Vec::new();
+        for p in spheres.into_iter().flatten() {
+            members.push(blocks.sphere_member(p));
+            local.push(padded(blocks.local_sphere(l, p)));
+        }
+        for p in rods.into_iter().flatten() {
+            members.push(blocks.rod_member(p));
+            local.push(padded(blocks.local_rod(l, p)));
+        }
         LatticeTree {
             run: run.clone(),
             blocks,
             top: BoxTree::build(&boxes),
+            firsts,
             bottom: BoxTree::build(&local),
-            codes,
+            members,
         }
     }
 
     /// The closest hit on the ray before `tmax` (`any`: the first found).
     pub fn traverse(&self, ray: &Ray, tmax: f64, any: bool) -> Option<Hit> {
-        let (l, blocks) = (&self.run.lattice, &self.blocks);
-        let nodes = blocks.nodes();
+        let l = &self.run.lattice;
         let mut best = None;
         self.top
             .traverse(ray.origin, ray.dir, ray.tmin, tmax, |b, tmax| {
-                let b = blocks.block(b as u64);
-                let o = ray.origin - blocks.corner(l, b);
+                let (first, corner) = self.firsts[b as usize];
                 let mut tmax = tmax;
+                let o = ray.origin - corner;
                 self.bottom
                     .traverse(o, ray.dir, ray.tmin, tmax, |item, t_end| {
-                        let code = self.codes[item as usize];
-                        let id = if code < nodes {
-                            blocks.sphere(l, b, code)
-                        } else {
-                            blocks.rod(l, b, code - nodes)
+                        let m = self.members[item as usize];
+                        let Some(n) = self.blocks.place(l, first, m) else {
+                            return t_end;
                         };
-                        let hit = id.and_then(|id| {
-                            let t = l.prim(id).intersect(ray.origin, ray.dir, ray.tmin, t_end)?;
-                            Some(Hit {
-                                t,
-                                prim: self.run.first + id as u32,
-                            })
+                        let prim = l.member_prim(n, m);
+                        let Some(t) = prim.intersect(ray.origin, ray.dir, ray.tmin, t_end) else {
+                            return t_end;
+                        };
+                        best = Some(Hit {
+                            t,
+                            prim: self.run.first + l.member_id(n, m) as u32,
                         });
-                        match hit {
-                            Some(h) => {
-                                best = Some(h);
-                                tmax = h.t;
-                                if any {
-                                    f64::NEG_INFINITY
-                                } else {
-                                    h.t
-                                }
-                            }
-                            None => t_end,
+                        tmax = t;
+                        if any {
+                            f64::NEG_INFINITY
+                        } else {
+                            t
                         }
                     });
                 if any && best.is_some() {

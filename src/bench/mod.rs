@@ -18,7 +18,7 @@ mod scene_files;
 mod suite;
 mod threads;
 
-pub(crate) use suite::{cases, many_groups, paper};
+pub(crate) use suite::{cases, many_groups, paper, PAPER_SCENES};
 
 use crate::accel::backend_by_name;
 use crate::compare::{compare, Comparison};
@@ -162,12 +162,14 @@ impl Row {
 }
 
 /// What a setting may switch off or leave out, beside its backend's name: each word is one.
-pub(crate) const SETTING_WORDS: [(&str, &str); 5] = [
+pub(crate) const SETTING_WORDS: [(&str, &str); 7] = [
     ("no-cull", "bounds and screen culling"),
     ("no-tree", "the trees over many groups"),
     ("no-merge", "merging groups of one velocity"),
     ("no-fused", "fans of primary rays"),
     ("colour-only", "the EXR passes (a PNG's render)"),
+    ("instanced", "every lattice instanced, however small"),
+    ("listed", "every lattice listed primitive by primitive"),
 ];
 
 /// A setting: a backend name, then any of [`SETTING_WORDS`]; an unknown word is an error, so a
@@ -184,6 +186,8 @@ pub(crate) fn parse_setting(setting: &str) -> crate::Result<(&str, WorldOptions,
             "no-merge" => o.merge_equal_velocities = false,
             "no-fused" => o.fused_primary = false,
             "colour-only" => passes = Passes::Colour,
+            "instanced" => o.instance_over = 0,
+            "listed" => o.instance_over = u64::MAX,
             other => {
                 let known: Vec<String> = SETTING_WORDS
                     .iter()
@@ -675,6 +679,7 @@ pub(crate) fn summary(rows: &[Row]) -> String {
 
 pub(crate) use csv_table::csv;
 pub(crate) use film_cost::summary as film_cost;
+pub(crate) use memory::{peak_mib, reset_peak};
 pub(crate) use plot::plot_svg;
 pub(crate) use scene_files::{scene_file_here, summary as scene_files};
 pub(crate) use threads::summary as thread_scaling;

@@ -2,6 +2,7 @@
 //! one: `tiles.rs`, or a film's frames: `film.rs`), `assemble`, `farm slurm` (`farm.rs`),
 //! `backends` and `bench`.
 
+mod bench_lattice;
 mod farm;
 mod film;
 mod tiles;
@@ -49,6 +50,15 @@ pub(crate) enum Command {
     /// this fresh process, and print what it cost.
     #[command(hide = true)]
     BenchSceneFile { kind: String, size: usize },
+    /// The bench's own: render the paper's lattice grown to N^3 nodes at SIZE^2 in this fresh
+    /// process (`bench_lattice.rs`), and print what it cost.
+    #[command(hide = true)]
+    BenchLattice {
+        n: u32,
+        size: u32,
+        backend: String,
+        threads: String,
+    },
 }
 
 #[derive(clap::Args, Debug)]
@@ -219,6 +229,15 @@ fn run(cli: Cli) -> ExitCode {
         Command::Farm { scheduler } => report(farm::run(&scheduler)),
         Command::BenchSceneFile { kind, size } => {
             println!("{}", bench::scene_file_here(&kind, size));
+            ExitCode::SUCCESS
+        }
+        Command::BenchLattice {
+            n,
+            size,
+            backend,
+            threads,
+        } => {
+            println!("{}", bench_lattice::here(n, size, &backend, &threads));
             ExitCode::SUCCESS
         }
     }
@@ -501,6 +520,7 @@ fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         for b in accel::backend_names() {
             summary.push_str(&bench::film_cost(args.quick, b)?);
         }
+        summary.push_str(&bench_lattice::summary(args.quick, &accel::backend_names()));
         summary.push_str(&bench::thread_scaling(
             args.quick,
             accel::default_backend_name(),

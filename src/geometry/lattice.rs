@@ -142,6 +142,24 @@ impl Lattice {
         self.sphere_count() + (0..a).map(|b| self.rods_along(b)).sum::<u64>() + flatten(n, dims)
     }
 
+    /// The primitive a block's member makes at lattice node `n` (`Blocks::place`): the same
+    /// primitive, to the bit, as the one of that number.
+    #[inline]
+    pub fn member_prim(&self, n: [u32; 3], m: Member) -> Primitive {
+        match m.axis {
+            SPHERE => self.sphere_at(n),
+            a => self.rod_at(a as usize, n),
+        }
+    }
+
+    /// The number of the primitive a block's member makes at lattice node `n`.
+    pub fn member_id(&self, n: [u32; 3], m: Member) -> u64 {
+        match m.axis {
+            SPHERE => self.sphere_id(n),
+            a => self.rod_id(a as usize, n),
+        }
+    }
+
     /// The box holding every primitive: the same box as the union of their boxes, to the bit.
     pub fn bounds(&self) -> Aabb {
         let r = self.reach();
@@ -182,6 +200,18 @@ fn unflatten(id: u64, dims: [u32; 3]) -> [u32; 3] {
     let (x, y) = (dims[0] as u64, dims[1] as u64);
     [(id % x) as u32, (id / x % y) as u32, (id / x / y) as u32]
 }
+
+/// One of a block's primitives: the sphere at a local node, or the rod from it along an axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Member {
+    /// The node within the block.
+    pub local: [u32; 3],
+    /// The rod's axis (0, 1, 2), or [`SPHERE`].
+    pub axis: u32,
+}
+
+/// A [`Member`]'s axis when it is the sphere.
+pub const SPHERE: u32 = 3;
 
 /// A lattice cut into blocks of equal numbers of nodes, for backends that build one block and
 /// place it at every block's corner (Embree instances, the f64 BVH's two levels). A block owns
@@ -237,6 +267,37 @@ impl Blocks {
         let local = unflatten(p as u64, self.size);
         let first = self.first_node(b);
         [0, 1, 2].map(|a| first[a] + local[a])
+    }
+
+    /// The block's sphere `p` (below `nodes`) as a member.
+    pub fn sphere_member(&self, p: u32) -> Member {
+        Member {
+            local: unflatten(p as u64, self.size),
+            axis: SPHERE,
+        }
+    }
+
+    /// The block's rod `p` (below 3 `nodes`: along axis p / nodes) as a member.
+    pub fn rod_member(&self, p: u32) -> Member {
+        Member {
+            local: unflatten((p % self.nodes()) as u64, self.size),
+            axis: p / self.nodes(),
+        }
+    }
+
+    /// The lattice node of member `m` in the block whose first node is `first` (`first_node`),
+    /// if the lattice has that primitive.
+    #[inline]
+    pub fn place(&self, l: &Lattice, first: [u32; 3], m: Member) -> Option<[u32; 3]> {
+        let n = [0, 1, 2].map(|a| first[a] + m.local[a]);
+        let step = |a: usize| u32::from(m.axis == a as u32);
+        let inside = (0..3).all(|a| n[a] + step(a) < l.counts[a]);
+        inside.then_some(n)
+    }
+
+    /// Node (0, 0, 0) of block `b` in lattice node numbers.
+    pub fn first_of(&self, b: [u32; 3]) -> [u32; 3] {
+        self.first_node(b)
     }
 
     /// The lattice's number of the sphere at the block's local node `p`, if it has one there.
@@ -355,11 +416,21 @@ mod tests {
                     let d = (moved.min - pb.min).abs().max((moved.max - pb.max).abs());
                     assert!(d.max_element() <= slack, "{counts:?} block {bp:?}: {d}");
                 };
+                let first = blocks.first_of(bp);
+                let member = |m: Member| {
+                    let n = blocks.place(&l, first, m)?;
+                    assert_eq!(l.prim(l.member_id(n, m)), l.member_prim(n, m));
+                    Some(l.member_id(n, m))
+                };
                 for p in 0..blocks.nodes() {
-                    check(blocks.sphere(&l, bp, p), blocks.local_sphere(&l, p));
+                    let id = blocks.sphere(&l, bp, p);
+                    assert_eq!(member(blocks.sphere_member(p)), id);
+                    check(id, blocks.local_sphere(&l, p));
                 }
                 for p in 0..3 * blocks.nodes() {
-                    check(blocks.rod(&l, bp, p), blocks.local_rod(&l, p));
+                    let id = blocks.rod(&l, bp, p);
+                    assert_eq!(member(blocks.rod_member(p)), id);
+                    check(id, blocks.local_rod(&l, p));
                 }
             }
             assert!(seen.iter().all(|&n| n == 1), "{counts:?}");

@@ -12,7 +12,7 @@ mod real;
 
 pub use aabb::Aabb;
 pub(crate) use box_tree::{walk, BoxTree, TreeNode, PACKET};
-pub use lattice::{Blocks, Lattice};
+pub use lattice::{Blocks, Lattice, Member, SPHERE};
 pub(crate) use light_buffer::LightBuffer;
 #[cfg(feature = "embree")]
 pub(crate) use primitive::{ball_crossings, capsule_hit, cuboid_hit, cylinder_crossings, AxisRod};

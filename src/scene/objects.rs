@@ -96,9 +96,17 @@ fn lattice_budget(t: &Table, total: &mut u64, l: &Lattice) -> SceneResult<()> {
         Blocks::of(l).count()
     );
     if let Some(why) = crate::memory::too_much(crate::memory::lattice_bytes(l), &what) {
-        return Err(t.error("counts", why));
+        return Err(at_value(t, "counts", why));
     }
     Ok(())
+}
+
+/// An error about the value of `key` (on its line), or the table's where it has none.
+fn at_value(t: &Table, key: &str, why: impl Into<String>) -> super::SceneError {
+    match t.get(key) {
+        Some(n) => t.error_at(n, key, why),
+        None => t.error(key, why),
+    }
 }
 
 pub(super) fn add_object(
@@ -207,7 +215,7 @@ pub(super) fn add_object(
             let sm = material_ref(t, "sphere_material", mats, mat)?;
             let rm = material_ref(t, "rod_material", mats, mat)?;
             geo.push_lattice(id, sm, rm, l)
-                .map_err(|why| t.error("counts", why))?;
+                .map_err(|why| at_value(t, "counts", why))?;
         }
         "bar_array" => {
             let counts = t

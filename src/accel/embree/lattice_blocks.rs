@@ -11,7 +11,7 @@ use super::exact::{
 use super::rtc::field::TFAR;
 use super::rtc::{CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
 use super::scene::f3;
-use crate::geometry::{Aabb, Blocks, Lattice, LatticeRun, Primitive};
+use crate::geometry::{Aabb, Blocks, Lattice, LatticeRun, Member, Primitive};
 use embree_sys::*;
 use glam::DVec3;
 use std::sync::Arc;
@@ -21,55 +21,37 @@ use std::sync::Arc;
 struct BlockShapes {
     lattice: Lattice,
     blocks: Blocks,
-    /// Rods (`Blocks::rod` numbers) rather than spheres (`Blocks::sphere`).
-    rods: bool,
+    /// The primitives, by primID, with their padded local boxes.
+    members: Vec<(Member, (DVec3, DVec3))>,
+    /// Each instance's block: its first node and its translation as Embree has it, by
+    /// instance (geomID minus `first_instance`).
+    instances: Arc<Vec<([u32; 3], [f32; 3])>>,
     /// The geomID of block 0's instance; block b's is this plus b.
     first_instance: u32,
     /// The geomID written in hits, whose map gives the lattice's first number.
     slot: u32,
     /// Embree coordinates are the lattice's minus this.
     center: DVec3,
-    /// What local boxes are padded by: the f32 rounding of the instances' translations and
-    /// of the corners, so that a box holds its primitive seen from any instance.
-    pad: f64,
 }
 
 impl BlockShapes {
-    /// The local box of primitive `p`, padded.
-    fn local_box(&self, p: u32) -> (DVec3, DVec3) {
-        let b = if self.rods {
-            self.blocks.local_rod(&self.lattice, p)
-        } else {
-            self.blocks.local_sphere(&self.lattice, p)
-        };
-        let pad = DVec3::splat(self.pad);
-        (b.min - pad, b.max + pad)
-    }
-
-    /// Instance `inst`'s translation, as Embree has it.
-    fn translation(&self, b: [u32; 3]) -> [f32; 3] {
-        f3(self.blocks.corner(&self.lattice, b) - self.center)
-    }
-
-    /// Primitive `p` of instance `inst`, if the lattice has it: its number, and the shape to
-    /// test (relative to the Embree scene's centre; for bare rays in the instance's own
-    /// coordinates, where Embree's rays are).
-    fn prim(&self, inst: u32, p: u32, bare: bool) -> Option<(u64, Round)> {
-        let b = self
-            .blocks
-            .block(inst.wrapping_sub(self.first_instance) as u64);
+    /// Primitive `p` of instance `inst`, if the lattice has it: its number, the shape to test
+    /// (relative to the Embree scene's centre; for bare rays in the instance's own
+    /// coordinates, where Embree's rays are) and the local box to cull lanes with.
+    #[inline]
+    fn prim(&self, inst: u32, p: u32, bare: bool) -> Option<(u64, Round, (DVec3, DVec3))> {
+        let (first, translation) = *self
+            .instances
+            .get(inst.wrapping_sub(self.first_instance) as usize)?;
+        let (m, cull) = self.members[p as usize];
         let l = &self.lattice;
-        let id = if self.rods {
-            self.blocks.rod(l, b, p)
-        } else {
-            self.blocks.sphere(l, b, p)
-        }?;
+        let n = self.blocks.place(l, first, m)?;
         let shift = if bare {
-            self.center + DVec3::from_array(self.translation(b).map(f64::from))
+            self.center + DVec3::from_array(translation.map(f64::from))
         } else {
             self.center
         };
-        let round = match l.prim(id) {
+        let round = match l.member_prim(n, m) {
             Primitive::Sphere { center, radius } => Round {
                 a: center - shift,
                 b: center - shift,
@@ -82,7 +64,7 @@ impl BlockShapes {
             },
             _ => unreachable!("a lattice makes spheres and rods"),
         };
-        Some((id, round))
+        Some((l.member_id(n, m), round, cull))
     }
 }
 
@@ -107,24 +89,45 @@ pub fn attach(
     let blocks = Blocks::of(l);
     let bounds = l.bounds();
     let span = Aabb::new(bounds.min - center, bounds.max - center).max_abs();
-    let pad = span * f64::from(f32::EPSILON) + blocks.local_slack(l);
-    let kinds = [(false, l.sphere_count() > 0), (true, l.rod_count() > 0)];
-    let shapes: Box<[BlockShapes]> = kinds
+    // What local boxes are padded by: the f32 rounding of the instances' translations and of
+    // the corners, so that a box holds its primitive seen from any instance.
+    let pad = DVec3::splat(span * f64::from(f32::EPSILON) + blocks.local_slack(l));
+    let padded = |b: Aabb| (b.min - pad, b.max + pad);
+    let instances: Arc<Vec<([u32; 3], [f32; 3])>> = Arc::new(
+        (0..blocks.count())
+            .map(|b| {
+                let b = blocks.block(b);
+                (blocks.first_of(b), f3(blocks.corner(l, b) - center))
+            })
+            .collect(),
+    );
+    let nodes = blocks.nodes();
+    let spheres = (l.sphere_count() > 0).then(|| {
+        (0..nodes)
+            .map(|p| (blocks.sphere_member(p), padded(blocks.local_sphere(l, p))))
+            .collect::<Vec<_>>()
+    });
+    let rods = (l.rod_count() > 0).then(|| {
+        (0..3 * nodes)
+            .map(|p| (blocks.rod_member(p), padded(blocks.local_rod(l, p))))
+            .collect::<Vec<_>>()
+    });
+    let shapes: Box<[BlockShapes]> = spheres
         .into_iter()
-        .filter(|&(_, present)| present)
-        .map(|(rods, _)| BlockShapes {
+        .chain(rods)
+        .map(|members| BlockShapes {
             lattice: l.clone(),
             blocks,
-            rods,
+            members,
+            instances: instances.clone(),
             first_instance,
             slot,
             center,
-            pad,
         })
         .collect();
     let mut block = SceneBuilder::new(device)?;
     for s in shapes.iter() {
-        let count = if s.rods { 3 } else { 1 } * blocks.nodes();
+        let count = s.members.len() as u32;
         let mut g = Geometry::new(device, RTC_GEOMETRY_TYPE_USER)?;
         let ptr = s as *const BlockShapes as *mut std::ffi::c_void;
         // SAFETY: the shapes are boxed in the `BlockScene` returned, which releases the block
@@ -143,10 +146,9 @@ pub fn attach(
         block.attach(g)?;
     }
     let scene = block.commit()?;
-    let first = &shapes[0];
-    for b in 0..blocks.count() {
+    for (b, &(_, translation)) in instances.iter().enumerate() {
         let mut g = Geometry::new(device, RTC_GEOMETRY_TYPE_INSTANCE)?;
-        g.set_instance(&scene, first.translation(blocks.block(b)));
+        g.set_instance(&scene, translation);
         builder.attach_as(g, first_instance + b as u32)?;
     }
     Ok(BlockScene {
@@ -165,7 +167,7 @@ unsafe extern "C" fn block_bounds(args: *const RTCBoundsFunctionArguments) {
     // SAFETY: Embree passes the user pointer we registered and a prim below the count we set.
     unsafe {
         let args = &*args;
-        let (lo, hi) = shapes(args.geometryUserPtr).local_box(args.primID);
+        let (lo, hi) = shapes(args.geometryUserPtr).members[args.primID as usize].1;
         *args.bounds_o = outward(lo, hi);
     }
 }
@@ -178,12 +180,11 @@ unsafe extern "C" fn block_intersect(args: *const RTCIntersectFunctionNArguments
         let s = shapes(args.geometryUserPtr);
         let ctx = &*(args.context as *const ExactContext);
         let inst = (*args.context).instID[0];
-        let Some((id, round)) = s.prim(inst, args.primID, ctx.is_bare()) else {
+        let Some((id, round, cull)) = s.prim(inst, args.primID, ctx.is_bare()) else {
             return;
         };
         let n = args.N as usize;
         let base = args.rayhit as *mut f32;
-        let cull = s.local_box(args.primID);
         lane_hits_within(ctx, &round, cull, args.valid, base, n, |i, t| {
             let slot = |k: usize| base.add(k * n + i);
             *slot(TFAR) = t;
@@ -206,12 +207,11 @@ unsafe extern "C" fn block_occluded(args: *const RTCOccludedFunctionNArguments) 
         let s = shapes(args.geometryUserPtr);
         let ctx = &*(args.context as *const ExactContext);
         let inst = (*args.context).instID[0];
-        let Some((_, round)) = s.prim(inst, args.primID, ctx.is_bare()) else {
+        let Some((_, round, cull)) = s.prim(inst, args.primID, ctx.is_bare()) else {
             return;
         };
         let n = args.N as usize;
         let base = args.ray as *mut f32;
-        let cull = s.local_box(args.primID);
         lane_hits_within(ctx, &round, cull, args.valid, base, n, |i, _| {
             *base.add(TFAR * n + i) = f32::NEG_INFINITY;
         });
