@@ -178,3 +178,60 @@ fn the_paper_lattice_renders_alike_instanced() {
         assert_eq!(differ, 0, "{name}: {differ} pixels differ");
     }
 }
+
+/// Groups of one velocity merged (`Geometry::append`): every primitive keeps its shape and its
+/// object, the held ones numbered before every lattice's, whatever order the groups came in.
+#[test]
+fn merged_geometries_keep_every_primitive() {
+    let small = |origin: f64, object: u32| {
+        let mut g = Geometry::default();
+        g.push_lattice(
+            object,
+            0,
+            1,
+            Lattice {
+                counts: [3, 2, 2],
+                spacing: DVec3::ONE,
+                origin: DVec3::splat(origin),
+                rod_radius: 0.05,
+                sphere_radius: 0.1,
+            },
+        )
+        .unwrap();
+        // Held after the lattice: numbered before it.
+        g.push_part(
+            object + 1,
+            2,
+            [Primitive::Sphere {
+                center: DVec3::splat(origin - 5.0),
+                radius: 1.0,
+            }],
+        );
+        g
+    };
+    let (a, b) = (small(0.0, 0), small(20.0, 10));
+    let mut merged = a.clone();
+    merged.append(&b);
+    assert_eq!(merged.len(), a.len() + b.len());
+    assert_eq!(merged.prims.len(), 2);
+    let flat = merged.flattened();
+    // Each primitive with its object, material and index among its object's primitives.
+    let of = |g: &Geometry, i: u32| {
+        let part = g.part_of(i);
+        (g.prim(i), part.object, part.material, g.index_in_object(i))
+    };
+    let mut from: Vec<_> = Vec::new();
+    for g in [&a, &b] {
+        from.extend((0..g.len()).map(|i| of(g, i)));
+    }
+    let mut got: Vec<_> = (0..merged.len())
+        .map(|i| {
+            assert_eq!(merged.prim(i), flat.prims[i as usize]);
+            of(&merged, i)
+        })
+        .collect();
+    let key = |p: &(Primitive, u32, u32, u32)| format!("{p:?}");
+    from.sort_by_key(key);
+    got.sort_by_key(key);
+    assert_eq!(got, from);
+}
