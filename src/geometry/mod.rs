@@ -5,6 +5,7 @@
 
 mod aabb;
 mod box_tree;
+mod group_geometry;
 mod lattice;
 mod light_buffer;
 mod primitive;
@@ -12,9 +13,10 @@ mod real;
 
 pub use aabb::Aabb;
 pub(crate) use box_tree::{walk, BoxTree, TreeNode, PACKET};
+pub use group_geometry::{Geometry, LatticeRun, Part};
 pub use lattice::{Blocks, Lattice, Member, SPHERE};
 pub(crate) use light_buffer::LightBuffer;
+pub use primitive::Primitive;
 #[cfg(feature = "embree")]
 pub(crate) use primitive::{ball_crossings, capsule_hit, cuboid_hit, cylinder_crossings, AxisRod};
-pub use primitive::{Geometry, LatticeRun, Part, Primitive};
 pub(crate) use real::Real;
