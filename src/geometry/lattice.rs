@@ -262,7 +262,9 @@ impl Blocks {
         l.node_at(self.first_node(b))
     }
 
-    /// The block's local node `p` (below [`nodes`](Self::nodes)) in lattice node numbers.
+    /// The block's local node `p` (below [`nodes`](Self::nodes)) in lattice node numbers
+    /// (with `sphere` and `rod`, the tests' numbering by arithmetic, against `place`).
+    #[cfg(test)]
     fn node_of(&self, b: [u32; 3], p: u32) -> [u32; 3] {
         let local = unflatten(p as u64, self.size);
         let first = self.first_node(b);
@@ -301,14 +303,16 @@ impl Blocks {
     }
 
     /// The lattice's number of the sphere at the block's local node `p`, if it has one there.
-    pub fn sphere(&self, l: &Lattice, b: [u32; 3], p: u32) -> Option<u64> {
+    #[cfg(test)]
+    fn sphere(&self, l: &Lattice, b: [u32; 3], p: u32) -> Option<u64> {
         let n = self.node_of(b, p);
         (n.iter().zip(&l.counts).all(|(i, c)| i < c)).then(|| l.sphere_id(n))
     }
 
     /// The lattice's number of the block's rod `p`: along axis p / nodes from local node
     /// p % nodes, if the lattice has it.
-    pub fn rod(&self, l: &Lattice, b: [u32; 3], p: u32) -> Option<u64> {
+    #[cfg(test)]
+    fn rod(&self, l: &Lattice, b: [u32; 3], p: u32) -> Option<u64> {
         let a = (p / self.nodes()) as usize;
         let n = self.node_of(b, p % self.nodes());
         let inside = (0..3).all(|k| n[k] + STEPS[a][k] < l.counts[k]);
