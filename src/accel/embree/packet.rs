@@ -31,8 +31,9 @@ pub(super) fn flush_denormals() {
 /// A thread's Embree packet of each kind, kept and reused: made per packet, a 16-wide
 /// `RTCRayHit16` is 1.28 kB zeroed before its rays are written over half of it. The fields
 /// every query here gives the same value (a ray's time 0, mask all ones, flags and id 0; a
-/// hit's instID none, which is also what Embree writes back at the top level) are set when
-/// the packet is made, and nothing changes them; each query writes the rest that Embree reads
+/// hit's instID none) are set when the packet is made, and nothing changes them but a hit's
+/// instID, which the lattice blocks' callbacks write (lattice_blocks.rs) and nothing reads:
+/// the hits' read-back goes by geomID and primID alone; each query writes the rest that Embree reads
 /// in the lanes it marks valid: a ray's origin, tnear, direction and tfar (`Lane::set`, or the
 /// fans' kernel) and a hit's geomID. The rest of a hit Embree writes where it
 /// reports one. Embree's callbacks start no query, so a packet is never in use twice on one
