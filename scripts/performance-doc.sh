@@ -16,8 +16,8 @@ figures is in [architecture.md](architecture.md#how-it-is-fast).
 
 What each row measures, on a fixed suite (the paper's lattice at β = 0, 0.5, 0.9 and 0.99 with
 every setting, what lights, mirrors, the EXR passes and spectra cost, a 100³ lattice at 1024²
-instanced and listed, 1 to 10,000 velocity groups, merging; and below the table, each in a
-process of its own, the 1000³ lattice at 1024² as a whole command):
+and a 1000 × 1000 bar array, instanced and listed, 1 to 10,000 velocity groups, merging; and
+below the table, each in a process of its own, the 1000³ lattice at 1024² as a whole command):
 
 - **build s**: building the acceleration structures; **render s**: a full render (shading,
   shadow and secondary rays, passes), the fastest of as many runs as fit in a quarter second
@@ -34,9 +34,9 @@ process of its own, the 1000³ lattice at 1024² as a whole command):
 - **embree bare (no relativity)**: the same rest-frame rays through the same Embree scene with
   no camera, boosts, rebasing or hit bookkeeping, measured side by side with the layer, so the
   relativistic layer's cost is a ratio from one run.
-- **listed**: lattices held primitive by primitive; by default a lattice of over 100,000
-  primitives is instanced (docs/architecture.md, "Lattices are instanced"), and the 100³ case's
-  **differing px** compares both ways with the f64 BVH's frame.
+- **listed**: lattices and bar arrays held primitive by primitive; by default one of over
+  100,000 primitives is instanced (docs/architecture.md, "Lattices and bar arrays are
+  instanced"), and those cases' **differing px** compares both ways with the f64 BVH's frame.
 - Cases with a scene **beside** them (many groups against the same boxes in one group; the
   spectral lattice against the same scene in RGB) measure both in alternating blocks, so the
   machine's drift falls on both alike.

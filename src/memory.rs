@@ -31,15 +31,17 @@ pub const STRIP_PIXELS: u64 = 1 << 18;
 /// encoder's 46 channels of 4 bytes.
 pub const BYTES_PER_PIXEL_EXR: u64 = 380;
 
-/// The memory a lattice costs rendered: its primitives', listed, or when it is instanced
-/// (more than [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) of them) one block's and a
-/// placement per block.
-pub fn lattice_bytes(l: &crate::geometry::Lattice) -> u64 {
-    if l.len() <= crate::render::INSTANCE_OVER {
-        return l.len().saturating_mul(BYTES_PER_PRIMITIVE);
+/// The memory an object held as itself (a lattice, a bar array) costs rendered: its
+/// primitives', listed, or when it is instanced (more than
+/// [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) of them) one block's and a placement per
+/// block.
+pub fn implicit_bytes(shape: &crate::geometry::Implicit) -> u64 {
+    if shape.len() <= crate::render::INSTANCE_OVER {
+        return shape.len().saturating_mul(BYTES_PER_PRIMITIVE);
     }
-    let blocks = crate::geometry::Blocks::of(l);
-    4 * u64::from(blocks.nodes()) * BYTES_PER_PRIMITIVE + blocks.count() * BYTES_PER_BLOCK
+    let blocks = crate::geometry::Blocks::of(shape.grid());
+    let members: u64 = shape.members(&blocks).iter().map(|m| m.len() as u64).sum();
+    members * BYTES_PER_PRIMITIVE + blocks.count() * BYTES_PER_BLOCK
 }
 
 /// The limit set by [`set_limit`]; 0 for the machine's available memory.

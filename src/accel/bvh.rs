@@ -2,7 +2,7 @@
 //! with its nodes in f32 (bvh32.rs), the benchmark's f32-against-f64 BVH.
 
 use super::bvh32::Nodes32;
-use super::lattice_tree::LatticeTree;
+use super::instanced_tree::InstancedTree;
 use super::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, BoxTree, Geometry, TreeNode};
 use std::sync::Arc;
@@ -12,8 +12,8 @@ pub struct Bvh {
     /// Over the primitives held one by one.
     nodes: Nodes,
     indices: Vec<u32>,
-    /// The lattices held as themselves, each in two levels.
-    lattices: Vec<LatticeTree>,
+    /// The objects held as themselves (lattices, bar arrays), each in two levels.
+    instanced: Vec<InstancedTree>,
 }
 
 /// The tree's nodes in f64, or in f32 about the geometry's centre.
@@ -37,12 +37,12 @@ impl Bvh {
     pub fn build(geometry: Arc<Geometry>) -> Bvh {
         let boxes: Vec<Aabb> = geometry.prims.iter().map(|p| p.bounds()).collect();
         let BoxTree { nodes, indices } = BoxTree::build(&boxes);
-        let lattices = geometry.lattices.iter().map(LatticeTree::build).collect();
+        let instanced = geometry.implicit.iter().map(InstancedTree::build).collect();
         Bvh {
             geometry,
             nodes: Nodes::F64(nodes),
             indices,
-            lattices,
+            instanced,
         }
     }
 
@@ -57,7 +57,7 @@ impl Bvh {
 
     fn traverse(&self, ray: &Ray, any: bool) -> Option<Hit> {
         let mut best = self.traverse_held(ray, any);
-        for l in &self.lattices {
+        for l in &self.instanced {
             if any && best.is_some() {
                 break;
             }

@@ -14,7 +14,7 @@ mod bvh32;
 #[cfg(feature = "embree")]
 mod embree;
 mod fan;
-mod lattice_tree;
+mod instanced_tree;
 
 pub(crate) use bvh::BvhBackend;
 pub(crate) use bvh32::Bvh32Backend;

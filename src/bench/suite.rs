@@ -214,6 +214,22 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
         )
         .without_hi_reference())
     }));
+    // A large bar array (a million bars; 10,000 in the quick suite), instanced and listed.
+    let bars = if quick { 100 } else { 1000 };
+    let bars_name = format!("bar array {bars}x{bars} beta=0.9");
+    out.push(LazyCase::new(&bars_name.clone(), move || {
+        let mut s = size(px);
+        s.extend([
+            "group.bars.velocity=[0.9,0,0]".to_string(),
+            format!("group.bars.object.array.counts=[{bars},{bars}]"),
+        ]);
+        Ok(Case::new(
+            &bars_name,
+            paper("bar_array", &s)?,
+            &["embree", "bvh", "embree listed", "bvh listed"],
+        )
+        .without_hi_reference())
+    }));
     // Many velocity groups, against one group holding the same boxes.
     let gpx = px / 2;
     let many = if quick {

@@ -1,7 +1,7 @@
 //! The static geometry of one velocity group in its rest frame: primitives held one by one,
-//! lattices held as themselves, and the parts (object and material) they belong to.
+//! lattices and bar arrays held as themselves, and the parts (object and material) they belong to.
 
-use super::{Aabb, Lattice, Primitive};
+use super::{Aabb, Implicit, Primitive};
 use glam::DVec3;
 
 /// A run of primitives that came from one scene object, with one material.
@@ -19,24 +19,26 @@ pub struct Part {
 
 /// The static geometry of one velocity group, in its rest frame.
 ///
-/// Primitives are numbered from 0: first those held in `prims`, then those of the implicit
-/// lattices, each a run of numbers (`LatticeRun`). Read one by number with [`prim`](Self::prim).
+/// Primitives are numbered from 0: first those held in `prims`, then those of the objects held
+/// as themselves, each a run of numbers (`ImplicitRun`). Read one by number with
+/// [`prim`](Self::prim).
 #[derive(Clone, Debug, Default)]
 pub struct Geometry {
     /// The primitives held one by one: numbers 0 to `prims.len()`.
     pub prims: Vec<Primitive>,
     /// The runs of primitives, in order, covering every primitive.
     pub parts: Vec<Part>,
-    /// Lattices whose primitives are made from their numbers, after `prims`, in order.
-    pub lattices: Vec<LatticeRun>,
+    /// Objects held as themselves (lattices, bar arrays), whose primitives are made from their
+    /// numbers, after `prims`, in order.
+    pub implicit: Vec<ImplicitRun>,
 }
 
-/// A lattice held as itself: its primitives are numbers `first ..` `first + lattice.len()`.
+/// An object held as itself: its primitives are numbers `first ..` `first + shape.len()`.
 #[derive(Clone, Debug, PartialEq)]
-pub struct LatticeRun {
-    /// The lattice.
-    pub lattice: Lattice,
-    /// The geometry's number of the lattice's primitive 0.
+pub struct ImplicitRun {
+    /// The object.
+    pub shape: Implicit,
+    /// The geometry's number of the object's primitive 0.
     pub first: u32,
 }
 
@@ -52,14 +54,14 @@ impl Geometry {
         self.prims.extend(prims);
         let end = self.prims.len() as u32;
         if end > start {
-            // Held primitives come before the lattices' numbers: move those along.
+            // Held primitives come before the implicit objects' numbers: move those along.
             let added = end - start;
             let at = self.parts.partition_point(|p| p.start < start);
             for p in &mut self.parts[at..] {
                 p.start += added;
                 p.end += added;
             }
-            for run in &mut self.lattices {
+            for run in &mut self.implicit {
                 run.first += added;
             }
             self.parts.insert(
@@ -74,52 +76,51 @@ impl Geometry {
         }
     }
 
-    /// Append a lattice as itself (its spheres one part, its rods another), numbered after
-    /// everything else; an error if the geometry would hold more primitives than a `u32`
-    /// numbers.
-    pub fn push_lattice(
+    /// Append an object as itself, numbered after everything else: its primitives in runs of
+    /// `(count, material)` (a lattice's spheres, then its rods; a bar array's bars); an error if
+    /// the geometry would hold more primitives than a `u32` numbers.
+    pub fn push_implicit(
         &mut self,
         object: u32,
-        sphere_material: u32,
-        rod_material: u32,
-        lattice: Lattice,
+        runs: &[(u64, u32)],
+        shape: Implicit,
     ) -> Result<(), String> {
         let first = self.len();
-        let total = first as u64 + lattice.len();
+        let total = first as u64 + shape.len();
         if total > u32::MAX as u64 {
             return Err(format!(
-                "a velocity group holds at most {} primitives; this lattice would make it {total}",
+                "a velocity group holds at most {} primitives; this object would make it {total}",
                 u32::MAX
             ));
         }
-        let mid = first + lattice.sphere_count() as u32;
-        let end = total as u32;
-        for (start, end, material) in [(first, mid, sphere_material), (mid, end, rod_material)] {
-            if end > start {
-                self.parts.push(Part {
-                    start,
-                    end,
-                    object,
-                    material,
-                });
-            }
+        let mut start = first;
+        for &(count, material) in runs.iter().filter(|(count, _)| *count > 0) {
+            let end = start + count as u32;
+            self.parts.push(Part {
+                start,
+                end,
+                object,
+                material,
+            });
+            start = end;
         }
-        if end > first {
-            self.lattices.push(LatticeRun { lattice, first });
+        debug_assert_eq!(start as u64, total, "the runs cover the object");
+        if total > first as u64 {
+            self.implicit.push(ImplicitRun { shape, first });
         }
         Ok(())
     }
 
     /// How many primitives, held and implicit.
     pub fn len(&self) -> u32 {
-        self.lattices.last().map_or(self.prims.len() as u32, |r| {
-            r.first + r.lattice.len() as u32
-        })
+        self.implicit
+            .last()
+            .map_or(self.prims.len() as u32, |r| r.first + r.shape.len() as u32)
     }
 
-    /// How many primitives the implicit lattices make.
+    /// How many primitives the objects held as themselves make.
     pub fn implicit_len(&self) -> u64 {
-        self.lattices.iter().map(|r| r.lattice.len()).sum()
+        self.implicit.iter().map(|r| r.shape.len()).sum()
     }
 
     /// Primitive number `id` (below [`len`](Self::len)).
@@ -133,36 +134,37 @@ impl Geometry {
 
     #[inline(never)]
     fn implicit(&self, id: u32) -> Primitive {
-        let i = self.lattices.partition_point(|r| r.first <= id) - 1;
-        let run = &self.lattices[i];
-        run.lattice.prim((id - run.first) as u64)
+        let i = self.implicit.partition_point(|r| r.first <= id) - 1;
+        let run = &self.implicit[i];
+        run.shape.prim((id - run.first) as u64)
     }
 
-    /// The same geometry with every lattice's primitives held one by one (the same numbers).
+    /// The same geometry with every implicit object's primitives held one by one (the same
+    /// numbers).
     pub fn flattened(&self) -> Geometry {
         let mut prims = Vec::with_capacity(self.len() as usize);
         prims.extend_from_slice(&self.prims);
-        for run in &self.lattices {
-            prims.extend(run.lattice.spheres().chain(run.lattice.rods()));
+        for run in &self.implicit {
+            prims.extend(run.shape.listed());
         }
         Geometry {
             prims,
             parts: self.parts.clone(),
-            lattices: Vec::new(),
+            implicit: Vec::new(),
         }
     }
 
     /// This geometry with the primitives of `other` after its own (held ones before the
-    /// lattices', both in order).
+    /// implicit objects', both in order).
     pub fn append(&mut self, other: &Geometry) {
         let held = other.prims.len() as u32;
         let (mine, theirs) = (
             self.prims.len() as u32,
             self.len() - self.prims.len() as u32,
         );
-        // Our lattices move along by their held primitives; their held ones follow ours, and
-        // their lattices all of ours.
-        for run in &mut self.lattices {
+        // Our implicit objects move along by their held primitives; their held ones follow
+        // ours, and their implicit ones all of ours.
+        for run in &mut self.implicit {
             run.first += held;
         }
         let mut parts = Vec::with_capacity(self.parts.len() + other.parts.len());
@@ -182,9 +184,9 @@ impl Geometry {
         parts.extend(own_lat.iter().map(|p| moved(p, held)));
         parts.extend(other_lat.iter().map(|p| moved(p, mine + theirs)));
         self.prims.extend_from_slice(&other.prims);
-        self.lattices
-            .extend(other.lattices.iter().map(|r| LatticeRun {
-                lattice: r.lattice.clone(),
+        self.implicit
+            .extend(other.implicit.iter().map(|r| ImplicitRun {
+                shape: r.shape.clone(),
                 first: r.first + mine + theirs,
             }));
         self.parts = parts;
@@ -216,9 +218,9 @@ impl Geometry {
             .prims
             .iter()
             .fold(Aabb::EMPTY, |b, p| b.union(&p.bounds()));
-        self.lattices
+        self.implicit
             .iter()
-            .fold(held, |b, r| b.union(&r.lattice.bounds()))
+            .fold(held, |b, r| b.union(&r.shape.bounds()))
     }
 
     /// Whether it holds no primitive.
@@ -231,11 +233,11 @@ impl Geometry {
         Geometry {
             prims: self.prims.iter().map(|p| p.translated(d)).collect(),
             parts: self.parts.clone(),
-            lattices: self
-                .lattices
+            implicit: self
+                .implicit
                 .iter()
-                .map(|r| LatticeRun {
-                    lattice: r.lattice.translated(d),
+                .map(|r| ImplicitRun {
+                    shape: r.shape.translated(d),
                     first: r.first,
                 })
                 .collect(),

@@ -4,6 +4,7 @@
 //! block's primitives, placed at every block's corner, with the primitives that do not exist
 //! (past the lattice's far faces) skipped by number.
 
+use super::implicit::{flatten, unflatten, Member, SPHERE};
 use super::{Aabb, Primitive};
 use glam::DVec3;
 
@@ -70,7 +71,8 @@ impl Lattice {
         self.origin + DVec3::new(i as f64, j as f64, k as f64) * self.spacing
     }
 
-    fn node_at(&self, n: [u32; 3]) -> DVec3 {
+    /// The position of node `n`.
+    pub fn node_at(&self, n: [u32; 3]) -> DVec3 {
         self.node(n[0], n[1], n[2])
     }
 
@@ -167,8 +169,22 @@ impl Lattice {
         Aabb::new(self.origin - r, self.node_at(far) + r)
     }
 
+    /// The box of member `m` relative to its block's first node.
+    pub fn local_box(&self, m: Member) -> Aabb {
+        let start = local(self, m.local);
+        if m.axis == SPHERE {
+            let r = DVec3::splat(self.sphere_radius);
+            return Aabb::new(start - r, start + r);
+        }
+        let s = STEPS[m.axis as usize];
+        let n = m.local;
+        let end = local(self, [n[0] + s[0], n[1] + s[1], n[2] + s[2]]);
+        let r = DVec3::splat(self.rod_radius);
+        Aabb::new(start - r, end + r)
+    }
+
     /// How far primitives reach beyond the nodes: the larger radius of the kinds present.
-    fn reach(&self) -> DVec3 {
+    pub fn reach(&self) -> DVec3 {
         let rods = if self.rod_count() > 0 {
             self.rod_radius
         } else {
@@ -188,172 +204,6 @@ impl Lattice {
             origin: self.origin + d,
             ..self.clone()
         }
-    }
-}
-
-/// `n` as a number in the mixed radix `dims`, x fastest.
-fn flatten(n: [u32; 3], dims: [u32; 3]) -> u64 {
-    n[0] as u64 + dims[0] as u64 * (n[1] as u64 + dims[1] as u64 * n[2] as u64)
-}
-
-fn unflatten(id: u64, dims: [u32; 3]) -> [u32; 3] {
-    let (x, y) = (dims[0] as u64, dims[1] as u64);
-    [(id % x) as u32, (id / x % y) as u32, (id / x / y) as u32]
-}
-
-/// One of a block's primitives: the sphere at a local node, or the rod from it along an axis.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Member {
-    /// The node within the block.
-    pub local: [u32; 3],
-    /// The rod's axis (0, 1, 2), or [`SPHERE`].
-    pub axis: u32,
-}
-
-/// A [`Member`]'s axis when it is the sphere.
-pub const SPHERE: u32 = 3;
-
-/// A lattice cut into blocks of equal numbers of nodes, for backends that build one block and
-/// place it at every block's corner (Embree instances, the f64 BVH's two levels). A block owns
-/// its nodes' spheres and the rods that start at its nodes (along +x, +y, +z, so a block's last
-/// rods reach into the next block); blocks on the far faces hold numbers for nodes and rods
-/// the lattice does not have, which [`Blocks::sphere`] and [`Blocks::rod`] answer None for.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Blocks {
-    /// Nodes per block along each axis.
-    pub size: [u32; 3],
-    /// Blocks along each axis.
-    pub grid: [u32; 3],
-}
-
-impl Blocks {
-    /// Blocks of about √n nodes a side for a lattice n nodes long, so that the block's
-    /// primitives and the blocks number alike (4 s³ against (n / s)³).
-    pub fn of(l: &Lattice) -> Blocks {
-        let longest = *l.counts.iter().max().expect("three counts") as f64;
-        let side = (longest.sqrt().ceil() as u32).clamp(2, 64);
-        let size = l.counts.map(|c| c.min(side));
-        let grid = [0, 1, 2].map(|a| l.counts[a].div_ceil(size[a]));
-        Blocks { size, grid }
-    }
-
-    /// How many blocks.
-    pub fn count(&self) -> u64 {
-        self.grid.iter().map(|&g| g as u64).product()
-    }
-
-    /// Nodes of one block.
-    pub fn nodes(&self) -> u32 {
-        self.size.iter().product()
-    }
-
-    /// Block number `b`'s grid position (x fastest).
-    pub fn block(&self, b: u64) -> [u32; 3] {
-        unflatten(b, self.grid)
-    }
-
-    /// Node (0, 0, 0) of block `b` in lattice node numbers.
-    fn first_node(&self, b: [u32; 3]) -> [u32; 3] {
-        [0, 1, 2].map(|a| b[a] * self.size[a])
-    }
-
-    /// Where block `b` sits: its first node's position, the origin of its local coordinates.
-    pub fn corner(&self, l: &Lattice, b: [u32; 3]) -> DVec3 {
-        l.node_at(self.first_node(b))
-    }
-
-    /// The block's local node `p` (below [`nodes`](Self::nodes)) in lattice node numbers
-    /// (with `sphere` and `rod`, the tests' numbering by arithmetic, against `place`).
-    #[cfg(test)]
-    fn node_of(&self, b: [u32; 3], p: u32) -> [u32; 3] {
-        let local = unflatten(p as u64, self.size);
-        let first = self.first_node(b);
-        [0, 1, 2].map(|a| first[a] + local[a])
-    }
-
-    /// The block's sphere `p` (below `nodes`) as a member.
-    pub fn sphere_member(&self, p: u32) -> Member {
-        Member {
-            local: unflatten(p as u64, self.size),
-            axis: SPHERE,
-        }
-    }
-
-    /// The block's rod `p` (below 3 `nodes`: along axis p / nodes) as a member.
-    pub fn rod_member(&self, p: u32) -> Member {
-        Member {
-            local: unflatten((p % self.nodes()) as u64, self.size),
-            axis: p / self.nodes(),
-        }
-    }
-
-    /// The lattice node of member `m` in the block whose first node is `first` (`first_node`),
-    /// if the lattice has that primitive.
-    #[inline]
-    pub fn place(&self, l: &Lattice, first: [u32; 3], m: Member) -> Option<[u32; 3]> {
-        let n = [0, 1, 2].map(|a| first[a] + m.local[a]);
-        let step = |a: usize| u32::from(m.axis == a as u32);
-        let inside = (0..3).all(|a| n[a] + step(a) < l.counts[a]);
-        inside.then_some(n)
-    }
-
-    /// Node (0, 0, 0) of block `b` in lattice node numbers.
-    pub fn first_of(&self, b: [u32; 3]) -> [u32; 3] {
-        self.first_node(b)
-    }
-
-    /// The lattice's number of the sphere at the block's local node `p`, if it has one there.
-    #[cfg(test)]
-    fn sphere(&self, l: &Lattice, b: [u32; 3], p: u32) -> Option<u64> {
-        let n = self.node_of(b, p);
-        (n.iter().zip(&l.counts).all(|(i, c)| i < c)).then(|| l.sphere_id(n))
-    }
-
-    /// The lattice's number of the block's rod `p`: along axis p / nodes from local node
-    /// p % nodes, if the lattice has it.
-    #[cfg(test)]
-    fn rod(&self, l: &Lattice, b: [u32; 3], p: u32) -> Option<u64> {
-        let a = (p / self.nodes()) as usize;
-        let n = self.node_of(b, p % self.nodes());
-        let inside = (0..3).all(|k| n[k] + STEPS[a][k] < l.counts[k]);
-        inside.then(|| l.rod_id(a, n))
-    }
-
-    /// The box of the block's sphere `p` in its local coordinates (relative to its corner).
-    pub fn local_sphere(&self, l: &Lattice, p: u32) -> Aabb {
-        let n = unflatten(p as u64, self.size);
-        let c = local(l, n);
-        let r = DVec3::splat(l.sphere_radius);
-        Aabb::new(c - r, c + r)
-    }
-
-    /// The box of the block's rod `p` in its local coordinates.
-    pub fn local_rod(&self, l: &Lattice, p: u32) -> Aabb {
-        let a = (p / self.nodes()) as usize;
-        let n = unflatten((p % self.nodes()) as u64, self.size);
-        let s = STEPS[a];
-        let start = local(l, n);
-        let end = local(l, [n[0] + s[0], n[1] + s[1], n[2] + s[2]]);
-        let r = DVec3::splat(l.rod_radius);
-        Aabb::new(start - r, end + r)
-    }
-
-    /// The box, in the lattice's coordinates, of what block `b` holds that exists.
-    pub fn bounds(&self, l: &Lattice, b: [u32; 3]) -> Aabb {
-        let first = self.first_node(b);
-        // The last node the block's primitives reach: its own last one, or the next block's
-        // first where rods run into it.
-        let last = [0, 1, 2].map(|a| (first[a] + self.size[a]).min(l.counts[a] - 1));
-        let r = l.reach();
-        Aabb::new(l.node_at(first) - r, l.node_at(last) + r)
-    }
-
-    /// How far a primitive's box in local coordinates may be from the primitive moved by the
-    /// block's corner, for any block: what rounding the corner and the nodes' positions can
-    /// make (a few units in the last place of the lattice's largest coordinate), with a
-    /// thousandfold margin.
-    pub fn local_slack(&self, l: &Lattice) -> f64 {
-        1e-12 * (l.bounds().max_abs() + l.bounds().diagonal())
     }
 }
 
@@ -396,56 +246,5 @@ mod tests {
             let union = listed.iter().fold(Aabb::EMPTY, |b, p| b.union(&p.bounds()));
             assert_eq!(l.bounds(), union, "{counts:?}");
         }
-    }
-
-    /// Every primitive of the lattice is in exactly one block, at its number, inside the
-    /// block's bounds and (moved by the block's corner) inside its local box.
-    #[test]
-    fn blocks_cover_every_primitive_once() {
-        for counts in [[7, 5, 3], [10, 10, 10], [1, 9, 2], [30, 4, 17]] {
-            let l = lattice(counts, 0.05, 0.15);
-            let blocks = Blocks::of(&l);
-            let mut seen = vec![0u8; l.len() as usize];
-            let slack = blocks.local_slack(&l);
-            for b in 0..blocks.count() {
-                let bp = blocks.block(b);
-                let corner = blocks.corner(&l, bp);
-                let bounds = blocks.bounds(&l, bp);
-                let mut check = |id: Option<u64>, local: Aabb| {
-                    let Some(id) = id else { return };
-                    seen[id as usize] += 1;
-                    let pb = l.prim(id).bounds();
-                    assert!(bounds.min.cmple(pb.min).all() && pb.max.cmple(bounds.max).all());
-                    let moved = Aabb::new(local.min + corner, local.max + corner);
-                    let d = (moved.min - pb.min).abs().max((moved.max - pb.max).abs());
-                    assert!(d.max_element() <= slack, "{counts:?} block {bp:?}: {d}");
-                };
-                let first = blocks.first_of(bp);
-                let member = |m: Member| {
-                    let n = blocks.place(&l, first, m)?;
-                    assert_eq!(l.prim(l.member_id(n, m)), l.member_prim(n, m));
-                    Some(l.member_id(n, m))
-                };
-                for p in 0..blocks.nodes() {
-                    let id = blocks.sphere(&l, bp, p);
-                    assert_eq!(member(blocks.sphere_member(p)), id);
-                    check(id, blocks.local_sphere(&l, p));
-                }
-                for p in 0..3 * blocks.nodes() {
-                    let id = blocks.rod(&l, bp, p);
-                    assert_eq!(member(blocks.rod_member(p)), id);
-                    check(id, blocks.local_rod(&l, p));
-                }
-            }
-            assert!(seen.iter().all(|&n| n == 1), "{counts:?}");
-        }
-    }
-
-    #[test]
-    fn blocks_are_about_the_square_root_of_the_lattice() {
-        let b = Blocks::of(&lattice([1000, 1000, 1000], 0.05, 0.15));
-        assert_eq!((b.size, b.grid), ([32; 3], [32; 3]));
-        let b = Blocks::of(&lattice([100, 3, 1], 0.05, 0.15));
-        assert_eq!((b.size, b.grid), ([10, 3, 1], [10, 1, 1]));
     }
 }

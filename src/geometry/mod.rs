@@ -4,17 +4,21 @@
 //! null direction whose length is the Doppler-like factor, so `t` is the world-frame lookback time.
 
 mod aabb;
+mod bars;
 mod box_tree;
 mod group_geometry;
+mod implicit;
 mod lattice;
 mod light_buffer;
 mod primitive;
 mod real;
 
 pub use aabb::Aabb;
+pub use bars::BarArray;
 pub(crate) use box_tree::{walk, BoxTree, TreeNode, PACKET};
-pub use group_geometry::{Geometry, LatticeRun, Part};
-pub use lattice::{Blocks, Lattice, Member, SPHERE};
+pub use group_geometry::{Geometry, ImplicitRun, Part};
+pub use implicit::{Blocks, Implicit, Member, BAR, SPHERE};
+pub use lattice::Lattice;
 pub(crate) use light_buffer::LightBuffer;
 pub use primitive::Primitive;
 #[cfg(feature = "embree")]

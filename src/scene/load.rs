@@ -116,12 +116,12 @@ fn build(doc: &Doc) -> SceneResult<Scene> {
         let mut geometry = Geometry::default();
         for o in t.tables("object")? {
             let id = objects.len() as u32;
-            let (first, lattices) = (geometry.prims.len(), geometry.lattices.len());
+            let (first, implicit) = (geometry.prims.len(), geometry.implicit.len());
             let kind = add_object(&o, id, &material_ids, &mut geometry, &mut total)?;
             let held = geometry.prims[first..].iter().map(|p| p.bounds());
-            let implicit = geometry.lattices[lattices..]
+            let implicit = geometry.implicit[implicit..]
                 .iter()
-                .map(|r| r.lattice.bounds());
+                .map(|r| r.shape.bounds());
             let reach = held
                 .chain(implicit)
                 .map(|b| b.min.abs().max(b.max.abs()).max_element())

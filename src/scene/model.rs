@@ -304,19 +304,19 @@ impl Scene {
     }
 
     /// The memory the groups' primitives cost rendered (`memory`): listed ones one by one,
-    /// instanced lattices by their blocks.
+    /// instanced lattices and bar arrays by their blocks.
     pub fn primitive_bytes(&self) -> u64 {
         self.groups
             .iter()
             .map(|g| {
                 let held = g.geometry.prims.len() as u64 * crate::memory::BYTES_PER_PRIMITIVE;
-                let lattices: u64 = g
+                let implicit: u64 = g
                     .geometry
-                    .lattices
+                    .implicit
                     .iter()
-                    .map(|r| crate::memory::lattice_bytes(&r.lattice))
+                    .map(|r| crate::memory::implicit_bytes(&r.shape))
                     .sum();
-                held.saturating_add(lattices)
+                held.saturating_add(implicit)
             })
             .fold(0, u64::saturating_add)
     }

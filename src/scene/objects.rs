@@ -3,7 +3,7 @@
 
 use super::procedural::{BarArray, Lattice};
 use super::reader::{SceneResult, Table};
-use crate::geometry::Blocks;
+use crate::geometry::{Blocks, Implicit};
 use crate::geometry::{Geometry, Primitive};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -82,20 +82,20 @@ fn budget(t: &Table, key: &str, total: &mut u64, add: u64) -> SceneResult<()> {
     Ok(())
 }
 
-/// A lattice is held as itself, whatever its size: rendered, one of more than
+/// A lattice or bar array is held as itself, whatever its size: rendered, one of more than
 /// [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) primitives is built from one block of them
 /// (`Blocks`), costing the block's primitives and one placement per block; a smaller one is
 /// listed primitive by primitive, counting against the scene's limit as any object does.
-fn lattice_budget(t: &Table, total: &mut u64, l: &Lattice) -> SceneResult<()> {
-    if l.len() <= crate::render::INSTANCE_OVER {
-        return budget(t, "counts", total, l.len());
+fn implicit_budget(t: &Table, total: &mut u64, shape: &Implicit) -> SceneResult<()> {
+    if shape.len() <= crate::render::INSTANCE_OVER {
+        return budget(t, "counts", total, shape.len());
     }
     let what = format!(
-        "a lattice of {} primitives in {} blocks",
-        l.len(),
-        Blocks::of(l).count()
+        "an object of {} primitives in {} blocks",
+        shape.len(),
+        Blocks::of(shape.grid()).count()
     );
-    if let Some(why) = crate::memory::too_much(crate::memory::lattice_bytes(l), &what) {
+    if let Some(why) = crate::memory::too_much(crate::memory::implicit_bytes(shape), &what) {
         return Err(at_value(t, "counts", why));
     }
     Ok(())
@@ -211,10 +211,12 @@ pub(super) fn add_object(
                     "rod_radius and sphere_radius are both 0: the lattice would be empty",
                 ));
             }
-            lattice_budget(t, total, &l)?;
             let sm = material_ref(t, "sphere_material", mats, mat)?;
             let rm = material_ref(t, "rod_material", mats, mat)?;
-            geo.push_lattice(id, sm, rm, l)
+            let runs = [(l.sphere_count(), sm), (l.rod_count(), rm)];
+            let shape = Implicit::Lattice(l);
+            implicit_budget(t, total, &shape)?;
+            geo.push_implicit(id, &runs, shape)
                 .map_err(|why| at_value(t, "counts", why))?;
         }
         "bar_array" => {
@@ -244,8 +246,11 @@ pub(super) fn add_object(
                 axis,
                 center: t.vec3("center")?.unwrap_or(DVec3::ZERO),
             };
-            budget(t, "counts", total, counts[0] * counts[1])?;
-            geo.push_part(id, mat, b.bars());
+            let runs = [(b.len(), mat)];
+            let shape = Implicit::Bars(b);
+            implicit_budget(t, total, &shape)?;
+            geo.push_implicit(id, &runs, shape)
+                .map_err(|why| at_value(t, "counts", why))?;
         }
         other => {
             let n = t.get("type").expect("read above");

@@ -1,15 +1,23 @@
-//! A lattice held as itself (instanced blocks in Embree, two levels in the f64 BVH) against
-//! the same lattice listed primitive by primitive: the same hits, primitive and lookback time
-//! to the bit, for rays from outside and inside, in packets and alone, and the same occlusion.
+//! Lattices and bar arrays held as themselves (instanced blocks in Embree, two levels in the
+//! f64 BVH) against the same objects listed primitive by primitive: the same hits, primitive
+//! and lookback time to the bit, for rays from outside and inside, in packets and alone, and
+//! the same occlusion.
 
 use crate::accel::{backend_by_name, Accelerator, Hit, Ray};
-use crate::geometry::{Geometry, Lattice, Primitive};
+use crate::geometry::{BarArray, Geometry, Implicit, Lattice, Primitive};
 use crate::rng::Rng;
 use glam::DVec3;
 use std::sync::Arc;
 
+/// Push a lattice as itself, spheres with material `sm`, rods with `rm`.
+fn push_lattice(g: &mut Geometry, object: u32, sm: u32, rm: u32, l: Lattice) {
+    let runs = [(l.sphere_count(), sm), (l.rod_count(), rm)];
+    g.push_implicit(object, &runs, Implicit::Lattice(l))
+        .unwrap();
+}
+
 /// A lattice whose blocks do not divide it (so the far blocks hold numbers it lacks), after a
-/// box held as itself, and a second lattice of spheres only.
+/// box held as itself, a second lattice of spheres only, and a bar array.
 fn geometry() -> Geometry {
     let mut g = Geometry::default();
     g.push_part(
@@ -27,7 +35,7 @@ fn geometry() -> Geometry {
         rod_radius: 0.05,
         sphere_radius: 0.15,
     };
-    g.push_lattice(1, 1, 2, lattice).unwrap();
+    push_lattice(&mut g, 1, 1, 2, lattice);
     let spheres = Lattice {
         counts: [5, 4, 3],
         spacing: DVec3::splat(2.0),
@@ -35,7 +43,17 @@ fn geometry() -> Geometry {
         rod_radius: 0.0,
         sphere_radius: 0.4,
     };
-    g.push_lattice(2, 3, 3, spheres).unwrap();
+    push_lattice(&mut g, 2, 3, 3, spheres);
+    let bars = BarArray {
+        counts: [13, 7],
+        spacing: [1.5, 2.0],
+        bar_size: [0.5, 0.6],
+        length: 9.0,
+        axis: 1,
+        center: DVec3::new(10.0, 2.0, 3.0),
+    };
+    g.push_implicit(3, &[(bars.len(), 4)], Implicit::Bars(bars))
+        .unwrap();
     g
 }
 
@@ -90,7 +108,7 @@ fn occluded(accel: &dyn Accelerator, rays: &[Ray], width: usize) -> Vec<bool> {
 fn held_lattices_hit_as_listed_ones() {
     let held = Arc::new(geometry());
     let listed = Arc::new(held.flattened());
-    assert!(held.prims.len() == 1 && listed.lattices.is_empty());
+    assert!(held.prims.len() == 1 && held.implicit.len() == 3 && listed.implicit.is_empty());
     assert_eq!(held.len(), listed.len());
     let mut rng = Rng(0x1a77_1ce0_5eed_0001);
     let rays = rays(&mut rng, 6000);
@@ -135,47 +153,58 @@ fn held_lattices_hit_as_listed_ones() {
     }
 }
 
-/// The paper's lattice rendered instanced and listed: the same frame, every pass, on each
-/// backend (the f64 BVH's hits are the listed ones to the bit; Embree's f32 traversal may
-/// find a silhouette's grazing ray on one side and not the other).
+/// The paper's lattice and bar array rendered instanced and listed: the same frame, every
+/// pass, on each backend.
 #[test]
-fn the_paper_lattice_renders_alike_instanced() {
+fn the_paper_scenes_render_alike_instanced() {
     use crate::render::{render_world, World, WorldOptions};
-    let sets: Vec<String> = [
-        "image.width=64",
-        "image.height=64",
-        "image.samples=1",
-        "group.lattice.velocity=[-0.9, 0, 0]",
-        "group.lattice.object.lattice.counts=[14, 13, 12]",
-        "render.doppler=true",
-        "render.searchlight=true",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    let scene = crate::bench::paper("lattice", &sets).unwrap();
-    for name in crate::accel::backend_names() {
-        let backend = backend_by_name(name).unwrap();
-        let build = |instance_over| {
-            let options = WorldOptions {
-                instance_over,
-                ..WorldOptions::default()
+    let sets = |list: &[&str]| -> Vec<String> {
+        let mut all = vec![
+            "image.width=64",
+            "image.height=64",
+            "image.samples=1",
+            "render.doppler=true",
+            "render.searchlight=true",
+        ];
+        all.extend_from_slice(list);
+        all.iter().map(|s| s.to_string()).collect()
+    };
+    let scenes = [
+        (
+            "lattice",
+            sets(&[
+                "group.lattice.velocity=[-0.9, 0, 0]",
+                "group.lattice.object.lattice.counts=[14, 13, 12]",
+            ]),
+        ),
+        ("bar_array", sets(&["group.bars.velocity=[0.9, 0, 0]"])),
+    ];
+    for (paper, sets) in scenes {
+        let scene = crate::bench::paper(paper, &sets).unwrap();
+        for name in crate::accel::backend_names() {
+            let backend = backend_by_name(name).unwrap();
+            let build = |instance_over| {
+                let options = WorldOptions {
+                    instance_over,
+                    ..WorldOptions::default()
+                };
+                World::build_with(&scene, backend.as_ref(), options).unwrap()
             };
-            World::build_with(&scene, backend.as_ref(), options).unwrap()
-        };
-        let held = build(0);
-        let listed = build(u64::MAX);
-        assert!(!held.groups[0].geometry.lattices.is_empty());
-        assert!(listed.groups[0].geometry.lattices.is_empty());
-        let a = render_world(&scene, &held).0;
-        let b = render_world(&scene, &listed).0;
-        let differ = a
-            .pixels
-            .iter()
-            .zip(&b.pixels)
-            .filter(|(p, q)| p != q)
-            .count();
-        assert_eq!(differ, 0, "{name}: {differ} pixels differ");
+            let held = build(0);
+            let listed = build(u64::MAX);
+            assert!(!held.groups[0].geometry.implicit.is_empty(), "{paper}");
+            assert!(listed.groups[0].geometry.implicit.is_empty());
+            let a = render_world(&scene, &held).0;
+            let b = render_world(&scene, &listed).0;
+            assert!(a.pixels.iter().any(|p| p.object_id > 0), "{paper}: empty");
+            let differ = a
+                .pixels
+                .iter()
+                .zip(&b.pixels)
+                .filter(|(p, q)| p != q)
+                .count();
+            assert_eq!(differ, 0, "{paper}, {name}: {differ} pixels differ");
+        }
     }
 }
 
@@ -185,7 +214,8 @@ fn the_paper_lattice_renders_alike_instanced() {
 fn merged_geometries_keep_every_primitive() {
     let small = |origin: f64, object: u32| {
         let mut g = Geometry::default();
-        g.push_lattice(
+        push_lattice(
+            &mut g,
             object,
             0,
             1,
@@ -196,8 +226,7 @@ fn merged_geometries_keep_every_primitive() {
                 rod_radius: 0.05,
                 sphere_radius: 0.1,
             },
-        )
-        .unwrap();
+        );
         // Held after the lattice: numbered before it.
         g.push_part(
             object + 1,

@@ -17,9 +17,9 @@ mod exact;
 mod f64x4;
 #[cfg(target_arch = "x86_64")]
 mod fan_kernel;
+mod instanced_blocks;
 mod lane_cull;
 mod lane_hits;
-mod lattice_blocks;
 mod packet;
 mod rtc;
 mod scene;

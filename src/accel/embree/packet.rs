@@ -32,7 +32,7 @@ pub(super) fn flush_denormals() {
 /// `RTCRayHit16` is 1.28 kB zeroed before its rays are written over half of it. The fields
 /// every query here gives the same value (a ray's time 0, mask all ones, flags and id 0; a
 /// hit's instID none) are set when the packet is made, and nothing changes them but a hit's
-/// instID, which the lattice blocks' callbacks write (lattice_blocks.rs) and nothing reads:
+/// instID, which the instanced blocks' callbacks write (instanced_blocks.rs) and nothing reads:
 /// the hits' read-back goes by geomID and primID alone; each query writes the rest that Embree reads
 /// in the lanes it marks valid: a ray's origin, tnear, direction and tfar (`Lane::set`, or the
 /// fans' kernel) and a hit's geomID. The rest of a hit Embree writes where it

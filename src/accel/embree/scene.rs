@@ -1,10 +1,10 @@
 //! One Embree scene per rest-frame geometry, in f32 about the geometry's centre (so f32 never
 //! sees large coordinates): Embree's triangles for meshes, while spheres, rods and boxes are
-//! user geometry running the exact f64 tests (exact.rs), and lattices held as themselves are
-//! instances of one block (lattice_blocks.rs).
+//! user geometry running the exact f64 tests (exact.rs), and lattices and bar arrays held as
+//! themselves are instances of one block (instanced_blocks.rs).
 
 use super::exact::{self, Round, Shape, Shapes};
-use super::lattice_blocks::{self, BlockScene};
+use super::instanced_blocks::{self, BlockScene};
 use super::rtc::{CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
 use crate::geometry::{Aabb, Blocks, Geometry as SceneGeometry, Primitive};
 use embree_sys::*;
@@ -93,7 +93,7 @@ pub struct EmbreeScene {
     /// What Embree's user geometry points into; dropped after the scene is released.
     _rounds: Option<Box<Shapes<Round>>>,
     _cuboids: Option<Box<Shapes<Aabb>>>,
-    /// The lattices' block scenes (and what their callbacks read), likewise.
+    /// The implicit objects' block scenes (and what their callbacks read), likewise.
     _blocks: Vec<BlockScene>,
 }
 
@@ -172,17 +172,17 @@ impl EmbreeScene {
             let g = user_geometry(&device, shapes)?;
             attach(&mut builder, &mut maps, g, cuboid_map, true)?;
         }
-        // Each lattice held as itself: a slot for its hits' geomID after the geometries
-        // above, and its instances' geomIDs after every slot.
-        let mut first_instance = (maps.len() + geo.lattices.len()) as u32;
-        let mut blocks = Vec::with_capacity(geo.lattices.len());
-        for run in &geo.lattices {
+        // Each object held as itself: a slot for its hits' geomID after the geometries above,
+        // and its instances' geomIDs after every slot.
+        let mut first_instance = (maps.len() + geo.implicit.len()) as u32;
+        let mut blocks = Vec::with_capacity(geo.implicit.len());
+        for run in &geo.implicit {
             let slot = maps.len() as u32;
             maps.push(PrimMap {
                 prims: Prims::From(run.first),
                 exact: true,
             });
-            blocks.push(lattice_blocks::attach(
+            blocks.push(instanced_blocks::attach(
                 &device,
                 &mut builder,
                 run,
@@ -190,7 +190,7 @@ impl EmbreeScene {
                 slot,
                 first_instance,
             )?);
-            first_instance += Blocks::of(&run.lattice).count() as u32;
+            first_instance += Blocks::of(run.shape.grid()).count() as u32;
         }
         let exact_runs = ExactRuns::of(&maps);
         Ok(EmbreeScene {
@@ -198,7 +198,7 @@ impl EmbreeScene {
             maps,
             exact_runs,
             center,
-            coherent_packets: geo.lattices.is_empty(),
+            coherent_packets: geo.implicit.is_empty(),
             _rounds: rounds,
             _cuboids: cuboids,
             _blocks: blocks,

@@ -58,7 +58,8 @@ impl RestGroups {
                 members.iter().map(|&i| &scene.groups[i].geometry).collect();
             let mut geometry = merge(&geos);
             if geometry.implicit_len() > 0 && geometry.implicit_len() <= options.instance_over {
-                // Small lattices as lists of primitives, as every backend traces best.
+                // Small lattices and bar arrays as lists of primitives, as every backend traces
+                // best.
                 geometry = Arc::new(geometry.flattened());
             }
             let bounds = geometry.bounds();

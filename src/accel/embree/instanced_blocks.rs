@@ -1,57 +1,31 @@
-//! A lattice held as itself (`LatticeRun`) as Embree instances: one Embree scene of a block's
-//! spheres and rods (user geometry, in the block's own coordinates) placed at every block's
-//! corner by a translation. Embree's f32 traversal only finds candidates; the callbacks make
-//! the lattice's own primitive from its number and test it in f64 on the caller's ray, as the
-//! listed lattice's user geometry does (exact.rs), so hits keep their exact lookback times,
-//! and a block's numbers the lattice does not have (past its far faces) are skipped.
+//! An object held as itself (`ImplicitRun`: a lattice, a bar array) as Embree instances: one
+//! Embree scene of a block's members (user geometry in the block's own coordinates: a
+//! lattice's spheres and rods as rounds, bars as boxes) placed at every block's first node by a
+//! translation. Embree's f32 traversal only finds candidates; the callbacks make the object's
+//! own primitive from its member and node and test it in f64 on the caller's ray, as the
+//! listed object's user geometry does (exact.rs), so hits keep their exact lookback times, and
+//! a block's members the object does not have (past its far faces) are skipped.
 
 use super::exact::{
-    lane_hits_within, outward, ExactContext, Round, GEOM_ID, INST_ID, NG, PRIM_ID, U,
+    lane_hits_within, outward, ExactContext, Round, Shape, GEOM_ID, INST_ID, NG, PRIM_ID, U,
 };
 use super::rtc::field::TFAR;
 use super::rtc::{CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
 use super::scene::f3;
-use crate::geometry::{Aabb, Blocks, Lattice, LatticeRun, Member, Primitive};
+use crate::geometry::{Aabb, Blocks, Implicit, ImplicitRun, Member, Primitive};
 use embree_sys::*;
 use glam::DVec3;
 use std::sync::Arc;
 
-/// One kind of a block's primitives (its spheres, or its rods), as its user geometry's
-/// callbacks read them.
-struct BlockShapes {
-    lattice: Lattice,
-    blocks: Blocks,
-    /// The primitives, by primID, with their padded local boxes.
-    members: Vec<(Member, (DVec3, DVec3))>,
-    /// Each instance's block: its first node and its translation as Embree has it, by
-    /// instance (geomID minus `first_instance`).
-    instances: Arc<Vec<([u32; 3], [f32; 3])>>,
-    /// The geomID of block 0's instance; block b's is this plus b.
-    first_instance: u32,
-    /// The geomID written in hits, whose map gives the lattice's first number.
-    slot: u32,
-    /// Embree coordinates are the lattice's minus this.
-    center: DVec3,
+/// A user-geometry shape made from a primitive moved by `-shift`.
+trait FromPrimitive: Shape {
+    fn from_primitive(p: Primitive, shift: DVec3) -> Self;
 }
 
-impl BlockShapes {
-    /// Primitive `p` of instance `inst`, if the lattice has it: its number, the shape to test
-    /// (relative to the Embree scene's centre; for bare rays in the instance's own
-    /// coordinates, where Embree's rays are) and the local box to cull lanes with.
+impl FromPrimitive for Round {
     #[inline]
-    fn prim(&self, inst: u32, p: u32, bare: bool) -> Option<(u64, Round, (DVec3, DVec3))> {
-        let (first, translation) = *self
-            .instances
-            .get(inst.wrapping_sub(self.first_instance) as usize)?;
-        let (m, cull) = self.members[p as usize];
-        let l = &self.lattice;
-        let n = self.blocks.place(l, first, m)?;
-        let shift = if bare {
-            self.center + DVec3::from_array(translation.map(f64::from))
-        } else {
-            self.center
-        };
-        let round = match l.member_prim(n, m) {
+    fn from_primitive(p: Primitive, shift: DVec3) -> Round {
+        match p {
             Primitive::Sphere { center, radius } => Round {
                 a: center - shift,
                 b: center - shift,
@@ -63,12 +37,65 @@ impl BlockShapes {
                 radius,
             },
             _ => unreachable!("a lattice makes spheres and rods"),
-        };
-        Some((l.member_id(n, m), round, cull))
+        }
     }
 }
 
-/// A lattice's block scene and what its callbacks read: released in that order.
+impl FromPrimitive for Aabb {
+    #[inline]
+    fn from_primitive(p: Primitive, shift: DVec3) -> Aabb {
+        match p {
+            Primitive::Cuboid { min, max } => Aabb::new(min - shift, max - shift),
+            _ => unreachable!("a bar array makes boxes"),
+        }
+    }
+}
+
+/// One kind of a block's members (a lattice's spheres, its rods; the bars), as its user
+/// geometry's callbacks read them.
+struct BlockShapes {
+    shape: Implicit,
+    blocks: Blocks,
+    /// The members, by primID, with their padded local boxes.
+    members: Vec<(Member, (DVec3, DVec3))>,
+    /// Each instance's block: its first node and its translation as Embree has it, by
+    /// instance (geomID minus `first_instance`).
+    instances: Arc<Vec<([u32; 3], [f32; 3])>>,
+    /// The geomID of block 0's instance; block b's is this plus b.
+    first_instance: u32,
+    /// The geomID written in hits, whose map gives the object's first number.
+    slot: u32,
+    /// Embree coordinates are the object's minus this.
+    center: DVec3,
+}
+
+impl BlockShapes {
+    /// Member `p` of instance `inst`, if the object has it: its number, the shape to test
+    /// (relative to the Embree scene's centre; for bare rays in the instance's own
+    /// coordinates, where Embree's rays are) and the local box to cull lanes with.
+    #[inline]
+    fn prim<S: FromPrimitive>(
+        &self,
+        inst: u32,
+        p: u32,
+        bare: bool,
+    ) -> Option<(u64, S, (DVec3, DVec3))> {
+        let (first, translation) = *self
+            .instances
+            .get(inst.wrapping_sub(self.first_instance) as usize)?;
+        let (m, cull) = self.members[p as usize];
+        let n = self.blocks.place(self.shape.grid(), first, m)?;
+        let shift = if bare {
+            self.center + DVec3::from_array(translation.map(f64::from))
+        } else {
+            self.center
+        };
+        let s = S::from_primitive(self.shape.member_prim(n, m), shift);
+        Some((self.shape.member_id(n, m), s, cull))
+    }
+}
+
+/// An object's block scene and what its callbacks read: released in that order.
 pub struct BlockScene {
     _scene: CommittedScene,
     /// Never grown or moved out of: Embree holds pointers into it.
@@ -76,73 +103,70 @@ pub struct BlockScene {
 }
 
 /// Build `run`'s block scene and attach one instance of it per block to `builder`, as geomIDs
-/// `first_instance ..`; hits are reported with geomID `slot` and primID the lattice's number.
+/// `first_instance ..`; hits are reported with geomID `slot` and primID the object's number.
 pub fn attach(
     device: &Arc<Device>,
     builder: &mut SceneBuilder,
-    run: &LatticeRun,
+    run: &ImplicitRun,
     center: DVec3,
     slot: u32,
     first_instance: u32,
 ) -> crate::Result<BlockScene> {
-    let l = &run.lattice;
-    let blocks = Blocks::of(l);
-    let bounds = l.bounds();
+    let shape = &run.shape;
+    let blocks = Blocks::of(shape.grid());
+    let bounds = shape.bounds();
     let span = Aabb::new(bounds.min - center, bounds.max - center).max_abs();
     // What local boxes are padded by: the f32 rounding of the instances' translations and of
-    // the corners, so that a box holds its primitive seen from any instance.
-    let pad = DVec3::splat(span * f64::from(f32::EPSILON) + blocks.local_slack(l));
-    let padded = |b: Aabb| (b.min - pad, b.max + pad);
+    // the nodes, so that a box holds its primitive seen from any instance.
+    let pad = DVec3::splat(span * f64::from(f32::EPSILON) + shape.local_slack());
     let instances: Arc<Vec<([u32; 3], [f32; 3])>> = Arc::new(
         (0..blocks.count())
             .map(|b| {
-                let b = blocks.block(b);
-                (blocks.first_of(b), f3(blocks.corner(l, b) - center))
+                let first = blocks.first_of(blocks.block(b));
+                (first, f3(shape.node(first) - center))
             })
             .collect(),
     );
-    let nodes = blocks.nodes();
-    let spheres = (l.sphere_count() > 0).then(|| {
-        (0..nodes)
-            .map(|p| (blocks.sphere_member(p), padded(blocks.local_sphere(l, p))))
-            .collect::<Vec<_>>()
-    });
-    let rods = (l.rod_count() > 0).then(|| {
-        (0..3 * nodes)
-            .map(|p| (blocks.rod_member(p), padded(blocks.local_rod(l, p))))
-            .collect::<Vec<_>>()
-    });
-    let shapes: Box<[BlockShapes]> = spheres
+    let shapes: Box<[BlockShapes]> = shape
+        .members(&blocks)
         .into_iter()
-        .chain(rods)
         .map(|members| BlockShapes {
-            lattice: l.clone(),
+            shape: shape.clone(),
             blocks,
-            members,
+            members: members
+                .into_iter()
+                .map(|m| {
+                    let b = shape.local_box(m);
+                    (m, (b.min - pad, b.max + pad))
+                })
+                .collect(),
             instances: instances.clone(),
             first_instance,
             slot,
             center,
         })
         .collect();
+    let functions = || match shape {
+        Implicit::Lattice(_) => UserFunctions {
+            bounds: block_bounds,
+            intersect: block_intersect::<Round>,
+            occluded: block_occluded::<Round>,
+        },
+        Implicit::Bars(_) => UserFunctions {
+            bounds: block_bounds,
+            intersect: block_intersect::<Aabb>,
+            occluded: block_occluded::<Aabb>,
+        },
+    };
     let mut block = SceneBuilder::new(device)?;
     for s in shapes.iter() {
         let count = s.members.len() as u32;
         let mut g = Geometry::new(device, RTC_GEOMETRY_TYPE_USER)?;
         let ptr = s as *const BlockShapes as *mut std::ffi::c_void;
         // SAFETY: the shapes are boxed in the `BlockScene` returned, which releases the block
-        // scene before them; the callbacks read the pointer as `BlockShapes`.
-        unsafe {
-            g.set_user(
-                count,
-                ptr,
-                UserFunctions {
-                    bounds: block_bounds,
-                    intersect: block_intersect,
-                    occluded: block_occluded,
-                },
-            )
-        };
+        // scene before them; the callbacks read the pointer as `BlockShapes`, and make the
+        // shape kind the object makes (`functions`).
+        unsafe { g.set_user(count, ptr, functions()) };
         block.attach(g)?;
     }
     let scene = block.commit()?;
@@ -172,7 +196,9 @@ unsafe extern "C" fn block_bounds(args: *const RTCBoundsFunctionArguments) {
     }
 }
 
-unsafe extern "C" fn block_intersect(args: *const RTCIntersectFunctionNArguments) {
+unsafe extern "C" fn block_intersect<S: FromPrimitive>(
+    args: *const RTCIntersectFunctionNArguments,
+) {
     // SAFETY: as for `block_bounds`; `rayhit` is an N-wide RTCRayHitN, `valid` has N entries
     // and `context` is the ExactContext the query was started with, inside an instance.
     unsafe {
@@ -180,12 +206,12 @@ unsafe extern "C" fn block_intersect(args: *const RTCIntersectFunctionNArguments
         let s = shapes(args.geometryUserPtr);
         let ctx = &*(args.context as *const ExactContext);
         let inst = (*args.context).instID[0];
-        let Some((id, round, cull)) = s.prim(inst, args.primID, ctx.is_bare()) else {
+        let Some((id, shape, cull)) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
             return;
         };
         let n = args.N as usize;
         let base = args.rayhit as *mut f32;
-        lane_hits_within(ctx, &round, cull, args.valid, base, n, |i, t| {
+        lane_hits_within(ctx, &shape, cull, args.valid, base, n, |i, t| {
             let slot = |k: usize| base.add(k * n + i);
             *slot(TFAR) = t;
             *slot(NG) = 0.0;
@@ -200,19 +226,19 @@ unsafe extern "C" fn block_intersect(args: *const RTCIntersectFunctionNArguments
     }
 }
 
-unsafe extern "C" fn block_occluded(args: *const RTCOccludedFunctionNArguments) {
+unsafe extern "C" fn block_occluded<S: FromPrimitive>(args: *const RTCOccludedFunctionNArguments) {
     // SAFETY: as for `block_intersect`, with an N-wide RTCRayN.
     unsafe {
         let args = &*args;
         let s = shapes(args.geometryUserPtr);
         let ctx = &*(args.context as *const ExactContext);
         let inst = (*args.context).instID[0];
-        let Some((_, round, cull)) = s.prim(inst, args.primID, ctx.is_bare()) else {
+        let Some((_, shape, cull)) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
             return;
         };
         let n = args.N as usize;
         let base = args.ray as *mut f32;
-        lane_hits_within(ctx, &round, cull, args.valid, base, n, |i, _| {
+        lane_hits_within(ctx, &shape, cull, args.valid, base, n, |i, _| {
             *base.add(TFAR * n + i) = f32::NEG_INFINITY;
         });
     }
