@@ -40,8 +40,7 @@ pub fn implicit_bytes(shape: &crate::geometry::Implicit) -> u64 {
         return shape.len().saturating_mul(BYTES_PER_PRIMITIVE);
     }
     let blocks = crate::geometry::Blocks::of(shape.grid());
-    let members: u64 = shape.members(&blocks).iter().map(|m| m.len() as u64).sum();
-    members * BYTES_PER_PRIMITIVE + blocks.count() * BYTES_PER_BLOCK
+    shape.member_count(&blocks) * BYTES_PER_PRIMITIVE + blocks.count() * BYTES_PER_BLOCK
 }
 
 /// The limit set by [`set_limit`]; 0 for the machine's available memory.

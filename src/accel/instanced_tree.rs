@@ -29,7 +29,8 @@ impl InstancedTree {
         let positions = (0..blocks.count()).map(|b| blocks.block(b));
         let firsts: Vec<([u32; 3], DVec3)> = positions
             .clone()
-            .map(|b| (blocks.first_of(b), shape.node(blocks.first_of(b))))
+            .map(|b| blocks.first_of(b))
+            .map(|first| (first, shape.node(first)))
             .collect();
         let boxes: Vec<Aabb> = positions.map(|b| shape.block_bounds(&blocks, b)).collect();
         let pad = DVec3::splat(shape.local_slack());

@@ -118,11 +118,6 @@ impl Geometry {
             .map_or(self.prims.len() as u32, |r| r.first + r.shape.len() as u32)
     }
 
-    /// How many primitives the objects held as themselves make.
-    pub fn implicit_len(&self) -> u64 {
-        self.implicit.iter().map(|r| r.shape.len()).sum()
-    }
-
     /// Primitive number `id` (below [`len`](Self::len)).
     #[inline]
     pub fn prim(&self, id: u32) -> Primitive {
@@ -142,16 +137,46 @@ impl Geometry {
     /// The same geometry with every implicit object's primitives held one by one (the same
     /// numbers).
     pub fn flattened(&self) -> Geometry {
-        let mut prims = Vec::with_capacity(self.len() as usize);
-        prims.extend_from_slice(&self.prims);
-        for run in &self.implicit {
-            prims.extend(run.shape.listed());
-        }
-        Geometry {
-            prims,
-            parts: self.parts.clone(),
+        self.listing(u64::MAX)
+    }
+
+    /// The same geometry with the implicit objects of at most `max` primitives held one by one
+    /// (after the held ones, before the objects still implicit, each in order; objects,
+    /// materials and the order within an object kept).
+    pub fn listing(&self, max: u64) -> Geometry {
+        let held = self.prims.len() as u32;
+        let mut g = Geometry {
+            prims: self.prims.clone(),
+            parts: self
+                .parts
+                .iter()
+                .filter(|p| p.start < held)
+                .cloned()
+                .collect(),
             implicit: Vec::new(),
+        };
+        for run in &self.implicit {
+            let end = run.first as u64 + run.shape.len();
+            let parts = self
+                .parts
+                .iter()
+                .filter(|p| p.start >= run.first && p.end as u64 <= end);
+            if run.shape.len() <= max {
+                for p in parts {
+                    let ids = (p.start - run.first) as u64..(p.end - run.first) as u64;
+                    g.push_part(p.object, p.material, ids.map(|id| run.shape.prim(id)));
+                }
+            } else {
+                let runs: Vec<(u64, u32)> = parts
+                    .clone()
+                    .map(|p| ((p.end - p.start) as u64, p.material))
+                    .collect();
+                let object = parts.clone().next().map_or(0, |p| p.object);
+                g.push_implicit(object, &runs, run.shape.clone())
+                    .expect("no more primitives than before");
+            }
         }
+        g
     }
 
     /// This geometry with the primitives of `other` after its own (held ones before the

@@ -168,6 +168,17 @@ impl Implicit {
         }
     }
 
+    /// How many members a block has ([`members`](Self::members) without making them).
+    pub fn member_count(&self, blocks: &Blocks) -> u64 {
+        let kinds = match self {
+            Implicit::Lattice(l) => {
+                u64::from(l.sphere_count() > 0) + 3 * u64::from(l.rod_count() > 0)
+            }
+            Implicit::Bars(_) => 1,
+        };
+        kinds * u64::from(blocks.nodes())
+    }
+
     /// The box, in the object's coordinates, of what block `b` holds that exists.
     pub fn block_bounds(&self, blocks: &Blocks, b: [u32; 3]) -> Aabb {
         let grid = self.grid();
@@ -281,8 +292,10 @@ mod tests {
         })
     }
 
-    /// Every primitive is made by exactly one member of one block, at its number, inside the
-    /// block's bounds and (moved by the block's first node) inside the member's local box.
+    /// Numbers make the primitives the scene listed, in order, and the analytic bounds are the
+    /// union of their boxes to the bit; every primitive is made by exactly one member of one
+    /// block, at its number, inside the block's bounds and (moved by the block's first node)
+    /// inside the member's local box.
     #[test]
     fn blocks_cover_every_primitive_once() {
         let shapes = [
@@ -290,6 +303,11 @@ mod tests {
             lattice([10, 10, 10], 0.05, 0.15),
             lattice([1, 9, 2], 0.05, 0.0),
             lattice([30, 4, 17], 0.0, 0.15),
+            lattice([3, 4, 5], 0.05, 0.15),
+            lattice([1, 4, 2], 0.05, 0.0),
+            lattice([2, 1, 1], 0.0, 0.2),
+            lattice([1, 1, 1], 0.05, 0.15),
+            lattice([5, 1, 3], 0.3, 0.1),
             bars([11, 11], 2),
             bars([40, 3], 0),
             bars([1, 17], 1),
@@ -310,7 +328,9 @@ mod tests {
                 let first = blocks.first_of(bp);
                 let corner = shape.node(first);
                 let bounds = shape.block_bounds(&blocks, bp);
-                for m in shape.members(&blocks).into_iter().flatten() {
+                let members: Vec<Member> = shape.members(&blocks).into_iter().flatten().collect();
+                assert_eq!(members.len() as u64, shape.member_count(&blocks));
+                for &m in &members {
                     let Some(n) = blocks.place(shape.grid(), first, m) else {
                         continue;
                     };

@@ -212,7 +212,7 @@ fn the_paper_scenes_render_alike_instanced() {
 /// object, the held ones numbered before every lattice's, whatever order the groups came in.
 #[test]
 fn merged_geometries_keep_every_primitive() {
-    let small = |origin: f64, object: u32| {
+    let small = |origin: f64, object: u32, nx: u32| {
         let mut g = Geometry::default();
         push_lattice(
             &mut g,
@@ -220,7 +220,7 @@ fn merged_geometries_keep_every_primitive() {
             0,
             1,
             Lattice {
-                counts: [3, 2, 2],
+                counts: [nx, 2, 2],
                 spacing: DVec3::ONE,
                 origin: DVec3::splat(origin),
                 rod_radius: 0.05,
@@ -238,7 +238,8 @@ fn merged_geometries_keep_every_primitive() {
         );
         g
     };
-    let (a, b) = (small(0.0, 0), small(20.0, 10));
+    // 32 and 44 primitives.
+    let (a, b) = (small(0.0, 0, 3), small(20.0, 10, 4));
     let mut merged = a.clone();
     merged.append(&b);
     assert_eq!(merged.len(), a.len() + b.len());
@@ -261,6 +262,12 @@ fn merged_geometries_keep_every_primitive() {
         .collect();
     let key = |p: &(Primitive, u32, u32, u32)| format!("{p:?}");
     from.sort_by_key(key);
+    got.sort_by_key(key);
+    assert_eq!(got, from);
+    // Listing the smaller lattice only: the same primitives, objects and indices.
+    let mixed = merged.listing(40);
+    assert_eq!((mixed.prims.len(), mixed.implicit.len()), (2 + 32, 1));
+    let mut got: Vec<_> = (0..mixed.len()).map(|i| of(&mixed, i)).collect();
     got.sort_by_key(key);
     assert_eq!(got, from);
 }

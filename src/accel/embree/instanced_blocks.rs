@@ -70,16 +70,12 @@ struct BlockShapes {
 }
 
 impl BlockShapes {
-    /// Member `p` of instance `inst`, if the object has it: its number, the shape to test
-    /// (relative to the Embree scene's centre; for bare rays in the instance's own
-    /// coordinates, where Embree's rays are) and the local box to cull lanes with.
+    /// Member `p` of instance `inst`, if the object has it: its node and member (which
+    /// `member_id` numbers, for a hit), the shape to test (relative to the Embree scene's
+    /// centre; for bare rays in the instance's own coordinates, where Embree's rays are) and the
+    /// local box to cull lanes with.
     #[inline]
-    fn prim<S: FromPrimitive>(
-        &self,
-        inst: u32,
-        p: u32,
-        bare: bool,
-    ) -> Option<(u64, S, (DVec3, DVec3))> {
+    fn prim<S: FromPrimitive>(&self, inst: u32, p: u32, bare: bool) -> Option<Candidate<S>> {
         let (first, translation) = *self
             .instances
             .get(inst.wrapping_sub(self.first_instance) as usize)?;
@@ -91,8 +87,21 @@ impl BlockShapes {
             self.center
         };
         let s = S::from_primitive(self.shape.member_prim(n, m), shift);
-        Some((self.shape.member_id(n, m), s, cull))
+        Some(Candidate {
+            node: n,
+            member: m,
+            shape: s,
+            cull,
+        })
     }
+}
+
+/// A member a callback tests: where it is, its shape, and the local box that culls lanes.
+struct Candidate<S> {
+    node: [u32; 3],
+    member: Member,
+    shape: S,
+    cull: (DVec3, DVec3),
 }
 
 /// An object's block scene and what its callbacks read: released in that order.
@@ -206,12 +215,14 @@ unsafe extern "C" fn block_intersect<S: FromPrimitive>(
         let s = shapes(args.geometryUserPtr);
         let ctx = &*(args.context as *const ExactContext);
         let inst = (*args.context).instID[0];
-        let Some((id, shape, cull)) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
+        let Some(c) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
             return;
         };
+        // Numbered only if some lane hits (most calls find none).
+        let mut id = None;
         let n = args.N as usize;
         let base = args.rayhit as *mut f32;
-        lane_hits_within(ctx, &shape, cull, args.valid, base, n, |i, t| {
+        lane_hits_within(ctx, &c.shape, c.cull, args.valid, base, n, |i, t| {
             let slot = |k: usize| base.add(k * n + i);
             *slot(TFAR) = t;
             *slot(NG) = 0.0;
@@ -219,6 +230,7 @@ unsafe extern "C" fn block_intersect<S: FromPrimitive>(
             *slot(NG + 2) = 1.0;
             *slot(U) = 0.0;
             *slot(U + 1) = 0.0;
+            let id = *id.get_or_insert_with(|| s.shape.member_id(c.node, c.member));
             *(slot(PRIM_ID) as *mut u32) = id as u32;
             *(slot(GEOM_ID) as *mut u32) = s.slot;
             *(slot(INST_ID) as *mut u32) = inst;
@@ -233,12 +245,12 @@ unsafe extern "C" fn block_occluded<S: FromPrimitive>(args: *const RTCOccludedFu
         let s = shapes(args.geometryUserPtr);
         let ctx = &*(args.context as *const ExactContext);
         let inst = (*args.context).instID[0];
-        let Some((_, shape, cull)) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
+        let Some(c) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
             return;
         };
         let n = args.N as usize;
         let base = args.ray as *mut f32;
-        lane_hits_within(ctx, &shape, cull, args.valid, base, n, |i, _| {
+        lane_hits_within(ctx, &c.shape, c.cull, args.valid, base, n, |i, _| {
             *base.add(TFAR * n + i) = f32::NEG_INFINITY;
         });
     }

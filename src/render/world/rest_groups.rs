@@ -4,7 +4,7 @@
 
 use super::WorldOptions;
 use crate::accel::{Accelerator, Backend};
-use crate::geometry::{Aabb, Geometry};
+use crate::geometry::{Aabb, Geometry, ImplicitRun};
 use crate::scene::Scene;
 use crate::spacetime::{Boost, Velocity};
 use std::sync::Arc;
@@ -57,10 +57,11 @@ impl RestGroups {
             let geos: Vec<&Arc<Geometry>> =
                 members.iter().map(|&i| &scene.groups[i].geometry).collect();
             let mut geometry = merge(&geos);
-            if geometry.implicit_len() > 0 && geometry.implicit_len() <= options.instance_over {
+            let small = |r: &ImplicitRun| r.shape.len() <= options.instance_over;
+            if geometry.implicit.iter().any(small) {
                 // Small lattices and bar arrays as lists of primitives, as every backend traces
-                // best.
-                geometry = Arc::new(geometry.flattened());
+                // best; large ones stay themselves, to be instanced.
+                geometry = Arc::new(geometry.listing(options.instance_over));
             }
             let bounds = geometry.bounds();
             let names: Vec<&str> = members
