@@ -1,3 +1,4 @@
+use super::exr_block::{BlockSource, Layout};
 use super::file::cause;
 use super::{cryptomatte, Attribute, ExrOptions};
 use crate::render::{Frame, CHANNELS};
@@ -165,19 +166,21 @@ pub fn write_strips(
     };
     let (template, extra) = channels(&empty, mattes, options);
     let headers = headers((width, height), template, &extra, options);
+    let layout = Layout::new(&headers[0].channels, options.mattes.as_ref())
+        .expect("the channels of a render");
     write_blocks(path, headers, |put| {
         fill(&mut |strip: &Frame| {
             if strip.width != width {
                 return Err(cause(std::io::Error::other("a strip of another width")));
             }
-            put(&channels(strip, mattes, options).0, strip.height as usize)
+            put(&layout.strip(strip), strip.height as usize)
         })
     })
 }
 
-/// Rows of channel samples, as the file orders its channels, and how many rows they hold.
+/// Rows of the image, as a source of the file's blocks, and how many rows they hold.
 pub(super) type Rows<'a> =
-    dyn FnMut(&AnyChannels<FlatSamples>, usize) -> std::result::Result<(), Cause> + 'a;
+    dyn FnMut(&dyn BlockSource, usize) -> std::result::Result<(), Cause> + 'a;
 
 /// Write a single-part scanline EXR with `headers` whose rows `fill` hands on in runs, top to
 /// bottom (each but the last a whole number of blocks): each run's blocks are compressed in
@@ -205,7 +208,7 @@ pub(super) fn write_blocks(
             let chunks: Vec<_> = blocks[next..next + mine]
                 .par_iter()
                 .map(|&(index, block)| {
-                    let raw = block_bytes(header, block, channels, y0, width);
+                    let raw = channels.block(&header.channels, block, y0, width);
                     compress(&meta.headers, block, raw).map(|c| (index, c))
                 })
                 .collect();
@@ -235,26 +238,6 @@ pub(super) fn write_blocks(
     }
     written.map_err(cause)?;
     sort_header_attributes(path).map_err(cause)
-}
-
-/// A block's uncompressed bytes: line by line, each line its channels in the file's order.
-fn block_bytes(
-    header: &exr::meta::header::Header,
-    block: exr::block::BlockIndex,
-    channels: &AnyChannels<FlatSamples>,
-    y0: usize,
-    width: usize,
-) -> exr::block::UncompressedBlock {
-    exr::block::UncompressedBlock::from_lines(&header.channels, block, |line| {
-        let at = (line.location.position.y() - y0) * width + line.location.position.x();
-        let n = line.location.sample_count;
-        let done = match &channels.list[line.location.channel].sample_data {
-            FlatSamples::F16(v) => line.write_samples_from_slice(&v[at..at + n]),
-            FlatSamples::F32(v) => line.write_samples_from_slice(&v[at..at + n]),
-            FlatSamples::U32(v) => line.write_samples_from_slice(&v[at..at + n]),
-        };
-        done.expect("a line of the block's own size");
-    })
 }
 
 /// A block compressed into its chunk. ZIP (16 lines or 1) is done here with libdeflate, about
@@ -292,24 +275,7 @@ fn compress(
 /// ones; each byte then replaced by its difference from the one before plus 128 (mod 256); then a
 /// zlib stream of that (read back by any inflate).
 pub(super) fn zip_bytes(data: &[u8]) -> Vec<u8> {
-    let half = data.len().div_ceil(2);
-    let mut split = vec![0; data.len()];
-    let (even, odd) = split.split_at_mut(half);
-    for ((e, o), pair) in even
-        .iter_mut()
-        .zip(odd.iter_mut())
-        .zip(data.chunks_exact(2))
-    {
-        (*e, *o) = (pair[0], pair[1]);
-    }
-    if data.len() % 2 == 1 {
-        even[half - 1] = data[data.len() - 1];
-    }
-    // Differences from a second buffer, so that the loop has no dependence to carry.
-    let mut t = split.clone();
-    for (d, w) in t[1..].iter_mut().zip(split.windows(2)) {
-        *d = w[1].wrapping_sub(w[0]).wrapping_add(128);
-    }
+    let t = predicted(data);
     let mut z = libdeflater::Compressor::new(libdeflater::CompressionLvl::new(4).expect("level 4"));
     let mut out = vec![0; z.zlib_compress_bound(t.len())];
     let n = z
@@ -317,6 +283,39 @@ pub(super) fn zip_bytes(data: &[u8]) -> Vec<u8> {
         .expect("a buffer of the bound's size");
     out.truncate(n);
     out
+}
+
+/// The bytes ZIP deflates: `data`'s bytes at even offsets, then those at odd ones, each but
+/// the first replaced by its difference from the one before it plus 128 (mod 256). Made in one
+/// pass from `data`, each half from pairs of bytes, so that the loops carry no dependence.
+fn predicted(data: &[u8]) -> Vec<u8> {
+    let n = data.len();
+    let half = n.div_ceil(2);
+    let mut t = vec![0; n];
+    let Some(&first) = data.first() else {
+        return t;
+    };
+    let (even, odd) = t.split_at_mut(half);
+    let delta = |a: u8, b: u8| b.wrapping_sub(a).wrapping_add(128);
+    // Pair i is (data[2i], data[2i + 1]): its bytes go to even[i] and odd[i], each less the
+    // byte of pair i − 1 in its place.
+    let pairs = n / 2;
+    let d = &data[..2 * pairs];
+    let (e, o) = (&mut even[..pairs], &mut odd[..pairs]);
+    for i in 1..pairs {
+        e[i] = delta(d[2 * i - 2], d[2 * i]);
+        o[i] = delta(d[2 * i - 1], d[2 * i + 1]);
+    }
+    even[0] = first;
+    if n % 2 == 1 && n > 1 {
+        // The unpaired last byte ends the even half.
+        even[half - 1] = delta(data[n - 3], data[n - 1]);
+    }
+    if pairs > 0 {
+        // The odd half starts after the even half's last byte.
+        odd[0] = delta(data[2 * (half - 1)], data[1]);
+    }
+    t
 }
 
 /// Put the header's attributes in the order of their names. The exr crate keeps custom
@@ -419,6 +418,26 @@ pub fn read_channels(path: &Path) -> crate::Result<Channels> {
 mod tests {
     use super::*;
     use crate::output::Compression as Packing;
+
+    /// The predictor is OpenEXR's, written the plain way: split, then differences.
+    #[test]
+    fn predicted_is_split_then_differences() {
+        let mut rng = crate::rng::Rng(3);
+        for n in [0, 1, 2, 3, 4, 5, 8, 17, 64, 1001] {
+            let data: Vec<u8> = (0..n).map(|_| rng.next_u64() as u8).collect();
+            let split: Vec<u8> = data
+                .iter()
+                .step_by(2)
+                .chain(data.iter().skip(1).step_by(2))
+                .copied()
+                .collect();
+            let mut want = split.clone();
+            for i in 1..n {
+                want[i] = split[i].wrapping_sub(split[i - 1]).wrapping_add(128);
+            }
+            assert_eq!(predicted(&data), want, "{n} bytes");
+        }
+    }
 
     /// Every channel reads back bit for bit through the exr crate, for the ZIPs done here (on
     /// smooth values, which compress, and on noise, whose blocks are stored raw) and for a

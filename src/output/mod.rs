@@ -3,6 +3,7 @@
 
 mod assemble;
 pub mod cryptomatte;
+mod exr_block;
 mod exr_out;
 pub mod file;
 pub mod header;

@@ -82,33 +82,39 @@ impl Frame {
 
     /// A channel by its EXR name.
     pub fn channel(&self, name: &str) -> Option<Vec<f32>> {
-        let f: fn(&PixelValue) -> f32 = match name {
-            "R" => |p| p.color[0],
-            "G" => |p| p.color[1],
-            "B" => |p| p.color[2],
-            "A" => |p| p.alpha,
-            "relativity.lookback" => |p| p.lookback,
-            "relativity.doppler" => |p| p.doppler,
-            "depth.Z" => |p| p.depth,
-            "Pcam.X" => |p| p.camera_position[0],
-            "Pcam.Y" => |p| p.camera_position[1],
-            "Pcam.Z" => |p| p.camera_position[2],
-            "material_id" => |p| p.material_id as f32,
-            "primitive_id" => |p| p.primitive_id as f32,
-            "object_id" => |p| p.object_id as f32,
-            "N.X" => |p| p.normal[0],
-            "N.Y" => |p| p.normal[1],
-            "N.Z" => |p| p.normal[2],
-            "P.X" => |p| p.position[0],
-            "P.Y" => |p| p.position[1],
-            "P.Z" => |p| p.position[2],
-            "Pref.X" => |p| p.rest_position[0],
-            "Pref.Y" => |p| p.rest_position[1],
-            "Pref.Z" => |p| p.rest_position[2],
-            _ => return None,
-        };
+        let f = pass(name)?;
         Some(self.pixels.iter().map(f).collect())
     }
+}
+
+/// Where the pass of a channel named `name` (one of [`CHANNELS`]) lies in a pixel.
+pub fn pass(name: &str) -> Option<fn(&PixelValue) -> f32> {
+    let f: fn(&PixelValue) -> f32 = match name {
+        "R" => |p| p.color[0],
+        "G" => |p| p.color[1],
+        "B" => |p| p.color[2],
+        "A" => |p| p.alpha,
+        "relativity.lookback" => |p| p.lookback,
+        "relativity.doppler" => |p| p.doppler,
+        "depth.Z" => |p| p.depth,
+        "Pcam.X" => |p| p.camera_position[0],
+        "Pcam.Y" => |p| p.camera_position[1],
+        "Pcam.Z" => |p| p.camera_position[2],
+        "material_id" => |p| p.material_id as f32,
+        "primitive_id" => |p| p.primitive_id as f32,
+        "object_id" => |p| p.object_id as f32,
+        "N.X" => |p| p.normal[0],
+        "N.Y" => |p| p.normal[1],
+        "N.Z" => |p| p.normal[2],
+        "P.X" => |p| p.position[0],
+        "P.Y" => |p| p.position[1],
+        "P.Z" => |p| p.position[2],
+        "Pref.X" => |p| p.rest_position[0],
+        "Pref.Y" => |p| p.rest_position[1],
+        "Pref.Z" => |p| p.rest_position[2],
+        _ => return None,
+    };
+    Some(f)
 }
 
 /// Channel names written to EXR, in this order.

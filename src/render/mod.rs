@@ -17,7 +17,7 @@ mod tile;
 mod world;
 
 pub use band::needs_spectra;
-pub use frame::{Frame, Mattes, PixelValue, CHANNELS, DEPTH_FAR, MATTE_RANKS};
+pub use frame::{pass, Frame, Mattes, PixelValue, CHANNELS, DEPTH_FAR, MATTE_RANKS};
 pub use world::{WorldOptions, INSTANCE_OVER};
 
 pub(crate) use band::Seen;

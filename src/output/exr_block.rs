@@ -1,0 +1,298 @@
+//! An EXR block's bytes made straight from a strip's pixels: each of the file's channels knows
+//! where its value lies in a pixel (a pass, or a rank of a Cryptomatte layer), and a block is
+//! written line by line, channel by channel, without first making a column of every channel.
+//! Blocks are independent, so the strip's blocks are made (and compressed) in parallel.
+
+use super::cryptomatte::{self, MatteNames, Pick};
+use crate::render::{Frame, PixelValue, MATTE_RANKS};
+use exr::block::{BlockIndex, UncompressedBlock};
+use exr::meta::attribute::{ChannelList, SampleType};
+use exr::prelude::*;
+
+/// What makes a block's bytes: a strip of the image whose first row is the image's `y0`.
+pub(super) trait BlockSource: Sync {
+    /// The uncompressed bytes of `block` of an image whose channels are `channels` and whose
+    /// lines are `width` samples long.
+    fn block(
+        &self,
+        channels: &ChannelList,
+        block: BlockIndex,
+        y0: usize,
+        width: usize,
+    ) -> UncompressedBlock;
+}
+
+/// Columns of samples, as the file orders its channels (what a tile being joined holds).
+impl BlockSource for AnyChannels<FlatSamples> {
+    fn block(
+        &self,
+        channels: &ChannelList,
+        block: BlockIndex,
+        y0: usize,
+        width: usize,
+    ) -> UncompressedBlock {
+        UncompressedBlock::from_lines(channels, block, |line| {
+            let at = (line.location.position.y() - y0) * width + line.location.position.x();
+            let n = line.location.sample_count;
+            let done = match &self.list[line.location.channel].sample_data {
+                FlatSamples::F16(v) => line.write_samples_from_slice(&v[at..at + n]),
+                FlatSamples::F32(v) => line.write_samples_from_slice(&v[at..at + n]),
+                FlatSamples::U32(v) => line.write_samples_from_slice(&v[at..at + n]),
+            };
+            done.expect("a line of the block's own size");
+        })
+    }
+}
+
+/// Where one channel's value lies in a pixel.
+#[derive(Clone)]
+enum Source {
+    /// A pass of the pixel's value.
+    Pass(fn(&PixelValue) -> f32),
+    /// The id of a rank of a Cryptomatte layer: `ids[index]` (0 where no object was seen).
+    MatteId(Pick, usize, std::sync::Arc<[f32]>),
+    /// The share of a rank of a Cryptomatte layer.
+    MatteShare(Pick, usize),
+}
+
+/// The file's channels, in its order, each with where its values lie and how it is stored.
+pub(super) struct Layout {
+    columns: Vec<(Source, SampleType)>,
+}
+
+impl Layout {
+    /// The layout of a file whose channels are `channels`, named as the render names its
+    /// passes (see [`crate::render::CHANNELS`]) and Cryptomatte layers; the mattes' ids from
+    /// `names`. None if a channel is neither.
+    pub(super) fn new(channels: &ChannelList, names: Option<&MatteNames>) -> Option<Layout> {
+        let columns = channels
+            .list
+            .iter()
+            .map(|c| Some((source(&c.name.to_string(), names)?, c.sample_type)))
+            .collect::<Option<_>>()?;
+        Some(Layout { columns })
+    }
+
+    /// A strip of the image, as a source of blocks.
+    pub(super) fn strip<'a>(&'a self, strip: &'a Frame) -> Strip<'a> {
+        Strip {
+            layout: self,
+            frame: strip,
+        }
+    }
+}
+
+/// A channel's source from its name: a pass, or `{layer}{level:02}.{R,G,B,A}` of a
+/// Cryptomatte layer (R and B ids, G and A shares, of ranks 2 × level and 2 × level + 1).
+fn source(name: &str, names: Option<&MatteNames>) -> Option<Source> {
+    if let Some(pass) = crate::render::pass(name) {
+        return Some(Source::Pass(pass));
+    }
+    let names = names?;
+    let kinds: [(&str, Pick, &[String]); 2] = [
+        ("CryptoObject", |m| &m.object, &names.objects),
+        ("CryptoMaterial", |m| &m.material, &names.materials),
+    ];
+    kinds.into_iter().find_map(|(layer, pick, names)| {
+        let (level, part) = name.strip_prefix(layer)?.split_once('.')?;
+        let level: usize = level.parse().ok()?;
+        let part = ["R", "G", "B", "A"].iter().position(|&p| p == part)?;
+        let rank = 2 * level + part / 2;
+        (rank < MATTE_RANKS).then(|| {
+            if part % 2 == 0 {
+                let ids = std::iter::once(0.0)
+                    .chain(names.iter().map(|n| cryptomatte::id(n)))
+                    .collect();
+                Source::MatteId(pick, rank, ids)
+            } else {
+                Source::MatteShare(pick, rank)
+            }
+        })
+    })
+}
+
+/// A strip of pixels with the layout of the file it goes to.
+pub(super) struct Strip<'a> {
+    layout: &'a Layout,
+    frame: &'a Frame,
+}
+
+impl BlockSource for Strip<'_> {
+    fn block(
+        &self,
+        _: &ChannelList,
+        block: BlockIndex,
+        y0: usize,
+        width: usize,
+    ) -> UncompressedBlock {
+        let lines = block.pixel_size.height();
+        let x0 = block.pixel_position.x();
+        let n = block.pixel_size.width();
+        let bytes: usize = self
+            .layout
+            .columns
+            .iter()
+            .map(|(_, t)| t.bytes_per_sample())
+            .sum();
+        let mut data = Vec::with_capacity(bytes * n * lines);
+        for line in 0..lines {
+            let at = (block.pixel_position.y() + line - y0) * width + x0;
+            let pixels = &self.frame.pixels[at..at + n];
+            let mattes = self.frame.mattes.get(at..at + n).unwrap_or(&[]);
+            for (source, sample_type) in &self.layout.columns {
+                let put = |data: &mut Vec<u8>, v: f32| match sample_type {
+                    SampleType::F16 => data.extend_from_slice(&f16::from_f32(v).to_ne_bytes()),
+                    SampleType::F32 => data.extend_from_slice(&v.to_ne_bytes()),
+                    SampleType::U32 => data.extend_from_slice(&(v as u32).to_ne_bytes()),
+                };
+                match source {
+                    Source::Pass(f) => pixels.iter().for_each(|p| put(&mut data, f(p))),
+                    Source::MatteId(pick, rank, ids) => mattes
+                        .iter()
+                        .for_each(|m| put(&mut data, ids[pick(m)[*rank].0 as usize])),
+                    Source::MatteShare(pick, rank) => {
+                        mattes.iter().for_each(|m| put(&mut data, pick(m)[*rank].1))
+                    }
+                }
+                // A strip without mattes has zeros in their channels.
+                if !matches!(source, Source::Pass(_)) && mattes.is_empty() {
+                    (0..n).for_each(|_| put(&mut data, 0.0));
+                }
+            }
+        }
+        UncompressedBlock { index: block, data }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::{Mattes, CHANNELS};
+    use exr::meta::attribute::ChannelDescription;
+
+    /// The columns of `frame`'s channels `names` (each its pass, or its Cryptomatte rank's id
+    /// or share, made independently of [`source`]), as the file orders them.
+    fn columns(
+        frame: &Frame,
+        names: &[String],
+        matte_names: &MatteNames,
+        half: bool,
+    ) -> AnyChannels<FlatSamples> {
+        let list = names.iter().map(|name| {
+            let values: Vec<f32> = if let Some(f) = crate::render::pass(name) {
+                frame.pixels.iter().map(f).collect()
+            } else {
+                let (layer, rest) = name.split_at(name.find(|c: char| c.is_ascii_digit()).unwrap());
+                let level: usize = rest[..2].parse().unwrap();
+                let part = ["R", "G", "B", "A"]
+                    .iter()
+                    .position(|p| rest.ends_with(p))
+                    .unwrap();
+                let (pick, ids): (fn(&Mattes) -> &cryptomatte::Ranks, &[String]) = match layer {
+                    "CryptoObject" => (|m| &m.object, &matte_names.objects),
+                    _ => (|m| &m.material, &matte_names.materials),
+                };
+                let rank = 2 * level + part / 2;
+                frame
+                    .mattes
+                    .iter()
+                    .map(|m| {
+                        let (i, share) = pick(m)[rank];
+                        match (part % 2, i) {
+                            (1, _) => share,
+                            (_, 0) => 0.0,
+                            (_, i) => cryptomatte::id(&ids[i as usize - 1]),
+                        }
+                    })
+                    .collect()
+            };
+            let samples = if half && crate::render::pass(name).is_some() {
+                FlatSamples::F16(values.into_iter().map(f16::from_f32).collect())
+            } else {
+                FlatSamples::F32(values)
+            };
+            AnyChannel::new(name.as_str(), samples)
+        });
+        AnyChannels::sort(list.collect())
+    }
+
+    /// Every block made from a strip's pixels holds the bytes the same block made from columns
+    /// of its channels holds: every pass and both Cryptomatte layers, full and half floats,
+    /// blocks of 1, 16 and 32 lines, including a last block cut short.
+    #[test]
+    fn blocks_from_pixels_are_blocks_from_columns() {
+        let (w, h) = (13usize, 45usize);
+        let mut rng = crate::rng::Rng(5);
+        let mut frame = Frame::new(w as u32, h as u32);
+        let mut f = || (rng.next_u64() % 10_000) as f32 / 77.0 - 50.0;
+        for p in &mut frame.pixels {
+            p.color = [f(), f(), f()];
+            p.alpha = f();
+            p.lookback = f();
+            p.doppler = f();
+            p.depth = f();
+            p.normal = [f(), f(), f()];
+            p.position = [f(), f(), f()];
+            p.rest_position = [f(), f(), f()];
+            p.camera_position = [f(), f(), f()];
+            p.object_id = f().abs() as u32;
+            p.material_id = f().abs() as u32;
+            p.primitive_id = f().abs() as u32;
+        }
+        let names = MatteNames {
+            objects: (0..5).map(|i| format!("object {i}")).collect(),
+            materials: vec!["white".into(), "red".into()],
+        };
+        frame.mattes = (0..w * h)
+            .map(|i| Mattes {
+                object: std::array::from_fn(|r| ((i + r) as u32 % 6, r as f32 / 7.0)),
+                material: std::array::from_fn(|r| ((i * r) as u32 % 3, 1.0 - r as f32 / 9.0)),
+            })
+            .collect();
+        let mut channel_names: Vec<String> = CHANNELS.iter().map(|c| c.to_string()).collect();
+        for layer in ["CryptoObject", "CryptoMaterial"] {
+            for level in 0..MATTE_RANKS / 2 {
+                channel_names
+                    .extend(["R", "G", "B", "A"].map(|p| format!("{layer}{level:02}.{p}")));
+            }
+        }
+        for half in [false, true] {
+            let cols = columns(&frame, &channel_names, &names, half);
+            let list: ChannelList = ChannelList::new(
+                cols.list
+                    .iter()
+                    .map(|c| {
+                        let t = match c.sample_data {
+                            FlatSamples::F16(_) => SampleType::F16,
+                            FlatSamples::F32(_) => SampleType::F32,
+                            FlatSamples::U32(_) => SampleType::U32,
+                        };
+                        ChannelDescription::named(c.name.clone(), t)
+                    })
+                    .collect(),
+            );
+            assert_eq!(list.list.len(), 22 + 24);
+            let layout = Layout::new(&list, Some(&names)).expect("every channel known");
+            let strip = layout.strip(&frame);
+            for lines in [1usize, 16, 32] {
+                for y in (0..h).step_by(lines) {
+                    let block = BlockIndex {
+                        layer: 0,
+                        pixel_position: Vec2(0, y),
+                        pixel_size: Vec2(w, lines.min(h - y)),
+                        level: Vec2(0, 0),
+                    };
+                    let want = cols.block(&list, block, 0, w).data;
+                    let got = strip.block(&list, block, 0, w).data;
+                    assert_eq!(got, want, "half {half}, {lines} lines, at {y}");
+                }
+            }
+        }
+        // A channel the render does not name has no layout.
+        let odd = ChannelList::new(smallvec::smallvec![ChannelDescription::named(
+            "Q",
+            SampleType::F32
+        )]);
+        assert!(Layout::new(&odd, Some(&names)).is_none());
+    }
+}
