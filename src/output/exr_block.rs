@@ -4,10 +4,11 @@
 //! Blocks are independent, so the strip's blocks are made (and compressed) in parallel.
 
 use super::cryptomatte::{self, MatteNames, Pick};
-use crate::render::{Frame, PixelValue, MATTE_RANKS};
+use crate::render::{Frame, MATTE_RANKS};
 use exr::block::{BlockIndex, UncompressedBlock};
 use exr::meta::attribute::{ChannelList, SampleType};
 use exr::prelude::*;
+use smallvec::SmallVec;
 
 /// What makes a block's bytes: a strip of the image whose first row is the image's `y0`.
 pub(super) trait BlockSource: Sync {
@@ -47,8 +48,8 @@ impl BlockSource for AnyChannels<FlatSamples> {
 /// Where one channel's value lies in a pixel.
 #[derive(Clone)]
 enum Source {
-    /// A pass of the pixel's value.
-    Pass(fn(&PixelValue) -> f32),
+    /// A pass of the pixel's value: which of [`crate::render::PixelValue::values`].
+    Pass(usize),
     /// The id of a rank of a Cryptomatte layer: `ids[index]` (0 where no object was seen).
     MatteId(Pick, usize, std::sync::Arc<[f32]>),
     /// The share of a rank of a Cryptomatte layer.
@@ -128,39 +129,77 @@ impl BlockSource for Strip<'_> {
         let lines = block.pixel_size.height();
         let x0 = block.pixel_position.x();
         let n = block.pixel_size.width();
-        let bytes: usize = self
+        // Each column's place in a line: its channel's samples, one after another.
+        let mut offsets: SmallVec<[usize; 64]> = SmallVec::new();
+        let mut line_bytes = 0;
+        for (_, t) in &self.layout.columns {
+            offsets.push(line_bytes);
+            line_bytes += n * t.bytes_per_sample();
+        }
+        let passes: SmallVec<[(usize, usize, SampleType); 32]> = self
             .layout
             .columns
             .iter()
-            .map(|(_, t)| t.bytes_per_sample())
-            .sum();
-        let mut data = Vec::with_capacity(bytes * n * lines);
-        for line in 0..lines {
+            .zip(&offsets)
+            .filter_map(|((s, t), &at)| match s {
+                Source::Pass(i) => Some((*i, at, *t)),
+                _ => None,
+            })
+            .collect();
+        let mut data = vec![0; line_bytes * lines];
+        for (line, out) in data.chunks_exact_mut(line_bytes.max(1)).enumerate() {
             let at = (block.pixel_position.y() + line - y0) * width + x0;
             let pixels = &self.frame.pixels[at..at + n];
-            let mattes = self.frame.mattes.get(at..at + n).unwrap_or(&[]);
-            for (source, sample_type) in &self.layout.columns {
-                let put = |data: &mut Vec<u8>, v: f32| match sample_type {
-                    SampleType::F16 => data.extend_from_slice(&f16::from_f32(v).to_ne_bytes()),
-                    SampleType::F32 => data.extend_from_slice(&v.to_ne_bytes()),
-                    SampleType::U32 => data.extend_from_slice(&(v as u32).to_ne_bytes()),
-                };
-                match source {
-                    Source::Pass(f) => pixels.iter().for_each(|p| put(&mut data, f(p))),
-                    Source::MatteId(pick, rank, ids) => mattes
-                        .iter()
-                        .for_each(|m| put(&mut data, ids[pick(m)[*rank].0 as usize])),
-                    Source::MatteShare(pick, rank) => {
-                        mattes.iter().for_each(|m| put(&mut data, pick(m)[*rank].1))
+            // The passes 16 pixels at a time: their values made once, then each column's 16
+            // samples stored together (one pixel's values spread over every column).
+            for (chunk, run) in pixels.chunks(16).enumerate() {
+                let values: SmallVec<[_; 16]> = run.iter().map(|p| p.values()).collect();
+                for &(i, column, t) in &passes {
+                    for (k, v) in values.iter().enumerate() {
+                        put(out, column, 16 * chunk + k, t, v[i]);
                     }
                 }
-                // A strip without mattes has zeros in their channels.
-                if !matches!(source, Source::Pass(_)) && mattes.is_empty() {
-                    (0..n).for_each(|_| put(&mut data, 0.0));
+            }
+            // The mattes column by column (a strip without mattes leaves them zero).
+            let Some(mattes) = self.frame.mattes.get(at..at + n) else {
+                continue;
+            };
+            for ((source, t), &column) in self.layout.columns.iter().zip(&offsets) {
+                match source {
+                    Source::Pass(_) => {}
+                    Source::MatteId(pick, rank, ids) => {
+                        for (x, m) in mattes.iter().enumerate() {
+                            put(out, column, x, *t, ids[pick(m)[*rank].0 as usize]);
+                        }
+                    }
+                    Source::MatteShare(pick, rank) => {
+                        for (x, m) in mattes.iter().enumerate() {
+                            put(out, column, x, *t, pick(m)[*rank].1);
+                        }
+                    }
                 }
             }
         }
         UncompressedBlock { index: block, data }
+    }
+}
+
+/// Store sample `x` of the column at byte `column` of `line` as a `t`.
+#[inline(always)]
+fn put(line: &mut [u8], column: usize, x: usize, t: SampleType, v: f32) {
+    match t {
+        SampleType::F16 => {
+            let at = column + 2 * x;
+            line[at..at + 2].copy_from_slice(&f16::from_f32(v).to_ne_bytes());
+        }
+        SampleType::F32 => {
+            let at = column + 4 * x;
+            line[at..at + 4].copy_from_slice(&v.to_ne_bytes());
+        }
+        SampleType::U32 => {
+            let at = column + 4 * x;
+            line[at..at + 4].copy_from_slice(&(v as u32).to_ne_bytes());
+        }
     }
 }
 
@@ -179,8 +218,8 @@ mod tests {
         half: bool,
     ) -> AnyChannels<FlatSamples> {
         let list = names.iter().map(|name| {
-            let values: Vec<f32> = if let Some(f) = crate::render::pass(name) {
-                frame.pixels.iter().map(f).collect()
+            let values: Vec<f32> = if let Some(column) = frame.channel(name) {
+                column
             } else {
                 let (layer, rest) = name.split_at(name.find(|c: char| c.is_ascii_digit()).unwrap());
                 let level: usize = rest[..2].parse().unwrap();

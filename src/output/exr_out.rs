@@ -275,25 +275,36 @@ fn compress(
 /// ones; each byte then replaced by its difference from the one before plus 128 (mod 256); then a
 /// zlib stream of that (read back by any inflate).
 pub(super) fn zip_bytes(data: &[u8]) -> Vec<u8> {
-    let t = predicted(data);
-    let mut z = libdeflater::Compressor::new(libdeflater::CompressionLvl::new(4).expect("level 4"));
-    let mut out = vec![0; z.zlib_compress_bound(t.len())];
-    let n = z
-        .zlib_compress(&t, &mut out)
-        .expect("a buffer of the bound's size");
-    out.truncate(n);
-    out
+    // Each thread keeps its compressor and its two buffers from one block to the next (a
+    // block's fresh buffers cost their zeroing and page faults each time).
+    thread_local! {
+        static ZIP: std::cell::RefCell<(Option<libdeflater::Compressor>, Vec<u8>, Vec<u8>)> =
+            Default::default();
+    }
+    ZIP.with_borrow_mut(|(z, t, out)| {
+        let z = z.get_or_insert_with(|| {
+            libdeflater::Compressor::new(libdeflater::CompressionLvl::new(4).expect("level 4"))
+        });
+        predicted(data, t);
+        out.resize(z.zlib_compress_bound(t.len()), 0);
+        let n = z
+            .zlib_compress(t, out)
+            .expect("a buffer of the bound's size");
+        out[..n].to_vec()
+    })
 }
 
 /// The bytes ZIP deflates: `data`'s bytes at even offsets, then those at odd ones, each but
 /// the first replaced by its difference from the one before it plus 128 (mod 256). Made in one
-/// pass from `data`, each half from pairs of bytes, so that the loops carry no dependence.
-fn predicted(data: &[u8]) -> Vec<u8> {
+/// pass from `data` into `t`, each half from pairs of bytes, so that the loops carry no
+/// dependence.
+fn predicted(data: &[u8], t: &mut Vec<u8>) {
     let n = data.len();
     let half = n.div_ceil(2);
-    let mut t = vec![0; n];
+    // Every byte is written below.
+    t.resize(n, 0);
     let Some(&first) = data.first() else {
-        return t;
+        return;
     };
     let (even, odd) = t.split_at_mut(half);
     let delta = |a: u8, b: u8| b.wrapping_sub(a).wrapping_add(128);
@@ -315,7 +326,6 @@ fn predicted(data: &[u8]) -> Vec<u8> {
         // The odd half starts after the even half's last byte.
         odd[0] = delta(data[2 * (half - 1)], data[1]);
     }
-    t
 }
 
 /// Put the header's attributes in the order of their names. The exr crate keeps custom
@@ -435,7 +445,10 @@ mod tests {
             for i in 1..n {
                 want[i] = split[i].wrapping_sub(split[i - 1]).wrapping_add(128);
             }
-            assert_eq!(predicted(&data), want, "{n} bytes");
+            // Into a buffer that held a longer block before.
+            let mut t = vec![7; 2000];
+            predicted(&data, &mut t);
+            assert_eq!(t, want, "{n} bytes");
         }
     }
 

@@ -82,39 +82,50 @@ impl Frame {
 
     /// A channel by its EXR name.
     pub fn channel(&self, name: &str) -> Option<Vec<f32>> {
-        let f = pass(name)?;
-        Some(self.pixels.iter().map(f).collect())
+        let i = pass(name)?;
+        Some(self.pixels.iter().map(|p| p.values()[i]).collect())
     }
 }
 
-/// Where the pass of a channel named `name` (one of [`CHANNELS`]) lies in a pixel.
-pub fn pass(name: &str) -> Option<fn(&PixelValue) -> f32> {
-    let f: fn(&PixelValue) -> f32 = match name {
-        "R" => |p| p.color[0],
-        "G" => |p| p.color[1],
-        "B" => |p| p.color[2],
-        "A" => |p| p.alpha,
-        "relativity.lookback" => |p| p.lookback,
-        "relativity.doppler" => |p| p.doppler,
-        "depth.Z" => |p| p.depth,
-        "Pcam.X" => |p| p.camera_position[0],
-        "Pcam.Y" => |p| p.camera_position[1],
-        "Pcam.Z" => |p| p.camera_position[2],
-        "material_id" => |p| p.material_id as f32,
-        "primitive_id" => |p| p.primitive_id as f32,
-        "object_id" => |p| p.object_id as f32,
-        "N.X" => |p| p.normal[0],
-        "N.Y" => |p| p.normal[1],
-        "N.Z" => |p| p.normal[2],
-        "P.X" => |p| p.position[0],
-        "P.Y" => |p| p.position[1],
-        "P.Z" => |p| p.position[2],
-        "Pref.X" => |p| p.rest_position[0],
-        "Pref.Y" => |p| p.rest_position[1],
-        "Pref.Z" => |p| p.rest_position[2],
-        _ => return None,
-    };
-    Some(f)
+impl PixelValue {
+    /// The pixel's value in each of [`CHANNELS`], in that order (ids as f32).
+    #[inline]
+    pub fn values(&self) -> [f32; CHANNELS.len()] {
+        let [r, g, b] = self.color;
+        let [nx, ny, nz] = self.normal;
+        let [px, py, pz] = self.position;
+        let [qx, qy, qz] = self.rest_position;
+        let [cx, cy, cz] = self.camera_position;
+        [
+            r,
+            g,
+            b,
+            self.alpha,
+            self.depth,
+            self.lookback,
+            self.doppler,
+            self.object_id as f32,
+            self.material_id as f32,
+            self.primitive_id as f32,
+            nx,
+            ny,
+            nz,
+            px,
+            py,
+            pz,
+            qx,
+            qy,
+            qz,
+            cx,
+            cy,
+            cz,
+        ]
+    }
+}
+
+/// Which of [`CHANNELS`] (and of [`PixelValue::values`]) is the channel named `name`.
+pub fn pass(name: &str) -> Option<usize> {
+    CHANNELS.iter().position(|&c| c == name)
 }
 
 /// Channel names written to EXR, in this order.
@@ -142,3 +153,60 @@ pub const CHANNELS: [&str; 22] = [
     "Pcam.Y",
     "Pcam.Z",
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each channel holds the field its name says.
+    #[test]
+    fn channels_hold_their_fields() {
+        let p = PixelValue {
+            color: [1.0, 2.0, 3.0],
+            alpha: 4.0,
+            lookback: 5.0,
+            doppler: 6.0,
+            object_id: 7,
+            normal: [8.0, 9.0, 10.0],
+            position: [11.0, 12.0, 13.0],
+            rest_position: [14.0, 15.0, 16.0],
+            depth: 17.0,
+            camera_position: [18.0, 19.0, 20.0],
+            material_id: 21,
+            primitive_id: 22,
+        };
+        let frame = Frame {
+            pixels: vec![p],
+            ..Frame::new(1, 1)
+        };
+        let want = [
+            ("R", 1.0),
+            ("G", 2.0),
+            ("B", 3.0),
+            ("A", 4.0),
+            ("relativity.lookback", 5.0),
+            ("relativity.doppler", 6.0),
+            ("object_id", 7.0),
+            ("N.X", 8.0),
+            ("N.Y", 9.0),
+            ("N.Z", 10.0),
+            ("P.X", 11.0),
+            ("P.Y", 12.0),
+            ("P.Z", 13.0),
+            ("Pref.X", 14.0),
+            ("Pref.Y", 15.0),
+            ("Pref.Z", 16.0),
+            ("depth.Z", 17.0),
+            ("Pcam.X", 18.0),
+            ("Pcam.Y", 19.0),
+            ("Pcam.Z", 20.0),
+            ("material_id", 21.0),
+            ("primitive_id", 22.0),
+        ];
+        assert_eq!(want.len(), CHANNELS.len());
+        for (name, v) in want {
+            assert_eq!(frame.channel(name), Some(vec![v]), "{name}");
+        }
+        assert_eq!(frame.channel("Z"), None);
+    }
+}
