@@ -194,10 +194,12 @@ pub(crate) fn render_world_in_strips<E>(
     let rows_per_strip = u32::try_from(tile_rows * u64::from(TILE)).unwrap_or(u32::MAX);
     let rows = Rows::new(scene, world, passes, progress);
     let mut stats = RenderStats::default();
+    // One strip's memory, refilled strip after strip (fresh memory costs its page faults).
+    let mut strip = Frame::new(0, 0);
     let mut y = 0;
     while y < h {
         let end = y.saturating_add(rows_per_strip).min(h);
-        let (strip, s) = rows.render(y..end);
+        let s = rows.render_into(y..end, &mut strip);
         put(&strip)?;
         stats.primary_rays += s.primary_rays;
         stats.nonfinite_pixels += s.nonfinite_pixels;
@@ -239,30 +241,29 @@ impl<'a> Rows<'a> {
     }
 
     /// Rows `rows` of the frame (`rows.start` a multiple of TILE), as a frame of their own.
-    /// Each row of tiles is rendered tile by tile straight into its rows (no second copy
-    /// of the image in flight).
     fn render(&self, rows: std::ops::Range<u32>) -> (Frame, RenderStats) {
+        let mut frame = Frame::new(0, 0);
+        let stats = self.render_into(rows, &mut frame);
+        (frame, stats)
+    }
+
+    /// Rows `rows` of the frame into `frame` (made their size, its memory reused where it
+    /// has the room; every pixel is written). Each row of tiles is rendered tile by tile
+    /// straight into its rows (no second copy of the image in flight).
+    fn render_into(&self, rows: std::ops::Range<u32>, frame: &mut Frame) -> RenderStats {
         debug_assert!(rows.start.is_multiple_of(TILE));
         let (scene, world, passes) = (self.scene, self.world, self.passes);
         let (w, _) = scene.image.frame_size();
-        // The frame's memory is first touched by the threads (a frame of every pass is about
-        // 190 bytes a pixel: made on one thread, its page faults are a serial part of the
-        // render).
         let n = (w as usize) * (rows.end - rows.start) as usize;
-        let mut frame = Frame {
-            width: w,
-            height: rows.end - rows.start,
-            pixels: (0..n)
-                .into_par_iter()
-                .map(|_| PixelValue::default())
-                .collect(),
-            mattes: Vec::new(),
-        };
+        (frame.width, frame.height) = (w, rows.end - rows.start);
+        refill(&mut frame.pixels, n);
+        if passes == Passes::All {
+            refill(&mut frame.mattes, n);
+        } else {
+            frame.mattes.clear();
+        }
         let row = ((w * TILE) as usize).max(1);
         let rows_of_tiles = frame.pixels.len().div_ceil(row);
-        if passes == Passes::All {
-            frame.mattes = (0..n).into_par_iter().map(|_| Default::default()).collect();
-        }
         // Each row's mattes beside its pixels (none in a render of colour alone).
         let mut mattes: Vec<&mut [Mattes]> = frame.mattes.chunks_mut(row).collect();
         mattes.resize_with(rows_of_tiles, Default::default);
@@ -307,6 +308,19 @@ impl<'a> Rows<'a> {
             stats.primary_rays += rays;
             stats.nonfinite_pixels += nonfinite;
         }
-        (frame, stats)
+        stats
+    }
+}
+
+/// Make `v` hold `n` values, keeping its memory where it has the room; the values it already
+/// holds stay (the caller overwrites them). Fresh memory is first touched by the threads: a
+/// frame of every pass is about 190 bytes a pixel, and made on one thread its page faults
+/// would be a serial part of the render.
+fn refill<T: Default + Send>(v: &mut Vec<T>, n: usize) {
+    if v.capacity() >= n {
+        v.truncate(n);
+        v.resize_with(n, Default::default);
+    } else {
+        *v = (0..n).into_par_iter().map(|_| T::default()).collect();
     }
 }
