@@ -41,6 +41,16 @@ below the table, each in a process of its own, the 1000³ lattice at 1024² as a
   spectral lattice against the same scene in RGB) measure both in alternating blocks, so the
   machine's drift falls on both alike.
 
+What bounds the whole command's ratio between backends: loading, shading, the passes and
+writing the file are the same work on every backend, and only the rays differ. With the rays
+taking R on one backend and r on the other and the rest S on both, the whole command's ratio
+is (R + S) / (r + S), below R / r whatever S is. R / r counts shadow rays as well as primary
+rays, and shadow rays (one per light and hit, each from its own surface point) gain less from
+Embree than primary rays, which share the imaging event; so the ratio of render times is below
+the primary-ray column's, and the whole command's below that. An EXR with every pass is 46
+channels of 4 bytes a pixel, deflated block by block (ZIP): its **write s** is mostly deflate,
+and at 1 spp it exceeds the render.
+
 Targets (from the issues that set them): the relativistic layer at least 0.85 of bare Embree;
 Embree at least 3x the f64 BVH on primary rays; 10,000 groups at most 3x the render time of the
 same boxes in one group; the 100³ lattice at 1024² within 10 s and 4 GB; the spectral lattice
