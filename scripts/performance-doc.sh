@@ -17,7 +17,8 @@ figures is in [architecture.md](architecture.md#how-it-is-fast).
 What each row measures, on a fixed suite (the paper's lattice at β = 0, 0.5, 0.9 and 0.99 with
 every setting, what lights, mirrors, the EXR passes and spectra cost, a 100³ lattice at 1024²
 and a 1000 × 1000 bar array, instanced and listed, 1 to 10,000 velocity groups, merging; and
-below the table, each in a process of its own, the 1000³ lattice at 1024² as a whole command):
+below the table, each in a process of its own, the 1000³ lattice and the paper's own 10³ at 1024²
+as whole commands, the latter the fastest of three on each backend):
 
 - **build s**: building the acceleration structures; **render s**: a full render (shading,
   shadow and secondary rays, passes), the fastest of as many runs as fit in a quarter second

@@ -364,6 +364,34 @@ fn embree_is_the_default_backend() {
     assert!(text.contains("bvh"));
 }
 
+/// The bench's whole-command rows come from `bench-lattice` in a process of its own: its
+/// Markdown line names the lattice and the backend, and its seconds follow for the ratio.
+#[test]
+fn bench_lattice_prints_its_line_and_its_seconds() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args(["bench-lattice", "10", "32", "bvh", "1"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("- "))
+        .unwrap_or_default();
+    assert!(
+        line.starts_with(
+            "- lattice 10^3 (3700 primitives) at 32^2, 1 spp, 0.9c, EXR, bvh: whole command "
+        ),
+        "{text}"
+    );
+    let seconds: f64 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("whole_s "))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no seconds: {text}"));
+    assert!(seconds > 0.0 && seconds.is_finite(), "{seconds}");
+}
+
 #[test]
 fn bench_writes_its_table_csv_and_plot() {
     let d = Dir::new("bench");

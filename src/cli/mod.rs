@@ -237,7 +237,11 @@ fn run(cli: Cli) -> ExitCode {
             backend,
             threads,
         } => {
-            println!("{}", bench_lattice::here(n, size, &backend, &threads));
+            let (line, wall) = bench_lattice::here(n, size, &backend, &threads);
+            println!("{line}");
+            if let Some(wall) = wall {
+                println!("{} {wall}", bench_lattice::WALL);
+            }
             ExitCode::SUCCESS
         }
     }
