@@ -5,7 +5,7 @@
 //!
 //! The estimates are upper bounds from the sizes of the structures: per pixel the frame's
 //! [`PixelValue`](crate::render::PixelValue) (92 bytes) and, for an EXR, its mattes and the
-//! encoder's copy of its channels (images are rendered and written a strip at a time,
+//! encoder's blocks in flight (images are rendered and written a strip at a time,
 //! [`STRIP_PIXELS`] or more, so only a strip counts); per primitive the f64 primitive, its
 //! share of the accelerator and the build's buffers (the bench's 100³ lattice, 4 million
 //! primitives, peaks near 270 bytes each).
@@ -28,7 +28,10 @@ pub const BYTES_PER_PIXEL_PNG: u64 = 96;
 /// strip's blocks compressed in parallel.
 pub const STRIP_PIXELS: u64 = 1 << 18;
 /// Bytes per pixel of an EXR render's strip: the frame (92), its mattes (96), and the
-/// encoder's 46 channels of 4 bytes.
+/// encoder's 46 channels of 4 bytes. The encoder holds no copy of the strip's channels any
+/// more, but each thread's block in flight and the two buffers it keeps for its ZIP (a block
+/// is 32 rows or fewer, a strip at least 64 rows per thread): less than that copy, so the
+/// figure stays an upper bound.
 pub const BYTES_PER_PIXEL_EXR: u64 = 380;
 
 /// The memory an object held as itself (a lattice, a bar array) costs rendered: its
