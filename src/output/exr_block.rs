@@ -209,54 +209,9 @@ mod tests {
     use crate::render::{Mattes, CHANNELS};
     use exr::meta::attribute::ChannelDescription;
 
-    /// The columns of `frame`'s channels `names` (each its pass, or its Cryptomatte rank's id
-    /// or share, made independently of [`source`]), as the file orders them.
-    fn columns(
-        frame: &Frame,
-        names: &[String],
-        matte_names: &MatteNames,
-        half: bool,
-    ) -> AnyChannels<FlatSamples> {
-        let list = names.iter().map(|name| {
-            let values: Vec<f32> = if let Some(column) = frame.channel(name) {
-                column
-            } else {
-                let (layer, rest) = name.split_at(name.find(|c: char| c.is_ascii_digit()).unwrap());
-                let level: usize = rest[..2].parse().unwrap();
-                let part = ["R", "G", "B", "A"]
-                    .iter()
-                    .position(|p| rest.ends_with(p))
-                    .unwrap();
-                let (pick, ids): (fn(&Mattes) -> &cryptomatte::Ranks, &[String]) = match layer {
-                    "CryptoObject" => (|m| &m.object, &matte_names.objects),
-                    _ => (|m| &m.material, &matte_names.materials),
-                };
-                let rank = 2 * level + part / 2;
-                frame
-                    .mattes
-                    .iter()
-                    .map(|m| {
-                        let (i, share) = pick(m)[rank];
-                        match (part % 2, i) {
-                            (1, _) => share,
-                            (_, 0) => 0.0,
-                            (_, i) => cryptomatte::id(&ids[i as usize - 1]),
-                        }
-                    })
-                    .collect()
-            };
-            let samples = if half && crate::render::pass(name).is_some() {
-                FlatSamples::F16(values.into_iter().map(f16::from_f32).collect())
-            } else {
-                FlatSamples::F32(values)
-            };
-            AnyChannel::new(name.as_str(), samples)
-        });
-        AnyChannels::sort(list.collect())
-    }
-
     /// Every block made from a strip's pixels holds the bytes the same block made from columns
-    /// of its channels holds: every pass and both Cryptomatte layers, full and half floats,
+    /// of its channels holds (each column made on its own, from `Frame::channel` and
+    /// `cryptomatte::layer`): every pass and both Cryptomatte layers, full and half floats,
     /// blocks of 1, 16 and 32 lines, including a last block cut short.
     #[test]
     fn blocks_from_pixels_are_blocks_from_columns() {
@@ -288,15 +243,13 @@ mod tests {
                 material: std::array::from_fn(|r| ((i * r) as u32 % 3, 1.0 - r as f32 / 9.0)),
             })
             .collect();
-        let mut channel_names: Vec<String> = CHANNELS.iter().map(|c| c.to_string()).collect();
-        for layer in ["CryptoObject", "CryptoMaterial"] {
-            for level in 0..MATTE_RANKS / 2 {
-                channel_names
-                    .extend(["R", "G", "B", "A"].map(|p| format!("{layer}{level:02}.{p}")));
-            }
-        }
         for half in [false, true] {
-            let cols = columns(&frame, &channel_names, &names, half);
+            let options = super::super::ExrOptions {
+                half,
+                mattes: Some(names.clone()),
+                ..Default::default()
+            };
+            let (cols, _) = super::super::exr_out::channels(&frame, true, &options);
             let list: ChannelList = ChannelList::new(
                 cols.list
                     .iter()
@@ -310,7 +263,7 @@ mod tests {
                     })
                     .collect(),
             );
-            assert_eq!(list.list.len(), 22 + 24);
+            assert_eq!(list.list.len(), CHANNELS.len() + 4 * MATTE_RANKS);
             let layout = Layout::new(&list, Some(&names)).expect("every channel known");
             let strip = layout.strip(&frame);
             for lines in [1usize, 16, 32] {

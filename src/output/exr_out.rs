@@ -32,16 +32,17 @@ pub fn write(frame: &Frame, path: &Path, options: &ExrOptions) -> std::result::R
     })
 }
 
-/// The channels of `frame` as the file holds them, sorted by name (every pass, and the
-/// Cryptomatte layers when `mattes`), made in parallel, with the Cryptomatte attributes.
-fn channels(
+/// The channels of `frame` as columns, as the file holds them, sorted by name (every pass,
+/// and the Cryptomatte layers when `mattes`), with the Cryptomatte attributes: the header's
+/// template (from a frame of one pixel), and what the blocks made straight from a strip's
+/// pixels (`exr_block.rs`) are tested against.
+pub(super) fn channels(
     frame: &Frame,
     mattes: bool,
     options: &ExrOptions,
 ) -> (AnyChannels<FlatSamples>, Vec<(String, Attribute)>) {
-    use rayon::prelude::*;
     let channels: Vec<AnyChannel<FlatSamples>> = CHANNELS
-        .par_iter()
+        .iter()
         .map(|&name| {
             let values = frame.channel(name).expect("known channel");
             let samples = if options.half && MAY_BE_HALF.contains(&name) {

@@ -1,5 +1,6 @@
-//! The 8-bit sRGB code of a linear value, `round(255 · srgb_encode(c))`, found by a binary
-//! search over the 255 values where the code steps up, instead of a `powf` per channel. The
+//! The 8-bit sRGB code of a linear value, `round(255 · srgb_encode(c))`, from the 255 values
+//! where the code steps up, instead of a `powf` per channel: a table gives the code at the
+//! start of the value's bucket of floats, and a step or two up the list finds its own. The
 //! steps are found once, by bisection over f32s with `srgb_encode` itself, so each code is the
 //! one the formula gives (tested against it around every step and at random values).
 
