@@ -3,8 +3,8 @@
 //! written line by line, channel by channel, without first making a column of every channel.
 //! Blocks are independent, so the strip's blocks are made (and compressed) in parallel.
 
-use super::cryptomatte::{self, MatteNames, Pick};
-use crate::render::{Frame, MATTE_RANKS};
+use super::cryptomatte::{self, MatteNames};
+use crate::render::{Frame, Mattes, MATTE_RANKS};
 use exr::block::{BlockIndex, UncompressedBlock};
 use exr::meta::attribute::{ChannelList, SampleType};
 use exr::prelude::*;
@@ -46,19 +46,23 @@ impl BlockSource for AnyChannels<FlatSamples> {
 }
 
 /// Where one channel's value lies in a pixel.
-#[derive(Clone)]
+#[derive(Clone, Copy)]
 enum Source {
     /// A pass of the pixel's value: which of [`crate::render::PixelValue::values`].
     Pass(usize),
-    /// The id of a rank of a Cryptomatte layer: `ids[index]` (0 where no object was seen).
-    MatteId(Pick, usize, std::sync::Arc<[f32]>),
-    /// The share of a rank of a Cryptomatte layer.
-    MatteShare(Pick, usize),
+    /// A value of the pixel's mattes: which of [`Layout::matte_values`].
+    Matte(usize),
 }
+
+/// How many values a pixel's mattes give: per kind (objects, materials) and rank, an id and a
+/// share.
+const MATTE_VALUES: usize = 2 * 2 * MATTE_RANKS;
 
 /// The file's channels, in its order, each with where its values lie and how it is stored.
 pub(super) struct Layout {
     columns: Vec<(Source, SampleType)>,
+    /// The Cryptomatte ids of the objects and of the materials, by index + 1 (0 for none).
+    ids: [Vec<f32>; 2],
 }
 
 impl Layout {
@@ -69,9 +73,15 @@ impl Layout {
         let columns = channels
             .list
             .iter()
-            .map(|c| Some((source(&c.name.to_string(), names)?, c.sample_type)))
+            .map(|c| Some((source(&c.name.to_string(), names.is_some())?, c.sample_type)))
             .collect::<Option<_>>()?;
-        Some(Layout { columns })
+        let ids = |names: &[String]| -> Vec<f32> {
+            std::iter::once(0.0)
+                .chain(names.iter().map(|n| cryptomatte::id(n)))
+                .collect()
+        };
+        let ids = names.map_or_else(Default::default, |n| [ids(&n.objects), ids(&n.materials)]);
+        Some(Layout { columns, ids })
     }
 
     /// A strip of the image, as a source of blocks.
@@ -81,35 +91,44 @@ impl Layout {
             frame: strip,
         }
     }
+
+    /// A pixel's mattes as the values of the Cryptomatte channels: for the objects, then the
+    /// materials, rank by rank, the id and the share.
+    #[inline]
+    fn matte_values(&self, m: &Mattes) -> [f32; MATTE_VALUES] {
+        let mut v = [0.0; MATTE_VALUES];
+        for (kind, ranks) in [&m.object, &m.material].into_iter().enumerate() {
+            for (rank, &(index, share)) in ranks.iter().enumerate() {
+                let at = 2 * (kind * MATTE_RANKS + rank);
+                v[at] = self.ids[kind].get(index as usize).copied().unwrap_or(0.0);
+                v[at + 1] = share;
+            }
+        }
+        v
+    }
 }
 
-/// A channel's source from its name: a pass, or `{layer}{level:02}.{R,G,B,A}` of a
-/// Cryptomatte layer (R and B ids, G and A shares, of ranks 2 × level and 2 × level + 1).
-fn source(name: &str, names: Option<&MatteNames>) -> Option<Source> {
+/// A channel's source from its name: a pass, or (where the file has `mattes`)
+/// `{layer}{level:02}.{R,G,B,A}` of a Cryptomatte layer (R and B ids, G and A shares, of ranks
+/// 2 × level and 2 × level + 1).
+fn source(name: &str, mattes: bool) -> Option<Source> {
     if let Some(pass) = crate::render::pass(name) {
         return Some(Source::Pass(pass));
     }
-    let names = names?;
-    let kinds: [(&str, Pick, &[String]); 2] = [
-        ("CryptoObject", |m| &m.object, &names.objects),
-        ("CryptoMaterial", |m| &m.material, &names.materials),
-    ];
-    kinds.into_iter().find_map(|(layer, pick, names)| {
-        let (level, part) = name.strip_prefix(layer)?.split_once('.')?;
-        let level: usize = level.parse().ok()?;
-        let part = ["R", "G", "B", "A"].iter().position(|&p| p == part)?;
-        let rank = 2 * level + part / 2;
-        (rank < MATTE_RANKS).then(|| {
-            if part % 2 == 0 {
-                let ids = std::iter::once(0.0)
-                    .chain(names.iter().map(|n| cryptomatte::id(n)))
-                    .collect();
-                Source::MatteId(pick, rank, ids)
-            } else {
-                Source::MatteShare(pick, rank)
-            }
+    if !mattes {
+        return None;
+    }
+    ["CryptoObject", "CryptoMaterial"]
+        .into_iter()
+        .enumerate()
+        .find_map(|(kind, layer)| {
+            let (level, part) = name.strip_prefix(layer)?.split_once('.')?;
+            let level: usize = level.parse().ok()?;
+            let part = ["R", "G", "B", "A"].iter().position(|&p| p == part)?;
+            let rank = 2 * level + part / 2;
+            (rank < MATTE_RANKS)
+                .then_some(Source::Matte(2 * (kind * MATTE_RANKS + rank) + part % 2))
         })
-    })
 }
 
 /// A strip of pixels with the layout of the file it goes to.
@@ -117,6 +136,9 @@ pub(super) struct Strip<'a> {
     layout: &'a Layout,
     frame: &'a Frame,
 }
+
+/// Pixels whose values are made together, then stored column by column.
+const RUN: usize = 16;
 
 impl BlockSource for Strip<'_> {
     fn block(
@@ -129,84 +151,77 @@ impl BlockSource for Strip<'_> {
         let lines = block.pixel_size.height();
         let x0 = block.pixel_position.x();
         let n = block.pixel_size.width();
-        // Each column's place in a line: its channel's samples, one after another.
-        let mut offsets: SmallVec<[usize; 64]> = SmallVec::new();
+        // Each column's place in a line (its channel's samples, one after another), by the
+        // kind of value it holds.
+        let (mut passes, mut mattes) = (SmallVec::<[_; 32]>::new(), SmallVec::<[_; 32]>::new());
         let mut line_bytes = 0;
-        for (_, t) in &self.layout.columns {
-            offsets.push(line_bytes);
+        for &(source, t) in &self.layout.columns {
+            match source {
+                Source::Pass(i) => passes.push((i, line_bytes, t)),
+                Source::Matte(i) => mattes.push((i, line_bytes, t)),
+            }
             line_bytes += n * t.bytes_per_sample();
         }
-        let passes: SmallVec<[(usize, usize, SampleType); 32]> = self
-            .layout
-            .columns
-            .iter()
-            .zip(&offsets)
-            .filter_map(|((s, t), &at)| match s {
-                Source::Pass(i) => Some((*i, at, *t)),
-                _ => None,
-            })
-            .collect();
         let mut data = vec![0; line_bytes * lines];
         for (line, out) in data.chunks_exact_mut(line_bytes.max(1)).enumerate() {
             let at = (block.pixel_position.y() + line - y0) * width + x0;
+            // RUN pixels at a time: their values made once, then each column's RUN samples
+            // stored together (one pixel's values spread over every column).
             let pixels = &self.frame.pixels[at..at + n];
-            // The passes 16 pixels at a time: their values made once, then each column's 16
-            // samples stored together (one pixel's values spread over every column).
-            for (chunk, run) in pixels.chunks(16).enumerate() {
-                let values: SmallVec<[_; 16]> = run.iter().map(|p| p.values()).collect();
-                for &(i, column, t) in &passes {
-                    for (k, v) in values.iter().enumerate() {
-                        put(out, column, 16 * chunk + k, t, v[i]);
-                    }
-                }
+            for (run, chunk) in pixels.chunks(RUN).enumerate() {
+                let values: SmallVec<[_; RUN]> = chunk.iter().map(|p| p.values()).collect();
+                store_run(out, run, &passes, &values);
             }
-            // The mattes column by column (a strip without mattes leaves them zero).
-            let Some(mattes) = self.frame.mattes.get(at..at + n) else {
+            // A strip without mattes leaves their channels zero.
+            let Some(pixel_mattes) = self.frame.mattes.get(at..at + n) else {
                 continue;
             };
-            for ((source, t), &column) in self.layout.columns.iter().zip(&offsets) {
-                match source {
-                    Source::Pass(_) => {}
-                    Source::MatteId(pick, rank, ids) => {
-                        for (x, m) in mattes.iter().enumerate() {
-                            put(out, column, x, *t, ids[pick(m)[*rank].0 as usize]);
-                        }
-                    }
-                    Source::MatteShare(pick, rank) => {
-                        for (x, m) in mattes.iter().enumerate() {
-                            put(out, column, x, *t, pick(m)[*rank].1);
-                        }
-                    }
-                }
+            if mattes.is_empty() {
+                continue;
+            }
+            for (run, chunk) in pixel_mattes.chunks(RUN).enumerate() {
+                let values: SmallVec<[_; RUN]> =
+                    chunk.iter().map(|m| self.layout.matte_values(m)).collect();
+                store_run(out, run, &mattes, &values);
             }
         }
         UncompressedBlock { index: block, data }
     }
 }
 
-/// Store sample `x` of the column at byte `column` of `line` as a `t`.
+/// Store run `run` of a line's pixels, whose values are `values`, in each of `columns` (which
+/// value, the column's first byte in the line, its sample type).
 #[inline(always)]
-fn put(line: &mut [u8], column: usize, x: usize, t: SampleType, v: f32) {
+fn store_run<const N: usize>(
+    line: &mut [u8],
+    run: usize,
+    columns: &[(usize, usize, SampleType)],
+    values: &[[f32; N]],
+) {
+    for &(i, column, t) in columns {
+        let size = t.bytes_per_sample();
+        let at = column + size * RUN * run;
+        let samples = line[at..at + size * values.len()].chunks_exact_mut(size);
+        for (sample, v) in samples.zip(values) {
+            store(sample, t, v[i]);
+        }
+    }
+}
+
+/// Store `v` as a `t` in `sample` (its size).
+#[inline(always)]
+fn store(sample: &mut [u8], t: SampleType, v: f32) {
     match t {
-        SampleType::F16 => {
-            let at = column + 2 * x;
-            line[at..at + 2].copy_from_slice(&f16::from_f32(v).to_ne_bytes());
-        }
-        SampleType::F32 => {
-            let at = column + 4 * x;
-            line[at..at + 4].copy_from_slice(&v.to_ne_bytes());
-        }
-        SampleType::U32 => {
-            let at = column + 4 * x;
-            line[at..at + 4].copy_from_slice(&(v as u32).to_ne_bytes());
-        }
+        SampleType::F16 => sample.copy_from_slice(&f16::from_f32(v).to_ne_bytes()),
+        SampleType::F32 => sample.copy_from_slice(&v.to_ne_bytes()),
+        SampleType::U32 => sample.copy_from_slice(&(v as u32).to_ne_bytes()),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::{Mattes, CHANNELS};
+    use crate::render::CHANNELS;
     use exr::meta::attribute::ChannelDescription;
 
     /// Every block made from a strip's pixels holds the bytes the same block made from columns
@@ -265,6 +280,8 @@ mod tests {
             );
             assert_eq!(list.list.len(), CHANNELS.len() + 4 * MATTE_RANKS);
             let layout = Layout::new(&list, Some(&names)).expect("every channel known");
+            // Cryptomatte channels without the names their ids come from have no layout.
+            assert!(Layout::new(&list, None).is_none());
             let strip = layout.strip(&frame);
             for lines in [1usize, 16, 32] {
                 for y in (0..h).step_by(lines) {
