@@ -4,7 +4,7 @@
 //! Blocks are independent, so the strip's blocks are made (and compressed) in parallel.
 
 use super::cryptomatte::{self, MatteNames};
-use crate::render::{Frame, Mattes, MATTE_RANKS};
+use crate::render::{Frame, Mattes, CHANNELS, MATTE_RANKS};
 use exr::block::{BlockIndex, UncompressedBlock};
 use exr::meta::attribute::{ChannelList, SampleType};
 use exr::prelude::*;
@@ -168,9 +168,12 @@ impl BlockSource for Strip<'_> {
             // RUN pixels at a time: their values made once, then each column's RUN samples
             // stored together (one pixel's values spread over every column).
             let pixels = &self.frame.pixels[at..at + n];
+            let mut values = [[0.0; CHANNELS.len()]; RUN];
             for (run, chunk) in pixels.chunks(RUN).enumerate() {
-                let values: SmallVec<[_; RUN]> = chunk.iter().map(|p| p.values()).collect();
-                store_run(out, run, &passes, &values);
+                for (v, p) in values.iter_mut().zip(chunk) {
+                    *v = p.values();
+                }
+                store_run(out, run, &passes, &values[..chunk.len()]);
             }
             // A strip without mattes leaves their channels zero.
             let Some(pixel_mattes) = self.frame.mattes.get(at..at + n) else {
@@ -179,10 +182,12 @@ impl BlockSource for Strip<'_> {
             if mattes.is_empty() {
                 continue;
             }
+            let mut values = [[0.0; MATTE_VALUES]; RUN];
             for (run, chunk) in pixel_mattes.chunks(RUN).enumerate() {
-                let values: SmallVec<[_; RUN]> =
-                    chunk.iter().map(|m| self.layout.matte_values(m)).collect();
-                store_run(out, run, &mattes, &values);
+                for (v, m) in values.iter_mut().zip(chunk) {
+                    *v = self.layout.matte_values(m);
+                }
+                store_run(out, run, &mattes, &values[..chunk.len()]);
             }
         }
         UncompressedBlock { index: block, data }
@@ -221,7 +226,6 @@ fn store(sample: &mut [u8], t: SampleType, v: f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::CHANNELS;
     use exr::meta::attribute::ChannelDescription;
 
     /// Every block made from a strip's pixels holds the bytes the same block made from columns
