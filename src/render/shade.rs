@@ -120,11 +120,15 @@ impl<'a, B: Band> Shader<'a, B> {
     /// Spawn a secondary ray at a hit: rest-frame direction `dir`, origin pushed off the
     /// surface by ε along `side` (rest frame), both boosted back to the world frame.
     fn spawn(&self, group: usize, hit_event: Event, side: DVec3, dir: DVec3) -> NullRay {
+        let (dir_w, _) = self.world.groups[group].boost.inverse().view_dir(dir);
+        NullRay::new(self.pushed_off(group, hit_event, side), dir_w)
+    }
+
+    /// The world-frame event ε off the surface at a hit, along rest-frame `side`: where a
+    /// secondary ray of the hit starts.
+    fn pushed_off(&self, group: usize, hit_event: Event, side: DVec3) -> Event {
         let g = &self.world.groups[group];
-        let out = g.boost.inverse();
-        let offset = out.event(Event::new(0.0, g.epsilon * side));
-        let (dir_w, _) = out.view_dir(dir);
-        NullRay::new(hit_event + offset, dir_w)
+        hit_event + g.boost.inverse().event(Event::new(0.0, g.epsilon * side))
     }
 
     /// The light leaving a hit toward the ray's origin, in the surface's frame at wavelengths
@@ -198,7 +202,7 @@ impl<'a, B: Band> Shader<'a, B> {
             return lit;
         }
         let glints = !mat.specular.is_black();
-        let from = self.spawn(hit.group, event, nf, nf).origin;
+        let from = self.pushed_off(hit.group, event, nf);
         shadows.extend(self.lights.iter().map(|l| {
             // The emission event on the light's worldline that lies on `from`'s past light
             // cone, found in the light's rest frame, where the light is static.
