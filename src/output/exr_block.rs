@@ -1,7 +1,8 @@
 //! An EXR block's bytes made straight from a strip's pixels: each of the file's channels knows
 //! where its value lies in a pixel (a pass, or a rank of a Cryptomatte layer), and a block is
-//! written line by line, channel by channel, without first making a column of every channel.
-//! Blocks are independent, so the strip's blocks are made (and compressed) in parallel.
+//! written line by line, 16 pixels at a time (their values made once, then stored column by
+//! column), without first making a column of every channel. Blocks are independent, so the
+//! strip's blocks are made (and compressed) in parallel.
 
 use super::cryptomatte::{self, MatteNames};
 use crate::render::{Frame, Mattes, CHANNELS, MATTE_RANKS};
@@ -100,7 +101,7 @@ impl Layout {
         for (kind, ranks) in [&m.object, &m.material].into_iter().enumerate() {
             for (rank, &(index, share)) in ranks.iter().enumerate() {
                 let at = 2 * (kind * MATTE_RANKS + rank);
-                v[at] = self.ids[kind].get(index as usize).copied().unwrap_or(0.0);
+                v[at] = self.ids[kind][index as usize];
                 v[at + 1] = share;
             }
         }

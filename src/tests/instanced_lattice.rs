@@ -197,13 +197,9 @@ fn the_paper_scenes_render_alike_instanced() {
             let a = render_world(&scene, &held).0;
             let b = render_world(&scene, &listed).0;
             assert!(a.pixels.iter().any(|p| p.object_id > 0), "{paper}: empty");
-            let differ = a
-                .pixels
-                .iter()
-                .zip(&b.pixels)
-                .filter(|(p, q)| p != q)
-                .count();
+            let differ = super::differing_pixels(&a, &b);
             assert_eq!(differ, 0, "{paper}, {name}: {differ} pixels differ");
+            assert!(a.mattes == b.mattes, "{paper}, {name}: the mattes differ");
         }
     }
 }

@@ -538,12 +538,7 @@ fn a_light_among_the_groups_casts_the_same_shadows_with_the_light_buffers() {
             lit > 300 && hit - lit > 300,
             "{name}: lit and shadowed surfaces in view ({lit} lit of {hit})"
         );
-        let differ = a
-            .pixels
-            .iter()
-            .zip(&b.pixels)
-            .filter(|(p, q)| p != q)
-            .count();
+        let differ = super::differing_pixels(&a, &b);
         assert_eq!(
             differ, 0,
             "{name}: the light buffers change {differ} pixels"

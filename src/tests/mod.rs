@@ -13,3 +13,12 @@ mod screen_cull;
 mod shadow_batches;
 mod strips;
 mod toml_tree;
+
+/// How many pixels of two frames of one size differ, in any pass.
+fn differing_pixels(a: &crate::render::Frame, b: &crate::render::Frame) -> usize {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .filter(|(p, q)| p != q)
+        .count()
+}
