@@ -135,14 +135,12 @@ impl Primitive {
         match *self {
             Primitive::Sphere { center, .. } => (p - center).normalize_or(DVec3::Z),
             Primitive::Capsule { a, b, .. } => {
-                // From the segment's nearest point: along a rod on an axis, p's own coordinate
-                // clamped to the segment (no division).
+                // From the segment's nearest point: along a rod on an axis, p clamped to the
+                // segment's box (no division). Off the axis lo and hi agree, so that is the
+                // rod's own coordinate there; written whole, not as one component set by a
+                // run-time index, whose store stalled the read of the vector after it.
                 let nearest = match AxisRod::of(a, b) {
-                    Some(rod) => {
-                        let mut q = rod.lo;
-                        q[rod.k] = p[rod.k].clamp(rod.lo[rod.k], rod.hi[rod.k]);
-                        q
-                    }
+                    Some(rod) => p.max(rod.lo).min(rod.hi),
                     None => {
                         let ab = b - a;
                         let s = ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE))

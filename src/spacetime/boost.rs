@@ -91,16 +91,14 @@ impl Boost {
     /// scalar one to the bit.
     #[inline(always)]
     pub(crate) fn null_dir_lanes<R: Real>(&self, a: [R; 3]) -> ([R; 3], R) {
-        if let Some((k, sigma)) = self.aligned {
-            // The axis is σ e_k: a∥ = σ a_k, a⊥ = a but for its k-th component (zero), and
-            // d' = a⊥ + par σ e_k. The same numbers as below but for the signs of zeros.
-            let ap = R::splat(sigma) * a[k];
-            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-            let p2 = a[i] * a[i] + a[j] * a[j];
-            let (s, par) = self.along(ap, p2);
-            let mut d = a;
-            d[k] = par * R::splat(sigma);
-            return (d, s);
+        match self.aligned {
+            // One copy per axis, so every index is a constant: a copy indexing by a run-time
+            // axis wrote d[k] to the stack and read d back whole, a store the load could not
+            // take forwarded, which stalled every call.
+            Some((0, sigma)) => return self.null_dir_along::<R, 0>(a, sigma),
+            Some((1, sigma)) => return self.null_dir_along::<R, 1>(a, sigma),
+            Some((_, sigma)) => return self.null_dir_along::<R, 2>(a, sigma),
+            None => {}
         }
         let axis = [
             R::splat(self.axis.x),
@@ -123,6 +121,20 @@ impl Boost {
             ],
             s,
         )
+    }
+
+    /// [`Boost::null_dir_lanes`] for a boost along σ e_K: a∥ = σ a_K, a⊥ = a but for its K-th
+    /// component (zero), and d' = a⊥ + par σ e_K. The same numbers as the general case but for
+    /// the signs of zeros.
+    #[inline(always)]
+    fn null_dir_along<R: Real, const K: usize>(&self, a: [R; 3], sigma: f64) -> ([R; 3], R) {
+        let ap = R::splat(sigma) * a[K];
+        let (i, j) = ((K + 1) % 3, (K + 2) % 3);
+        let p2 = a[i] * a[i] + a[j] * a[j];
+        let (s, par) = self.along(ap, p2);
+        let mut d = a;
+        d[K] = par * R::splat(sigma);
+        (d, s)
     }
 
     /// For a unit direction with a∥ = `ap` along the axis and |a⊥|² = `p2` across it: the
