@@ -135,7 +135,8 @@ impl<'a, B: Band> Shader<'a, B> {
     /// `shift` times the camera's: its light from each light not in shadow, and what it
     /// reflects and transmits.
     pub fn shade(&self, ray: &NullRay, hit: &SurfaceHit, shift: f64, budget: Budget) -> (B, u64) {
-        let mut shadows = Vec::with_capacity(self.lights.len());
+        // On the stack for a few lights: a secondary hit allocates nothing.
+        let mut shadows = smallvec::SmallVec::<[Option<ShadowQuery>; 4]>::new();
         let lit = self.prepare(ray, hit, shift, &mut shadows);
         self.finish(
             &lit,
@@ -174,7 +175,7 @@ impl<'a, B: Band> Shader<'a, B> {
         ray: &NullRay,
         hit: &SurfaceHit,
         shift: f64,
-        shadows: &mut Vec<Option<ShadowQuery>>,
+        shadows: &mut impl Extend<Option<ShadowQuery>>,
     ) -> Lit<'a> {
         let scene = self.scene;
         let g = &self.world.groups[hit.group];
