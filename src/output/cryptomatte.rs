@@ -41,6 +41,22 @@ pub type Pick = fn(&Mattes) -> &Ranks;
 /// Channels by name, with their values in pixel order.
 pub type Channels = Vec<(String, Vec<f32>)>;
 
+/// The Cryptomatte layers a render writes: its objects' mattes, then its materials'.
+pub const LAYERS: [&str; 2] = ["CryptoObject", "CryptoMaterial"];
+
+/// The name of column `c` of `layer`: rank c / 2's id (c even) or share (c odd), as R, G, B
+/// or A of the layer's level c / 4 (`CryptoObject00.R`, …).
+pub fn channel_name(layer: &str, c: usize) -> String {
+    format!("{layer}{:02}.{}", c / 4, ["R", "G", "B", "A"][c % 4])
+}
+
+/// The ids of `names` by index + 1, as a pixel's mattes number them: 0.0 (no object) first.
+pub fn id_table(names: &[String]) -> Vec<f32> {
+    std::iter::once(0.0)
+        .chain(names.iter().map(|n| id(n)))
+        .collect()
+}
+
 /// The channels and header attributes of one kind of matte (`layer`, e.g. `CryptoObject`),
 /// `pick` choosing the ranks from a pixel's mattes and `names` naming each index (ids are
 /// index + 1).
@@ -51,8 +67,7 @@ pub fn layer(
     names: &[String],
 ) -> (Channels, Vec<(String, Attribute)>) {
     use rayon::prelude::*;
-    let ids: Vec<f32> = names.iter().map(|n| id(n)).collect();
-    let id_of = |i: u32| if i == 0 { 0.0 } else { ids[i as usize - 1] };
+    let ids = id_table(names);
     // Column c holds rank c / 2's id (c even) or share (c odd): RGBA of level c / 4. The
     // columns are made in parallel, each in one pass over the pixels.
     let channels = (0..2 * MATTE_RANKS)
@@ -60,17 +75,19 @@ pub fn layer(
         .map(|c| {
             let rank = c / 2;
             let values: Vec<f32> = if c % 2 == 0 {
-                mattes.iter().map(|m| id_of(pick(m)[rank].0)).collect()
+                mattes
+                    .iter()
+                    .map(|m| ids[pick(m)[rank].0 as usize])
+                    .collect()
             } else {
                 mattes.iter().map(|m| pick(m)[rank].1).collect()
             };
-            let name = format!("{layer}{:02}.{}", c / 4, ["R", "G", "B", "A"][c % 4]);
-            (name, values)
+            (channel_name(layer, c), values)
         })
         .collect();
     let manifest: serde_json::Map<String, serde_json::Value> = names
         .iter()
-        .zip(&ids)
+        .zip(&ids[1..])
         .map(|(n, i)| (n.clone(), format!("{:08x}", i.to_bits()).into()))
         .collect();
     let key = &format!("{:08x}", murmur3(layer))[..7];

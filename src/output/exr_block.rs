@@ -76,12 +76,9 @@ impl Layout {
             .iter()
             .map(|c| Some((source(&c.name.to_string(), names.is_some())?, c.sample_type)))
             .collect::<Option<_>>()?;
-        let ids = |names: &[String]| -> Vec<f32> {
-            std::iter::once(0.0)
-                .chain(names.iter().map(|n| cryptomatte::id(n)))
-                .collect()
-        };
-        let ids = names.map_or_else(Default::default, |n| [ids(&n.objects), ids(&n.materials)]);
+        let ids = names.map_or_else(Default::default, |n| {
+            [&n.objects, &n.materials].map(|names| cryptomatte::id_table(names))
+        });
         Some(Layout { columns, ids })
     }
 
@@ -109,9 +106,9 @@ impl Layout {
     }
 }
 
-/// A channel's source from its name: a pass, or (where the file has `mattes`)
-/// `{layer}{level:02}.{R,G,B,A}` of a Cryptomatte layer (R and B ids, G and A shares, of ranks
-/// 2 × level and 2 × level + 1).
+/// A channel's source from its name: a pass, or (where the file has `mattes`) a column of a
+/// Cryptomatte layer, named as [`cryptomatte::channel_name`] names it (column c holds rank
+/// c / 2's id or share, value `c` of the layer's kind in [`Layout::matte_values`]).
 fn source(name: &str, mattes: bool) -> Option<Source> {
     if let Some(pass) = crate::render::pass(name) {
         return Some(Source::Pass(pass));
@@ -119,17 +116,10 @@ fn source(name: &str, mattes: bool) -> Option<Source> {
     if !mattes {
         return None;
     }
-    ["CryptoObject", "CryptoMaterial"]
-        .into_iter()
-        .enumerate()
-        .find_map(|(kind, layer)| {
-            let (level, part) = name.strip_prefix(layer)?.split_once('.')?;
-            let level: usize = level.parse().ok()?;
-            let part = ["R", "G", "B", "A"].iter().position(|&p| p == part)?;
-            let rank = 2 * level + part / 2;
-            (rank < MATTE_RANKS)
-                .then_some(Source::Matte(2 * (kind * MATTE_RANKS + rank) + part % 2))
-        })
+    let columns = 2 * MATTE_RANKS;
+    (0..cryptomatte::LAYERS.len() * columns)
+        .find(|&v| cryptomatte::channel_name(cryptomatte::LAYERS[v / columns], v % columns) == name)
+        .map(Source::Matte)
 }
 
 /// A strip of pixels with the layout of the file it goes to.

@@ -57,8 +57,8 @@ pub(super) fn channels(
     let mut extra = Vec::new();
     if let (Some(names), true) = (&options.mattes, mattes) {
         let kinds: [(&str, cryptomatte::Pick, &[String]); 2] = [
-            ("CryptoObject", |m| &m.object, &names.objects),
-            ("CryptoMaterial", |m| &m.material, &names.materials),
+            (cryptomatte::LAYERS[0], |m| &m.object, &names.objects),
+            (cryptomatte::LAYERS[1], |m| &m.material, &names.materials),
         ];
         for (layer, pick, names) in kinds {
             let (channels, attributes) = cryptomatte::layer(layer, &frame.mattes, pick, names);
