@@ -96,6 +96,27 @@ impl std::error::Error for Error {
 /// The cause of an error, shared so that [`Error`] can be cloned.
 pub type Cause = Arc<dyn std::error::Error + Send + Sync>;
 
+/// An error as the cause of another (a render's inside the writing of its file).
+impl From<Error> for Cause {
+    fn from(e: Error) -> Cause {
+        Arc::new(e)
+    }
+}
+
+impl Error {
+    /// The error of this crate's that caused this one, if any (an image written as it was
+    /// rendered fails with the render's error as its cause): the one to report.
+    pub fn root(self) -> Error {
+        let inner = match &self {
+            Error::Image {
+                source: Some(s), ..
+            } => s.downcast_ref::<Error>().cloned(),
+            _ => None,
+        };
+        inner.map_or(self, Error::root)
+    }
+}
+
 impl From<SceneError> for Error {
     fn from(e: SceneError) -> Error {
         Error::Scene(e)

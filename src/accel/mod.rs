@@ -18,13 +18,57 @@ mod instanced_tree;
 
 pub(crate) use bvh::BvhBackend;
 pub(crate) use bvh32::Bvh32Backend;
+#[cfg(all(feature = "embree", test))]
+pub(crate) use embree::Isa;
 #[cfg(feature = "embree")]
 pub(crate) use embree::{BareRay, EmbreeAccel, EmbreeBackend};
 pub use fan::{Fan, FanHits, NO_HIT};
 
 use crate::geometry::{Aabb, BoxTree, Geometry, LightBuffer};
 use glam::DVec3;
-use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// What went wrong inside a backend where no error could be returned: Embree calls back into
+/// the renderer from C, where a panic must not unwind and a query has no result to fail with.
+/// The backend records the first fault here; the render checks it after every strip and fails
+/// rather than write a picture that may be wrong.
+#[derive(Debug, Default)]
+pub struct Faults {
+    any: AtomicBool,
+    first: Mutex<Option<String>>,
+}
+
+impl Faults {
+    /// Record a fault (the first one's message is kept).
+    pub fn record(&self, what: impl FnOnce() -> String) {
+        if self.any.swap(true, Ordering::AcqRel) {
+            return;
+        }
+        if let Ok(mut first) = self.first.lock() {
+            first.get_or_insert_with(what);
+        }
+    }
+
+    /// Whether a fault was recorded.
+    pub fn any(&self) -> bool {
+        self.any.load(Ordering::Acquire)
+    }
+
+    /// An error if a fault was recorded.
+    pub fn check(&self) -> crate::Result<()> {
+        if !self.any() {
+            return Ok(());
+        }
+        let what = self
+            .first
+            .lock()
+            .ok()
+            .and_then(|f| f.clone())
+            .unwrap_or_else(|| "a fault".to_string());
+        Err(crate::Error::backend(what))
+    }
+}
 
 /// A static ray `origin + t dir`, searched for `tmin < t < tmax`. A ray with `tmin > tmax` is
 /// inactive (masked) and must be skipped.
@@ -121,6 +165,11 @@ pub trait Backend: Send + Sync {
     fn cullers(&self) -> CullerFactory {
         Arc::new(|boxes| Ok(Box::new(BoxTree::build(boxes)) as Box<dyn BoxCuller>))
     }
+    /// Where the backend records what went wrong while tracing (`Faults`), if it can fail
+    /// there; the render checks it.
+    fn faults(&self) -> Option<Arc<Faults>> {
+        None
+    }
 }
 
 /// Builds a [`BoxCuller`] over boxes.
@@ -193,23 +242,83 @@ pub fn backend_names() -> Vec<&'static str> {
     }
 }
 
+/// Every name `--backend` accepts in this build: the backends (`backend_names`), then the
+/// variants kept for comparisons.
+pub fn all_backend_names() -> Vec<&'static str> {
+    let mut names = backend_names();
+    #[cfg(feature = "embree")]
+    names.extend(EMBREE_WIDTHS);
+    names.push("bvh-f32");
+    names
+}
+
+/// What `rest-embree backends` prints: every name `--backend` takes and what it is; for
+/// Embree, what this CPU and `REST_EMBREE_ISA` make of it (an error if that names an
+/// instruction set Embree or the CPU does not have).
+pub fn backend_report() -> crate::Result<Vec<String>> {
+    let mut lines = Vec::new();
+    #[cfg(feature = "embree")]
+    {
+        let embree = embree_summary()?.unwrap_or_default();
+        lines.push(format!("embree (default): {embree}"));
+    }
+    let default = if cfg!(feature = "embree") {
+        ""
+    } else {
+        " (default)"
+    };
+    lines.push(format!(
+        "bvh{default}: the f64 BVH in pure Rust, the reference every backend is compared with"
+    ));
+    #[cfg(feature = "embree")]
+    lines.push(format!(
+        "{}: Embree with a fixed packet width (single: one ray at a time), for comparisons",
+        EMBREE_WIDTHS.join(", ")
+    ));
+    lines.push("bvh-f32: the f64 BVH's tree with f32 nodes, for comparisons".to_string());
+    #[cfg(feature = "embree")]
+    lines.push(format!(
+        "Embree's instruction set: {}={} (one this CPU has; unset: the CPU's best)",
+        embree::ISA_ENV,
+        embree::Isa::ALL.map(embree::Isa::name).join("|")
+    ));
+    Ok(lines)
+}
+
+/// What Embree runs here (version, instruction set, packet widths), as `backends` says it;
+/// None in a build without Embree. For the bench's record of the machine.
+pub fn embree_summary() -> crate::Result<Option<String>> {
+    #[cfg(feature = "embree")]
+    return EmbreeBackend::new()
+        .configured_by_env()?
+        .describe()
+        .map(Some);
+    #[cfg(not(feature = "embree"))]
+    Ok(None)
+}
+
 /// The backend `render` uses when none is named: Embree where built, else the f64 BVH.
 pub fn default_backend_name() -> &'static str {
     backend_names()[0]
 }
 
-/// The Embree backend of that name: `embree` picks 16- or 8-wide packets from the CPU;
-/// `embree-16`, `embree-8` and `embree-single` fix the width, for comparisons.
+/// The Embree backend of that name: `embree` traces packets as wide as Embree traces natively
+/// on this CPU (16, 8 or 4); `embree-16`, `embree-8`, `embree-4` and `embree-single` fix the
+/// width, for comparisons.
 #[cfg(feature = "embree")]
 pub(crate) fn embree_backend(name: &str) -> Option<EmbreeBackend> {
     match name {
         "embree" => Some(EmbreeBackend::new()),
         "embree-16" => Some(EmbreeBackend::with_packet_width(16)),
         "embree-8" => Some(EmbreeBackend::with_packet_width(8)),
+        "embree-4" => Some(EmbreeBackend::with_packet_width(4)),
         "embree-single" => Some(EmbreeBackend::with_packet_width(1)),
         _ => None,
     }
 }
+
+/// The Embree backends of fixed packet width, for comparisons (`--backend` takes them too).
+pub const EMBREE_WIDTHS: [&str; 4] = ["embree-16", "embree-8", "embree-4", "embree-single"];
 
 /// The backend of that name, or an error that lists the choices.
 pub fn backend_by_name(name: &str) -> crate::Result<Box<dyn Backend>> {
@@ -217,17 +326,21 @@ pub fn backend_by_name(name: &str) -> crate::Result<Box<dyn Backend>> {
         "bvh" => Ok(Box::new(BvhBackend)),
         // The f64 BVH's tree with f32 nodes, for comparisons.
         "bvh-f32" => Ok(Box::new(Bvh32Backend)),
+        // The instruction set and test hook the environment asks for (`EmbreeBackend::configured_by_env`).
         #[cfg(feature = "embree")]
-        "embree" | "embree-16" | "embree-8" | "embree-single" => {
-            Ok(Box::new(embree_backend(name).expect("an Embree name")))
+        "embree" | "embree-16" | "embree-8" | "embree-4" | "embree-single" => {
+            match embree_backend(name) {
+                Some(b) => Ok(Box::new(b.configured_by_env()?)),
+                None => Err(crate::Error::backend(format!("unknown backend '{name}'"))),
+            }
         }
         #[cfg(not(feature = "embree"))]
-        "embree" | "embree-16" | "embree-8" | "embree-single" => Err(crate::Error::backend(
+        "embree" | "embree-16" | "embree-8" | "embree-4" | "embree-single" => Err(crate::Error::backend(
             "backend 'embree' is not in this build: rebuild with `--features embree` (needs libembree-dev and libclang-dev)",
         )),
         other => Err(crate::Error::backend(format!(
             "unknown backend '{other}' (choose one of: {})",
-            backend_names().join(", ")
+            all_backend_names().join(", ")
         ))),
     }
 }

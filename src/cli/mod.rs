@@ -30,7 +30,7 @@ pub(crate) enum Command {
     Render(RenderArgs),
     /// Measure each backend's speed and error on the same scenes (default: the paper's lattice).
     Bench(BenchArgs),
-    /// List the intersection backends of this build.
+    /// List the intersection backends of this build, and the instruction set Embree runs here.
     Backends,
     /// Join EXR tiles (from `render --tiles NxM --tile I`) into the EXR of the whole image.
     Assemble {
@@ -217,12 +217,11 @@ fn parse() -> Result<Cli, ExitCode> {
 
 fn run(cli: Cli) -> ExitCode {
     match cli.command {
-        Command::Backends => {
-            for (i, name) in accel::backend_names().iter().enumerate() {
-                println!("{name}{}", if i == 0 { " (default)" } else { "" });
+        Command::Backends => report(accel::backend_report().map(|lines| {
+            for line in lines {
+                println!("{line}");
             }
-            ExitCode::SUCCESS
-        }
+        })),
         Command::Render(args) => report(run_render(&args)),
         Command::Bench(args) => report(run_bench(&args)),
         Command::Assemble { output, tiles } => report(run_assemble(&output, &tiles)),
@@ -325,7 +324,16 @@ fn render_to_file(
             written
         }
     };
-    written?;
+    // A render that failed while its file was written (a fault the backend recorded) is
+    // reported as itself, naming the scene; the file was not written.
+    written.map_err(|e| match e.root() {
+        Error::Backend(m) => Error::backend(format!(
+            "rendering `{}` into `{}` failed: {m}; the file was not written",
+            args.scene.display(),
+            path.display()
+        )),
+        e => e,
+    })?;
     Ok(stats)
 }
 
@@ -530,12 +538,17 @@ fn run_bench(args: &BenchArgs) -> crate::Result<()> {
             accel::default_backend_name(),
         )?);
     }
+    // Which of Embree's code paths ran (its instruction set decides its packet width).
+    let embree = match accel::embree_summary()? {
+        Some(e) => format!(" Embree: {e}."),
+        None => String::new(),
+    };
     println!(
-        "threads: {}\n\n{table}\n{summary}",
+        "threads: {}.{embree}\n\n{table}\n{summary}",
         rayon::current_num_threads()
     );
     let md = format!(
-        "Measured with `rest-embree bench{}` on {} threads.\n\n{table}\n{summary}",
+        "Measured with `rest-embree bench{}` on {} threads.{embree}\n\n{table}\n{summary}",
         if args.quick { " --quick" } else { "" },
         rayon::current_num_threads()
     );

@@ -99,6 +99,7 @@ pub fn render(
     let build_time = t0.elapsed();
     let t1 = Instant::now();
     let (frame, mut stats) = render_world_passes(scene, &world, options.passes);
+    world.check()?;
     stats.build_time = build_time;
     stats.trace_time = t1.elapsed();
     Ok((frame, stats))
@@ -175,8 +176,9 @@ pub(crate) fn render_world_watched(
 
 /// Render the frame a strip of at least `min_pixels` pixels at a time (whole rows of tiles),
 /// top to bottom, handing each strip to `put`: a large image written as it is rendered never
-/// holds the whole frame. The strips hold the whole frame's pixels exactly.
-pub(crate) fn render_world_in_strips<E>(
+/// holds the whole frame. The strips hold the whole frame's pixels exactly. A strip the backend
+/// recorded a fault in (`World::check`) is not handed on: the render ends with the error.
+pub(crate) fn render_world_in_strips<E: From<crate::Error>>(
     scene: &Scene,
     world: &World,
     passes: Passes,
@@ -200,6 +202,7 @@ pub(crate) fn render_world_in_strips<E>(
     while y < h {
         let end = y.saturating_add(rows_per_strip).min(h);
         let s = rows.render_into(y..end, &mut strip);
+        world.check()?;
         put(&strip)?;
         stats.primary_rays += s.primary_rays;
         stats.nonfinite_pixels += s.nonfinite_pixels;

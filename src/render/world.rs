@@ -17,7 +17,7 @@ mod moving_bounds;
 mod rest_groups;
 pub use rest_groups::RestGroups;
 mod primary_hits;
-use crate::accel::{Accelerator, Backend, Hit, Ray};
+use crate::accel::{Accelerator, Backend, Faults, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, PACKET};
 use crate::scene::Scene;
 use crate::spacetime::{Boost, NullRay, Velocity};
@@ -177,6 +177,8 @@ pub struct World {
     /// accelerator: needed to skip groups and to keep f32 coordinates small when rays come from
     /// afar; pure cost for one group seen from close by, whose rays all start near it.
     clip_rays: bool,
+    /// Where the backend records what went wrong while tracing (`check`).
+    faults: Option<Arc<Faults>>,
 }
 
 /// The kinetic trees over the groups, made on first use: only rays that neither start at the
@@ -269,7 +271,14 @@ impl World {
             primary_tree,
             light_trees,
             clip_rays,
+            faults: backend.faults(),
         })
+    }
+
+    /// An error if the backend recorded a fault while tracing (Embree's callbacks cannot
+    /// return one): what was rendered since may be wrong.
+    pub fn check(&self) -> crate::Result<()> {
+        self.faults.as_ref().map_or(Ok(()), |f| f.check())
     }
 
     /// The trees over many groups: kinetic (built on first use), apparent boxes for primary

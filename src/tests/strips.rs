@@ -41,7 +41,7 @@ fn strips_hold_the_whole_frame() {
                         assert_eq!(b.width, w);
                         pixels.extend_from_slice(&b.pixels);
                         strips += 1;
-                        Ok::<(), ()>(())
+                        Ok::<(), crate::Error>(())
                     })
                 })
                 .unwrap();

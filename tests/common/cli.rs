@@ -103,11 +103,23 @@ pub fn with(line_from: &str, line_to: &str) -> String {
 
 /// The exit status of the command with these arguments, and its standard error.
 pub fn status(args: &[&str]) -> (Option<i32>, String) {
+    let (code, err, _) = status_with_env(args, &[]);
+    assert!(!err.contains("panicked"), "the command panicked: {err}");
+    (code, err)
+}
+
+/// The exit status (None: killed by a signal, an abort) of the command with these arguments
+/// and environment variables (the Embree backend's own, `REST_EMBREE_ISA` and
+/// `REST_EMBREE_FAULT`, only as given), its standard error and its standard output.
+pub fn status_with_env(args: &[&str], env: &[(&str, &str)]) -> (Option<i32>, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
         .args(args)
+        .env_remove("REST_EMBREE_ISA")
+        .env_remove("REST_EMBREE_FAULT")
+        .envs(env.iter().copied())
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!err.contains("panicked"), "the command panicked: {err}");
-    (out.status.code(), err)
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    (out.status.code(), err, stdout)
 }

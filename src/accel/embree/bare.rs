@@ -3,7 +3,7 @@
 //! cost of the relativistic layer is a ratio measured in the same run.
 
 use super::exact::Lanes;
-use super::packet::{flush_denormals, single};
+use super::packet::{flush_denormals, single, Query};
 use super::{EmbreeAccel, EmbreeRay};
 use embree_sys::*;
 use glam::DVec3;
@@ -30,7 +30,7 @@ impl EmbreeAccel {
         flush_denormals();
         // No f64 rays: user geometry tests Embree's own f32 rays.
         let lanes = Lanes::<16>::new(&[]);
-        let mut context = self.context(true, &[], &lanes);
+        let mut context = self.context(Query::Intersect, &[], &lanes);
         let ctx = context.raw();
         let mut hits = 0;
         let w = self.width.clamp(1, 16);
@@ -38,6 +38,7 @@ impl EmbreeAccel {
             hits += match w {
                 16 => self.bare16(chunk, ctx),
                 8 => self.bare8(chunk, ctx),
+                4 => self.bare4(chunk, ctx),
                 _ => chunk
                     .iter()
                     .map(|r| {
@@ -54,6 +55,7 @@ impl EmbreeAccel {
                     .sum(),
             };
         }
+        self.settle(&context);
         hits
     }
 }

@@ -15,6 +15,8 @@ use glam::DVec3;
 use std::sync::Arc;
 
 pub struct EmbreeCuller {
+    /// Where a fault in a callback is recorded (the device's).
+    device: Arc<Device>,
     /// None when there are no boxes. Released before the boxes, which it points into (fields
     /// drop in order).
     rtc: Option<CommittedScene>,
@@ -42,14 +44,20 @@ struct CullContext<'a> {
     len: [f64; PACKET],
     shift: [f64; PACKET],
     slack: f64,
+    /// Whether a callback panicked (caught: no panic may unwind into Embree) or met a ray
+    /// that is not one of the query's.
+    fault: Option<&'static str>,
+    /// The test hook of `EmbreeBackend::with_fault_injected` (`Device::injection`).
+    inject: Option<&'a std::sync::atomic::AtomicBool>,
 }
 
 /// Offer box `prim` to every valid lane that may meet it (lane_cull.rs); a lane whose tmax
-/// drops below its tmin is done.
+/// drops below its tmin is done. A lane's ray is the query's ray its id names (Embree may
+/// split and copy the packet before it calls back: exact.rs).
 ///
 /// # Safety
 /// `context` is a `CullContext` (every query of this culler passes one); `user` the culler's
-/// boxes; `ray` an N-wide SoA ray (RTCRayN layout: tfar is field 8) with `valid` of N entries.
+/// boxes; `ray` an N-wide SoA ray (RTCRayN layout) with `valid` of N entries.
 unsafe fn offer(
     context: *mut RTCIntersectContext,
     user: *mut std::ffi::c_void,
@@ -60,18 +68,42 @@ unsafe fn offer(
 ) {
     unsafe {
         let ctx = &mut *(context as *mut CullContext);
-        let boxes = &*(user as *const Shapes<Aabb>);
-        let (lo, hi) = boxes.0[prim as usize].bounds();
-        let lanes = ctx.tmax.len();
-        for i in lanes_near(valid, ray, n, lo, hi).filter(|&i| i < lanes) {
-            let before = ctx.tmax[i];
-            let t = (ctx.visit)(prim, i, before);
-            ctx.tmax[i] = t;
-            if t < ctx.tmin[i] {
-                *ray.add(field::TFAR * n + i) = f32::NEG_INFINITY;
-            } else if t < before {
-                *ray.add(field::TFAR * n + i) = (t * ctx.len[i] - ctx.shift[i] + ctx.slack) as f32;
+        let run = std::panic::AssertUnwindSafe(|| {
+            let once = |f: &std::sync::atomic::AtomicBool| {
+                f.swap(false, std::sync::atomic::Ordering::Relaxed)
+            };
+            if ctx.inject.is_some_and(once) {
+                panic!(
+                    "a fault injected into an Embree callback ({})",
+                    super::FAULT_ENV
+                );
             }
+            let boxes = &*(user as *const Shapes<Aabb>);
+            let Some(b) = boxes.0.get(prim as usize) else {
+                return;
+            };
+            let (lo, hi) = b.bounds();
+            for i in lanes_near(valid, ray, n, lo, hi) {
+                let r = *(ray.add(field::ID * n + i) as *const u32) as usize;
+                let (Some(&before), Some(&tmin)) = (ctx.tmax.get(r), ctx.tmin.get(r)) else {
+                    ctx.fault =
+                        Some("Embree called back with a ray that is not one of the query's");
+                    continue;
+                };
+                let t = (ctx.visit)(prim, r, before);
+                ctx.tmax[r] = t;
+                if t < tmin {
+                    *ray.add(field::TFAR * n + i) = f32::NEG_INFINITY;
+                } else if t < before {
+                    *ray.add(field::TFAR * n + i) =
+                        (t * ctx.len[r] - ctx.shift[r] + ctx.slack) as f32;
+                }
+            }
+        });
+        if std::panic::catch_unwind(run).is_err() {
+            ctx.fault = Some(
+                "a culling callback panicked while Embree traced rays (the panic was caught; its message is above)",
+            );
         }
     }
 }
@@ -147,6 +179,7 @@ impl EmbreeCuller {
             Some(builder.commit()?)
         };
         Ok(EmbreeCuller {
+            device,
             rtc,
             _boxes: boxes,
             center,
@@ -171,6 +204,11 @@ impl BoxCuller for EmbreeCuller {
         flush_denormals();
         let n = dirs.len().min(PACKET).min(tmax.len());
         let mut rh = RTCRayHit16::default();
+        // Lanes not traced are empty intervals as well as masked: where Embree splits a packet
+        // it does not use the mask (`packet::deactivate`).
+        rh.ray.tnear = [f32::INFINITY; 16];
+        rh.ray.tfar = [f32::NEG_INFINITY; 16];
+        rh.ray.id = std::array::from_fn(|i| i as u32);
         let mut valid = rtc::Valid([0i32; 16]);
         let o = o - self.center;
         let (mut lens, mut shifts) = ([1.0; PACKET], [0.0; PACKET]);
@@ -213,11 +251,16 @@ impl BoxCuller for EmbreeCuller {
             len: lens,
             shift: shifts,
             slack: self.slack,
+            fault: None,
+            inject: self.device.injection(),
         };
         ctx.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         let raw = (&mut ctx as *mut CullContext).cast::<RTCIntersectContext>();
         // SAFETY: a committed scene, a 64-byte aligned valid mask of 16, the context above
         // (which the callbacks read as a CullContext) outliving the call.
         unsafe { scene.intersect16(&valid, raw, &mut rh) };
+        if let Some(what) = ctx.fault {
+            self.device.faults.record(|| what.to_string());
+        }
     }
 }

@@ -15,6 +15,7 @@ use crate::geometry::{capsule_hit, cuboid_hit, Aabb};
 use embree_sys::*;
 use glam::DVec3;
 use std::cell::Cell;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::OnceLock;
 
 /// A primitive Embree traces as user geometry, relative to the Embree scene's centre.
@@ -86,6 +87,49 @@ pub(super) struct ExactContext<'a> {
     pullback: f64,
     /// The exact t of the closest user-geometry hit so far in each lane (starts at tmax).
     best: &'a [Cell<f64>],
+    /// What went wrong in a callback of this query, for the query to record (`Fault`).
+    fault: Cell<Fault>,
+    /// The test hook of `EmbreeBackend::with_fault_injected` (`Device::injection`).
+    inject: Option<&'a AtomicBool>,
+}
+
+/// What can go wrong inside a callback, where nothing can be returned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Fault {
+    None,
+    /// A panic, caught before it could unwind into Embree.
+    Panicked,
+    /// Embree called back with a ray whose id names no ray of the query.
+    StrayRay,
+}
+
+impl Fault {
+    /// What it means, for the render's error.
+    pub fn message(self) -> &'static str {
+        match self {
+            Fault::None => "no fault",
+            Fault::Panicked => "a user-geometry callback panicked while Embree traced rays (the panic was caught; its message is above)",
+            Fault::StrayRay => "Embree called back with a ray that is not one of the query's",
+        }
+    }
+}
+
+/// Run a callback's body: a panic is caught here, before it could unwind into Embree's C++
+/// (where it would abort the process), and recorded as the query's fault.
+#[inline(always)]
+pub(super) fn guarded(ctx: &ExactContext, body: impl FnOnce()) {
+    let run = || {
+        if ctx.inject.is_some_and(|f| f.swap(false, Ordering::Relaxed)) {
+            panic!(
+                "a fault injected into an Embree callback ({})",
+                super::FAULT_ENV
+            );
+        }
+        body()
+    };
+    if std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).is_err() {
+        ctx.fault.set(Fault::Panicked);
+    }
 }
 
 /// Per-lane storage of an `ExactContext` for up to N rays.
@@ -126,6 +170,7 @@ impl<'a> ExactContext<'a> {
         lanes: &'a Lanes<N>,
         center: DVec3,
         pullback: f64,
+        inject: Option<&'a AtomicBool>,
     ) -> Self {
         ExactContext {
             rtc: initial_context(coherent),
@@ -133,7 +178,14 @@ impl<'a> ExactContext<'a> {
             center,
             pullback,
             best: &lanes.best,
+            fault: Cell::new(Fault::None),
+            inject,
         }
+    }
+
+    /// What went wrong in this query's callbacks, if anything.
+    pub fn fault(&self) -> Fault {
+        self.fault.get()
     }
 
     /// The pointer Embree is given, and hands back to the callbacks: taken from the whole
@@ -147,28 +199,43 @@ impl<'a> ExactContext<'a> {
         self.rays.is_empty()
     }
 
-    /// The exact t of the user-geometry hit in `lane` (valid when Embree reports one there).
-    pub fn exact_t(&self, lane: usize) -> f64 {
-        self.best[lane].get()
+    /// The exact t of the user-geometry hit of the query's ray `i` (valid when Embree reports
+    /// one there).
+    pub fn exact_t(&self, i: usize) -> f64 {
+        self.best.get(i).map_or(f64::INFINITY, Cell::get)
     }
 }
 
 /// Field k of lane i of an N-wide SoA ray (`RTCRayN` / `RTCRayHitN`: 12 ray fields, then the
 /// hit's Ng_x, Ng_y, Ng_z, u, v, primID, geomID, instID, each N floats wide).
-use super::rtc::field::{DIR, ORG, TFAR, TNEAR};
+use super::rtc::field::{DIR, ID, ORG, TFAR, TNEAR};
 pub(super) const NG: usize = 12;
 pub(super) const U: usize = 15;
 pub(super) const PRIM_ID: usize = 17;
 pub(super) const GEOM_ID: usize = 18;
 pub(super) const INST_ID: usize = 19;
 
+/// Primitive `prim` of the shapes (None past their end, which Embree never asks for).
+///
 /// # Safety
-/// `user` is the pointer registered for a live `Shapes<S>`, `prim` below its length.
-unsafe fn shape<'r, S: Shape>(user: *mut std::ffi::c_void, prim: u32) -> &'r S {
+/// `user` is the pointer registered for a live `Shapes<S>`.
+unsafe fn shape<'r, S: Shape>(user: *mut std::ffi::c_void, prim: u32) -> Option<&'r S> {
     unsafe {
         let all: &'r Shapes<S> = &*(user as *const Shapes<S>);
-        &all.0[prim as usize]
+        all.0.get(prim as usize)
     }
+}
+
+/// Which of the query's rays lane i of an N-wide SoA ray is: the index the query put in the
+/// ray's id. Embree carries the id through whatever it does to a packet before it calls back
+/// (a packet of a width the CPU does not trace natively is split and copied, and streams are
+/// reordered), so the lane's position says nothing.
+///
+/// # Safety
+/// `base` points to an N-wide SoA ray with lane `i < n`.
+#[inline(always)]
+unsafe fn caller(base: *const f32, n: usize, i: usize) -> usize {
+    unsafe { *(base.add(ID * n + i) as *const u32) as usize }
 }
 
 /// Embree's f32 ray in lane i as f64: origin, direction, tnear, tfar.
@@ -185,14 +252,26 @@ unsafe fn read(base: *const f32, n: usize, i: usize) -> (DVec3, DVec3, f64, f64)
     )
 }
 
+/// Panic-free: no indexing, float arithmetic only.
 pub(super) unsafe extern "C" fn bounds<S: Shape>(args: *const RTCBoundsFunctionArguments) {
     // SAFETY: Embree passes the user pointer we registered (a live `Shapes<S>`) and a prim
     // index below the primitive count we set.
     unsafe {
         let args = &*args;
-        let (lo, hi) = shape::<S>(args.geometryUserPtr, args.primID).bounds();
-        *args.bounds_o = outward(lo, hi);
+        *args.bounds_o = match shape::<S>(args.geometryUserPtr, args.primID) {
+            Some(s) => {
+                let (lo, hi) = s.bounds();
+                outward(lo, hi)
+            }
+            // Never asked for; a box of everything loses nothing.
+            None => everything(),
+        };
     }
+}
+
+/// The f32 box of all space.
+pub(super) fn everything() -> RTCBounds {
+    outward(DVec3::splat(-1e30), DVec3::splat(1e30))
 }
 
 /// The f32 box holding the f64 box (lo, hi): rounded outward.
@@ -258,9 +337,9 @@ pub(super) unsafe fn lane_hits_within<S: Shape>(
     // The lanes through the primitive's several-ray test, then what it left undecided through
     // the scalar one.
     let mut rays = LaneRays::new();
-    rays.gather(near.map(|i| {
-        let (o, d, tmin, tmax) = unsafe { lane_ray(ctx, base, n, i) };
-        (i, o, d, tmin, tmax)
+    rays.gather(near.filter_map(|i| {
+        let (_, o, d, tmin, tmax) = unsafe { lane_ray(ctx, base, n, i) }?;
+        Some((i, o, d, tmin, tmax))
     }));
     let mut answers = [0.0; MAX];
     prim.hits(&rays, &mut answers);
@@ -271,23 +350,27 @@ pub(super) unsafe fn lane_hits_within<S: Shape>(
         } else {
             (answer < f64::INFINITY).then_some(answer)
         };
-        if let Some(te) = t.and_then(|t| unsafe { embree_t(ctx, base, n, i, t, tmin, tmax) }) {
+        let r = unsafe { ray_of(ctx, base, n, i) };
+        if let Some(te) = t.and_then(|t| unsafe { embree_t(ctx, base, n, i, r, t, tmin, tmax) }) {
             found(i, te);
         }
     }
 }
 
-/// Embree's t for an exact hit t of lane i, if it is closer than Embree's tfar (for the caller's
-/// rays, also recorded as the lane's exact best); bare rays' hits clamped to (tnear, tfar).
+/// Embree's t for an exact hit t of lane i, the query's ray r, if it is closer than Embree's
+/// tfar (for the caller's rays, also recorded as the ray's exact best); bare rays' hits
+/// clamped to (tnear, tfar).
 ///
 /// # Safety
 /// As for `lane_hits`, lane `i < n`.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 unsafe fn embree_t(
     ctx: &ExactContext,
     base: *const f32,
     n: usize,
     i: usize,
+    r: usize,
     t: f64,
     tmin: f64,
     tmax: f64,
@@ -295,11 +378,12 @@ unsafe fn embree_t(
     if ctx.rays.is_empty() {
         return Some((t as f32).clamp(tmin as f32, tmax as f32));
     }
-    let te = (t * scale(ctx.rays[i].len) + ctx.pullback) as f32;
+    let (ray, best) = (ctx.rays.get(r)?, ctx.best.get(r)?);
+    let te = (t * scale(ray.len) + ctx.pullback) as f32;
     // Embree's tfar may have been lowered by one of its own primitives.
     let tfar = unsafe { *base.add(TFAR * n + i) };
     (te <= tfar).then(|| {
-        ctx.best[i].set(t);
+        best.set(t);
         te
     })
 }
@@ -316,13 +400,28 @@ unsafe fn lane_hit<S: Shape>(
     n: usize,
     i: usize,
 ) -> Option<f32> {
-    let (o, d, tmin, tmax) = unsafe { lane_ray(ctx, base, n, i) };
+    let (r, o, d, tmin, tmax) = unsafe { lane_ray(ctx, base, n, i) }?;
     let t = prim.hit(o, d, tmin, tmax)?;
-    unsafe { embree_t(ctx, base, n, i, t, tmin, tmax) }
+    unsafe { embree_t(ctx, base, n, i, r, t, tmin, tmax) }
 }
 
-/// Lane i's ray to test, relative to the Embree scene's centre: the caller's f64 ray, with the
-/// lane's exact best as its end; for bare rays Embree's f32 one (origin, direction, tmin, tmax).
+/// Which of the query's rays lane i is (`caller`); for bare rays, which have none, the lane.
+///
+/// # Safety
+/// As for `lane_hits`, lane `i < n`.
+#[inline(always)]
+unsafe fn ray_of(ctx: &ExactContext, base: *const f32, n: usize, i: usize) -> usize {
+    if ctx.rays.is_empty() {
+        i
+    } else {
+        unsafe { caller(base, n, i) }
+    }
+}
+
+/// Lane i's ray to test, relative to the Embree scene's centre: which of the query's rays it
+/// is, and that f64 ray, with its exact best as its end; for bare rays Embree's f32 one
+/// (origin, direction, tmin, tmax). None, with the fault recorded, if the lane's id names no
+/// ray of the query.
 ///
 /// # Safety
 /// As for `lane_hits`, lane `i < n`.
@@ -332,10 +431,20 @@ unsafe fn lane_ray(
     base: *const f32,
     n: usize,
     i: usize,
-) -> (DVec3, DVec3, f64, f64) {
-    match ctx.rays.get(i) {
-        Some(r) => (r.origin - ctx.center, r.dir, r.tmin, ctx.best[i].get()),
-        None => unsafe { read(base, n, i) },
+) -> Option<(usize, DVec3, DVec3, f64, f64)> {
+    if ctx.rays.is_empty() {
+        let (o, d, tmin, tmax) = unsafe { read(base, n, i) };
+        return Some((i, o, d, tmin, tmax));
+    }
+    let r = unsafe { caller(base, n, i) };
+    match (ctx.rays.get(r), ctx.best.get(r)) {
+        (Some(ray), Some(best)) => {
+            Some((r, ray.origin - ctx.center, ray.dir, ray.tmin, best.get()))
+        }
+        _ => {
+            ctx.fault.set(Fault::StrayRay);
+            None
+        }
     }
 }
 
@@ -344,23 +453,46 @@ pub(super) unsafe extern "C" fn intersect<S: Shape>(args: *const RTCIntersectFun
     // `context` is the ExactContext the query was started with.
     unsafe {
         let args = &*args;
-        let prim = shape::<S>(args.geometryUserPtr, args.primID);
         let ctx = &*(args.context as *const ExactContext);
-        let n = args.N as usize;
-        let base = args.rayhit as *mut f32;
-        let inst = (*args.context).instID[0];
-        lane_hits(ctx, prim, args.valid, base, n, |i, t| {
-            let slot = |k: usize| base.add(k * n + i);
-            *slot(TFAR) = t;
-            *slot(NG) = 0.0;
-            *slot(NG + 1) = 0.0;
-            *slot(NG + 2) = 1.0;
-            *slot(U) = 0.0;
-            *slot(U + 1) = 0.0;
-            *(slot(PRIM_ID) as *mut u32) = args.primID;
-            *(slot(GEOM_ID) as *mut u32) = args.geomID;
-            *(slot(INST_ID) as *mut u32) = inst;
+        guarded(ctx, || {
+            let Some(prim) = shape::<S>(args.geometryUserPtr, args.primID) else {
+                return;
+            };
+            let n = args.N as usize;
+            let base = args.rayhit as *mut f32;
+            let inst = (*args.context).instID[0];
+            lane_hits(ctx, prim, args.valid, base, n, |i, t| {
+                report_hit(base, n, i, t, args.primID, args.geomID, inst)
+            });
         });
+    }
+}
+
+/// Write a hit into lane i of an N-wide SoA ray hit.
+///
+/// # Safety
+/// `base` points to an N-wide `RTCRayHitN`, lane `i < n`.
+#[inline(always)]
+pub(super) unsafe fn report_hit(
+    base: *mut f32,
+    n: usize,
+    i: usize,
+    t: f32,
+    prim: u32,
+    geom: u32,
+    inst: u32,
+) {
+    unsafe {
+        let slot = |k: usize| base.add(k * n + i);
+        *slot(TFAR) = t;
+        *slot(NG) = 0.0;
+        *slot(NG + 1) = 0.0;
+        *slot(NG + 2) = 1.0;
+        *slot(U) = 0.0;
+        *slot(U + 1) = 0.0;
+        *(slot(PRIM_ID) as *mut u32) = prim;
+        *(slot(GEOM_ID) as *mut u32) = geom;
+        *(slot(INST_ID) as *mut u32) = inst;
     }
 }
 
@@ -368,12 +500,16 @@ pub(super) unsafe extern "C" fn occluded<S: Shape>(args: *const RTCOccludedFunct
     // SAFETY: as for `intersect`, with an N-wide RTCRayN.
     unsafe {
         let args = &*args;
-        let prim = shape::<S>(args.geometryUserPtr, args.primID);
         let ctx = &*(args.context as *const ExactContext);
-        let n = args.N as usize;
-        let base = args.ray as *mut f32;
-        lane_hits(ctx, prim, args.valid, base, n, |i, _| {
-            *base.add(TFAR * n + i) = f32::NEG_INFINITY;
+        guarded(ctx, || {
+            let Some(prim) = shape::<S>(args.geometryUserPtr, args.primID) else {
+                return;
+            };
+            let n = args.N as usize;
+            let base = args.ray as *mut f32;
+            lane_hits(ctx, prim, args.valid, base, n, |i, _| {
+                *base.add(TFAR * n + i) = f32::NEG_INFINITY;
+            });
         });
     }
 }

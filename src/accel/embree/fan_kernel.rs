@@ -14,7 +14,7 @@
 
 use super::exact::Lanes;
 use super::f64x4::F4;
-use super::packet::{flush_denormals, Reused, Valid};
+use super::packet::{deactivate_from, flush_denormals, Query, Reused, Valid};
 use super::{lane_geometry, scale, EmbreeAccel, MAX_UNNORMALISED};
 use crate::accel::{Fan, FanHits, Ray, NO_HIT};
 use crate::geometry::Real;
@@ -129,10 +129,12 @@ macro_rules! fan_packet {
                         rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                         valid.0[i] = -1;
                     }
-                    let mut ctx = self.context(true, &rays[..n], &lanes);
+                    deactivate_from(&mut rh.ray, n);
+                    let mut ctx = self.context(Query::Intersect, &rays[..n], &lanes);
                     // SAFETY: an N-wide packet with its valid mask (64-byte aligned), the scene and
                     // the context its user geometry expects.
                     unsafe { self.scene.rtc.$isect_q(&valid, ctx.raw(), rh) };
+                    self.settle(&ctx);
                     if let Some(runs) = self.scene.exact_runs {
                         // Every hit exact, so as `to_hit` reads it (the callbacks record only
                         // a t in the rays' lookback (0, ∞)), but with no lookup and no branch on

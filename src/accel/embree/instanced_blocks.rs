@@ -7,7 +7,7 @@
 //! a block's members the object does not have (past its far faces) are skipped.
 
 use super::exact::{
-    lane_hits_within, outward, ExactContext, Round, Shape, GEOM_ID, INST_ID, NG, PRIM_ID, U,
+    everything, guarded, lane_hits_within, outward, report_hit, ExactContext, Round, Shape,
 };
 use super::rtc::field::TFAR;
 use super::rtc::{CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
@@ -79,7 +79,7 @@ impl BlockShapes {
         let (first, translation) = *self
             .instances
             .get(inst.wrapping_sub(self.first_instance) as usize)?;
-        let (m, cull) = self.members[p as usize];
+        let (m, cull) = *self.members.get(p as usize)?;
         let n = self.blocks.place(self.shape.grid(), first, m)?;
         let shift = if bare {
             self.center + DVec3::from_array(translation.map(f64::from))
@@ -196,12 +196,19 @@ unsafe fn shapes<'r>(user: *mut std::ffi::c_void) -> &'r BlockShapes {
     unsafe { &*(user as *const BlockShapes) }
 }
 
+/// Panic-free: no indexing, float arithmetic only.
 unsafe extern "C" fn block_bounds(args: *const RTCBoundsFunctionArguments) {
     // SAFETY: Embree passes the user pointer we registered and a prim below the count we set.
     unsafe {
         let args = &*args;
-        let (lo, hi) = shapes(args.geometryUserPtr).members[args.primID as usize].1;
-        *args.bounds_o = outward(lo, hi);
+        let member = shapes(args.geometryUserPtr)
+            .members
+            .get(args.primID as usize);
+        *args.bounds_o = match member {
+            Some(&(_, (lo, hi))) => outward(lo, hi),
+            // Never asked for; a box of everything loses nothing.
+            None => everything(),
+        };
     }
 }
 
@@ -212,28 +219,21 @@ unsafe extern "C" fn block_intersect<S: FromPrimitive>(
     // and `context` is the ExactContext the query was started with, inside an instance.
     unsafe {
         let args = &*args;
-        let s = shapes(args.geometryUserPtr);
         let ctx = &*(args.context as *const ExactContext);
-        let inst = (*args.context).instID[0];
-        let Some(c) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
-            return;
-        };
-        // Numbered only if some lane hits (most calls find none).
-        let mut id = None;
-        let n = args.N as usize;
-        let base = args.rayhit as *mut f32;
-        lane_hits_within(ctx, &c.shape, c.cull, args.valid, base, n, |i, t| {
-            let slot = |k: usize| base.add(k * n + i);
-            *slot(TFAR) = t;
-            *slot(NG) = 0.0;
-            *slot(NG + 1) = 0.0;
-            *slot(NG + 2) = 1.0;
-            *slot(U) = 0.0;
-            *slot(U + 1) = 0.0;
-            let id = *id.get_or_insert_with(|| s.shape.member_id(c.node, c.member));
-            *(slot(PRIM_ID) as *mut u32) = id as u32;
-            *(slot(GEOM_ID) as *mut u32) = s.slot;
-            *(slot(INST_ID) as *mut u32) = inst;
+        guarded(ctx, || {
+            let s = shapes(args.geometryUserPtr);
+            let inst = (*args.context).instID[0];
+            let Some(c) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
+                return;
+            };
+            // Numbered only if some lane hits (most calls find none).
+            let mut id = None;
+            let n = args.N as usize;
+            let base = args.rayhit as *mut f32;
+            lane_hits_within(ctx, &c.shape, c.cull, args.valid, base, n, |i, t| {
+                let id = *id.get_or_insert_with(|| s.shape.member_id(c.node, c.member));
+                report_hit(base, n, i, t, id as u32, s.slot, inst);
+            });
         });
     }
 }
@@ -242,16 +242,18 @@ unsafe extern "C" fn block_occluded<S: FromPrimitive>(args: *const RTCOccludedFu
     // SAFETY: as for `block_intersect`, with an N-wide RTCRayN.
     unsafe {
         let args = &*args;
-        let s = shapes(args.geometryUserPtr);
         let ctx = &*(args.context as *const ExactContext);
-        let inst = (*args.context).instID[0];
-        let Some(c) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
-            return;
-        };
-        let n = args.N as usize;
-        let base = args.ray as *mut f32;
-        lane_hits_within(ctx, &c.shape, c.cull, args.valid, base, n, |i, _| {
-            *base.add(TFAR * n + i) = f32::NEG_INFINITY;
+        guarded(ctx, || {
+            let s = shapes(args.geometryUserPtr);
+            let inst = (*args.context).instID[0];
+            let Some(c) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
+                return;
+            };
+            let n = args.N as usize;
+            let base = args.ray as *mut f32;
+            lane_hits_within(ctx, &c.shape, c.cull, args.valid, base, n, |i, _| {
+                *base.add(TFAR * n + i) = f32::NEG_INFINITY;
+            });
         });
     }
 }

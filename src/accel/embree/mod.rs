@@ -18,6 +18,7 @@ mod f64x4;
 #[cfg(target_arch = "x86_64")]
 mod fan_kernel;
 mod instanced_blocks;
+mod isa;
 mod lane_cull;
 mod lane_hits;
 mod packet;
@@ -25,31 +26,85 @@ mod rtc;
 mod scene;
 
 pub use bare::BareRay;
+pub use isa::{Isa, ENV as ISA_ENV};
 
-use super::{Accelerator, Backend, BoxCuller, CullerFactory, Fan, FanHits, Hit, Ray};
+use super::{Accelerator, Backend, BoxCuller, CullerFactory, Fan, FanHits, Faults, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, Real};
 use rtc::Device;
 use std::sync::{Arc, OnceLock};
 
 pub struct EmbreeBackend {
     device: OnceLock<crate::Result<Arc<Device>>>,
-    /// Packet width for batches: None picks 16 or 8 from the CPU; 1 sends single rays.
+    /// Packet width for batches: None, the widest Embree traces natively here (16, 8 or 4);
+    /// 1 sends single rays.
     packet_width: Option<usize>,
+    /// The instruction set Embree is to run; None, Embree's choice (the CPU's best).
+    isa: Option<Isa>,
+    /// What went wrong in a callback while tracing.
+    faults: Arc<Faults>,
+    /// A test hook: a user-geometry callback panics (`REST_EMBREE_FAULT=callback`), to prove
+    /// that the panic is caught at the FFI boundary and the render fails with an error.
+    inject_fault: bool,
 }
+
+/// The environment variable of the fault-injection test hook (`EmbreeBackend::configured_by_env`).
+pub const FAULT_ENV: &str = "REST_EMBREE_FAULT";
 
 impl EmbreeBackend {
     pub fn new() -> Self {
         Self {
             device: OnceLock::new(),
             packet_width: None,
+            isa: None,
+            faults: Arc::default(),
+            inject_fault: false,
         }
     }
 
-    /// A backend that always uses this packet width (16, 8, or 1 for single rays).
+    /// A backend that always uses this packet width (16, 8, 4, or 1 for single rays: any
+    /// other width is taken as 1).
     pub fn with_packet_width(width: usize) -> Self {
         Self {
-            device: OnceLock::new(),
-            packet_width: Some(width),
+            packet_width: Some(if matches!(width, 4 | 8 | 16) {
+                width
+            } else {
+                1
+            }),
+            ..Self::new()
+        }
+    }
+
+    /// The same backend running Embree's code path for `isa` (checked: the CPU has it).
+    pub fn on_isa(self, isa: Isa) -> crate::Result<Self> {
+        Ok(Self {
+            isa: Some(isa.checked()?),
+            ..self
+        })
+    }
+
+    /// The same backend with a panic in the first user-geometry callback that runs (a test of
+    /// the FFI boundary).
+    pub fn with_fault_injected(self) -> Self {
+        Self {
+            inject_fault: true,
+            ..self
+        }
+    }
+
+    /// The backend as the environment asks: `REST_EMBREE_ISA` (isa.rs) and the test hook
+    /// `REST_EMBREE_FAULT=callback`.
+    pub fn configured_by_env(self) -> crate::Result<Self> {
+        let backend = match Isa::from_env()? {
+            Some(isa) => self.on_isa(isa)?,
+            None => self,
+        };
+        match std::env::var(FAULT_ENV).ok().as_deref() {
+            None | Some("") => Ok(backend),
+            Some("callback") => Ok(backend.with_fault_injected()),
+            Some(other) => Err(crate::Error::flag(
+                FAULT_ENV,
+                format!("{other:?} is not a fault this test hook knows (choose: callback)"),
+            )),
         }
     }
 
@@ -57,8 +112,8 @@ impl EmbreeBackend {
     /// callers that trace it more ways than the trait's).
     pub fn accelerator(&self, geometry: Arc<Geometry>) -> crate::Result<EmbreeAccel> {
         let device = self.device()?;
-        let width = self.packet_width.unwrap_or(device.packet_width);
-        let scene = scene::EmbreeScene::build(device, &geometry)?;
+        let width = self.packet_width.unwrap_or(device.native_width());
+        let scene = scene::EmbreeScene::build(device.clone(), &geometry)?;
         let diag = geometry.bounds().diagonal();
         Ok(EmbreeAccel {
             scene,
@@ -67,14 +122,61 @@ impl EmbreeBackend {
             // How far a ray's origin is pulled back before the f32 cast, so geometry flush with
             // the bounds (where the renderer put the origin) is not lost to f32 rounding.
             pullback: 1e-4 * diag.max(1e-6),
+            device,
         })
     }
 
-    fn device(&self) -> crate::Result<Arc<Device>> {
+    /// The Embree device, made on first use: the instruction set it runs and its native
+    /// packet widths (`rest-embree backends` prints them).
+    pub fn device(&self) -> crate::Result<Arc<Device>> {
         // Embree's build threads follow the render's (--threads sets rayon's global pool).
         self.device
-            .get_or_init(|| Device::new(rayon::current_num_threads()).map(Arc::new))
+            .get_or_init(|| {
+                let threads = rayon::current_num_threads();
+                let device = Device::new(threads, self.isa, self.faults.clone())?;
+                device
+                    .inject_fault
+                    .store(self.inject_fault, std::sync::atomic::Ordering::Relaxed);
+                Ok(Arc::new(device))
+            })
             .clone()
+    }
+
+    /// The packet width this backend traces batches with (`device` for the native ones).
+    pub fn packet_width(&self) -> crate::Result<usize> {
+        Ok(match self.packet_width {
+            Some(w) => w,
+            None => self.device()?.native_width(),
+        })
+    }
+
+    /// What `rest-embree backends` says of it: Embree's version, the instruction set it runs
+    /// (of those the CPU has), the packet widths it traces natively and the one this backend
+    /// traces with.
+    pub fn describe(&self) -> crate::Result<String> {
+        let device = self.device()?;
+        let widths: Vec<String> = [4, 8, 16]
+            .iter()
+            .zip(device.native)
+            .filter(|(_, native)| *native)
+            .map(|(w, _)| w.to_string())
+            .collect();
+        let on_cpu: Vec<&str> = Isa::on_cpu().into_iter().map(Isa::name).collect();
+        let how = match self.isa {
+            Some(_) => format!("as {} asks", isa::ENV),
+            None => "the CPU's best".to_string(),
+        };
+        let width = match self.packet_width()? {
+            1 => "single rays".to_string(),
+            w => format!("packets of {w}"),
+        };
+        Ok(format!(
+            "Intel Embree {}, instruction set {} ({how}; this CPU has {}), native packets of {}; traces {width}",
+            device.version(),
+            device.isa.name(),
+            on_cpu.join(", "),
+            if widths.is_empty() { "none".to_string() } else { widths.join(", ") },
+        ))
     }
 }
 
@@ -100,6 +202,10 @@ impl Backend for EmbreeBackend {
     fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>> {
         Ok(Box::new(self.accelerator(geometry)?))
     }
+
+    fn faults(&self) -> Option<Arc<Faults>> {
+        Some(self.faults.clone())
+    }
 }
 
 pub struct EmbreeAccel {
@@ -107,6 +213,8 @@ pub struct EmbreeAccel {
     geometry: Arc<Geometry>,
     width: usize,
     pullback: f64,
+    /// Where faults in callbacks are recorded (and whether to inject one).
+    device: Arc<Device>,
 }
 
 /// A ray as Embree sees it: f32, relative to the scene centre, unit direction.
@@ -222,10 +330,10 @@ impl Accelerator for EmbreeAccel {
             return;
         }
         for (rs, hs) in rays.chunks(self.width).zip(hits.chunks_mut(self.width)) {
-            if self.width == 16 {
-                self.intersect16(rs, hs);
-            } else {
-                self.intersect8(rs, hs);
+            match self.width {
+                16 => self.intersect16(rs, hs),
+                8 => self.intersect8(rs, hs),
+                _ => self.intersect4(rs, hs),
             }
         }
     }
@@ -239,10 +347,10 @@ impl Accelerator for EmbreeAccel {
             return;
         }
         for (rs, os) in rays.chunks(self.width).zip(out.chunks_mut(self.width)) {
-            if self.width == 16 {
-                self.occluded16(rs, os);
-            } else {
-                self.occluded8(rs, os);
+            match self.width {
+                16 => self.occluded16(rs, os),
+                8 => self.occluded8(rs, os),
+                _ => self.occluded4(rs, os),
             }
         }
     }

@@ -1,6 +1,6 @@
 //! Ray packets and single rays through Embree's C API.
 
-use super::exact::{ExactContext, Lanes};
+use super::exact::{ExactContext, Fault, Lanes};
 use super::{BareRay, EmbreeAccel, EmbreeRay};
 use crate::accel::{Hit, Ray};
 use embree_sys::*;
@@ -30,12 +30,13 @@ pub(super) fn flush_denormals() {
 
 /// A thread's Embree packet of each kind, kept and reused: made per packet, a 16-wide
 /// `RTCRayHit16` is 1.28 kB zeroed before its rays are written over half of it. The fields
-/// every query here gives the same value (a ray's time 0, mask all ones, flags and id 0; a
-/// hit's instID none) are set when the packet is made, and nothing changes them but a hit's
+/// every query here gives the same value (a ray's time 0, mask all ones, flags 0, id its lane,
+/// by which the callbacks find the query's ray; a hit's instID none) are set when the packet
+/// is made, and nothing changes them but a hit's
 /// instID, which the instanced blocks' callbacks write (instanced_blocks.rs) and nothing reads:
 /// the hits' read-back goes by geomID and primID alone; each query writes the rest that Embree reads
 /// in the lanes it marks valid: a ray's origin, tnear, direction and tfar (`Lane::set`, or the
-/// fans' kernel) and a hit's geomID. The rest of a hit Embree writes where it
+/// fans' kernel) and a hit's geomID; in the others an empty interval (`Lane::deactivate`). The rest of a hit Embree writes where it
 /// reports one. Embree's callbacks start no query, so a packet is never in use twice on one
 /// thread.
 pub(super) trait Reused: Sized {
@@ -69,6 +70,7 @@ macro_rules! packet_fns {
                         fill_lane(&mut rh.ray, i, &r.lane(), &mut valid.0);
                         rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                     }
+                    deactivate_from(&mut rh.ray, rays.len());
                     unsafe { self.scene.rtc.$isect_q(&valid, ctx, rh) };
                     (0..rays.len())
                         .filter(|&i| rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
@@ -85,8 +87,10 @@ macro_rules! packet_fns {
                         fill_lane(&mut rh.ray, i, &e, &mut valid.0);
                         rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                     }
-                    let mut ctx = self.context(true, rays, &lanes);
+                    deactivate_from(&mut rh.ray, rays.len());
+                    let mut ctx = self.context(Query::Intersect, rays, &lanes);
                     unsafe { self.scene.rtc.$isect_q(&valid, ctx.raw(), rh) };
+                    self.settle(&ctx);
                     if let Some(runs) = self.scene.exact_runs {
                         // As the fans read hits back (`ExactRuns`): every hit exact, within the
                         // ray's (tmin, tmax), its primitive with no lookup.
@@ -130,8 +134,10 @@ macro_rules! packet_fns {
                         let e = self.embree_ray(r);
                         fill_lane(ray, i, &e, &mut valid.0);
                     }
-                    let mut ctx = self.context(true, rays, &lanes);
+                    deactivate_from(ray, rays.len());
+                    let mut ctx = self.context(Query::Occluded, rays, &lanes);
                     unsafe { self.scene.rtc.$occl_q(&valid, ctx.raw(), ray) };
+                    self.settle(&ctx);
                     for i in 0..rays.len() {
                         out[i] = valid.0[i] != 0 && ray.tfar[i] == f32::NEG_INFINITY;
                     }
@@ -144,6 +150,7 @@ macro_rules! packet_fns {
             $RayN,
             $RayN {
                 mask: [u32::MAX; $n],
+                id: std::array::from_fn(|i| i as u32),
                 ..Default::default()
             }
         );
@@ -152,6 +159,7 @@ macro_rules! packet_fns {
             $RayHitN {
                 ray: $RayN {
                     mask: [u32::MAX; $n],
+                    id: std::array::from_fn(|i| i as u32),
                     ..Default::default()
                 },
                 hit: $HitN {
@@ -172,6 +180,15 @@ macro_rules! packet_fns {
                 self.tnear[i] = e.tnear;
                 self.tfar[i] = e.tfar;
             }
+
+            fn deactivate(&mut self, i: usize) {
+                self.tnear[i] = f32::INFINITY;
+                self.tfar[i] = f32::NEG_INFINITY;
+            }
+
+            fn width(&self) -> usize {
+                $n
+            }
         }
     };
 }
@@ -181,15 +198,32 @@ macro_rules! packet_fns {
 pub(super) use super::rtc::Valid;
 
 pub(super) trait Lane {
+    /// Lane i traces `e`.
     fn set(&mut self, i: usize, e: &EmbreeRay);
+    /// Lane i traces nothing: its interval is empty (tnear +∞, tfar −∞). The valid mask alone
+    /// does not do: where Embree does not trace a packet's width natively it splits the packet
+    /// and takes a lane as valid by its interval, not the mask (Embree 3's
+    /// `RayStreamFilter::filterSOA`), and a reused packet's idle lanes hold old rays.
+    fn deactivate(&mut self, i: usize);
+    /// The packet's width.
+    fn width(&self) -> usize;
 }
 
 /// Put a ray in lane i; inactive rays (masked by the caller, e.g. missing the group's bounds)
-/// stay out of the valid mask.
+/// stay out of the valid mask and get an empty interval.
 pub(super) fn fill_lane<R: Lane>(ray: &mut R, i: usize, e: &EmbreeRay, valid: &mut [i32]) {
     if e.active {
         ray.set(i, e);
         valid[i] = -1;
+    } else {
+        ray.deactivate(i);
+    }
+}
+
+/// Lanes `first..` of the packet trace nothing (`Lane::deactivate`).
+pub(super) fn deactivate_from<R: Lane>(ray: &mut R, first: usize) {
+    for i in first..ray.width() {
+        ray.deactivate(i);
     }
 }
 
@@ -205,6 +239,7 @@ packet_fns!(
     occluded16
 );
 packet_fns!(8, intersect8, occluded8, bare8, RTCRayHit8, RTCRay8, RTCHit8, intersect8, occluded8);
+packet_fns!(4, intersect4, occluded4, bare4, RTCRayHit4, RTCRay4, RTCHit4, intersect4, occluded4);
 
 pub(super) fn single(e: &EmbreeRay) -> RTCRay {
     RTCRay {
@@ -223,20 +258,55 @@ pub(super) fn single(e: &EmbreeRay) -> RTCRay {
     }
 }
 
+/// Which query a context is for, and how it is traced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Query {
+    /// Closest hits of a packet (coherent).
+    Intersect,
+    /// Occlusion of a packet (coherent, but for scenes with instances).
+    Occluded,
+    /// One ray, or bare rays (incoherent).
+    Single,
+}
+
 impl EmbreeAccel {
     /// The context for a query of these rays (lanes in order), as user geometry needs it.
     pub(super) fn context<'a, const N: usize>(
-        &self,
-        coherent: bool,
+        &'a self,
+        query: Query,
         rays: &'a [Ray],
         lanes: &'a Lanes<N>,
     ) -> ExactContext<'a> {
-        // Embree 3.13's coherent packet traversal can fail to return from an occlusion query
-        // into instances once a coherent closest-hit query has run on the thread (found on
-        // the instanced lattice: the call spun in Embree's traversal); scenes with instances
-        // trace their packets as incoherent.
-        let coherent = coherent && self.scene.coherent_packets;
-        ExactContext::new(coherent, rays, lanes, self.scene.center, self.pullback)
+        // Packets go to Embree's coherent traversal, but occlusion queries into instances:
+        // with AVX-512, Embree 3.13.5's coherent 16-wide occlusion query into a scene of
+        // instances does not return for some packets (the paper's lattice grown to 30^3 nodes
+        // and instanced, rendered at 32^2: the thread spins inside rtcOccluded16, in Embree's
+        // own traversal, with no callback of ours on the stack), while 8- and 4-wide ones,
+        // the same query incoherent and coherent closest-hit queries into the same scene all
+        // return. It is not the lane bookkeeping (16 lanes are native there: no split).
+        let coherent = match query {
+            Query::Intersect => true,
+            Query::Occluded => self.scene.coherent_occlusion,
+            Query::Single => false,
+        };
+        let inject = self.device.injection();
+        ExactContext::new(
+            coherent,
+            rays,
+            lanes,
+            self.scene.center,
+            self.pullback,
+            inject,
+        )
+    }
+
+    /// Record what went wrong in the query's callbacks, if anything, for the render to report.
+    #[inline(always)]
+    pub(super) fn settle(&self, ctx: &ExactContext) {
+        let fault = ctx.fault();
+        if fault != Fault::None {
+            self.device.faults.record(|| fault.message().to_string());
+        }
     }
 
     pub(super) fn intersect1(&self, r: &Ray) -> Option<Hit> {
@@ -253,8 +323,9 @@ impl EmbreeAccel {
         };
         let rays = std::slice::from_ref(r);
         let lanes = Lanes::<1>::new(rays);
-        let mut ctx = self.context(false, rays, &lanes);
+        let mut ctx = self.context(Query::Single, rays, &lanes);
         unsafe { self.scene.rtc.intersect1(ctx.raw(), &mut rh) };
+        self.settle(&ctx);
         if rh.hit.geomID == RTC_INVALID_GEOMETRY_ID {
             return None;
         }
@@ -269,8 +340,9 @@ impl EmbreeAccel {
         let mut ray = single(&e);
         let rays = std::slice::from_ref(r);
         let lanes = Lanes::<1>::new(rays);
-        let mut ctx = self.context(false, rays, &lanes);
+        let mut ctx = self.context(Query::Single, rays, &lanes);
         unsafe { self.scene.rtc.occluded1(ctx.raw(), &mut ray) };
+        self.settle(&ctx);
         ray.tfar == f32::NEG_INFINITY
     }
 }

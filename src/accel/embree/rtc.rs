@@ -8,9 +8,12 @@
 //!   gives a [`CommittedScene`], the only kind that is shared between threads and traced.
 //! - [`field`]: where Embree's SoA rays keep each field, for the user-geometry callbacks.
 
+use super::isa::Isa;
+use crate::accel::Faults;
 use crate::{Error, Result};
 use embree_sys::*;
 use std::ffi::{c_char, c_void, CStr, CString};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// Fields of Embree's SoA ray (`RTCRayN`), each `N` f32 lanes wide, by index: lane i of field
@@ -20,6 +23,9 @@ pub mod field {
     pub const TNEAR: usize = 3;
     pub const DIR: usize = 4;
     pub const TFAR: usize = 8;
+    /// The ray's id: the queries put each ray's lane in the caller's packet here, and Embree
+    /// carries it through any split or reordering of the packet (exact.rs).
+    pub const ID: usize = 10;
 }
 
 const _: () = {
@@ -28,14 +34,28 @@ const _: () = {
     assert!(offset_of!(RTCRay16, tnear) == field::TNEAR * 64);
     assert!(offset_of!(RTCRay16, dir_x) == field::DIR * 64);
     assert!(offset_of!(RTCRay16, tfar) == field::TFAR * 64);
+    assert!(offset_of!(RTCRay16, id) == field::ID * 64);
     assert!(offset_of!(RTCRay8, tfar) == field::TFAR * 32);
+    assert!(offset_of!(RTCRay8, id) == field::ID * 32);
+    assert!(offset_of!(RTCRay4, tfar) == field::TFAR * 16);
+    assert!(offset_of!(RTCRay4, id) == field::ID * 16);
+    assert!(offset_of!(RTCRay, tfar) == field::TFAR * 4);
+    assert!(offset_of!(RTCRay, id) == field::ID * 4);
 };
 
 pub struct Device {
     raw: RTCDevice,
     errors: *mut Mutex<Vec<String>>,
-    /// Packet width for primary rays: 16 where the CPU traces 16-wide natively, else 8.
-    pub packet_width: usize,
+    /// The instruction set Embree runs (`isa.rs`).
+    pub isa: Isa,
+    /// Whether Embree traces packets of 4, 8 and 16 rays natively here (any other width it
+    /// splits and copies before it calls back into user geometry).
+    pub native: [bool; 3],
+    /// What went wrong in a callback while tracing (checked by the render).
+    pub faults: Arc<Faults>,
+    /// The test hook of `EmbreeBackend::with_fault_injected`: set, the next callback to run
+    /// panics (once, so the log shows one panic).
+    pub inject_fault: AtomicBool,
 }
 
 // SAFETY: Embree devices may be used from any thread (Embree's API is thread-safe for device
@@ -44,26 +64,35 @@ unsafe impl Send for Device {}
 unsafe impl Sync for Device {}
 
 unsafe extern "C" fn on_error(user: *mut c_void, code: RTCError, msg: *const c_char) {
-    let text = if msg.is_null() {
-        String::new()
-    } else {
-        // SAFETY: Embree passes a NUL-terminated message.
-        unsafe { CStr::from_ptr(msg) }
-            .to_string_lossy()
-            .into_owned()
-    };
-    // SAFETY: `user` is the device's error list, registered in `Device::new` and unregistered
-    // before it is freed.
-    let list = unsafe { &*(user as *const Mutex<Vec<String>>) };
-    if let Ok(mut l) = list.lock() {
-        l.push(format!("{code:?}: {text}"));
-    }
+    // No panic may unwind into Embree: whatever fails here loses a message, nothing more.
+    let _ = std::panic::catch_unwind(|| {
+        let text = if msg.is_null() {
+            String::new()
+        } else {
+            // SAFETY: Embree passes a NUL-terminated message.
+            unsafe { CStr::from_ptr(msg) }
+                .to_string_lossy()
+                .into_owned()
+        };
+        // SAFETY: `user` is the device's error list, registered in `Device::new` and
+        // unregistered before it is freed.
+        let list = unsafe { &*(user as *const Mutex<Vec<String>>) };
+        if let Ok(mut l) = list.lock() {
+            l.push(format!("{code:?}: {text}"));
+        }
+    });
 }
 
 impl Device {
-    /// A device; `threads` limits Embree's own build threads (0: all cores).
-    pub fn new(threads: usize) -> Result<Device> {
-        let config = CString::new(format!("threads={threads},verbose=0")).expect("no NUL");
+    /// A device; `threads` limits Embree's own build threads (0: all cores); `isa` is the
+    /// instruction set to run (None: Embree's choice, the best the CPU has), which the caller
+    /// has checked the CPU has (`Isa::checked`).
+    pub fn new(threads: usize, isa: Option<Isa>, faults: Arc<Faults>) -> Result<Device> {
+        let mut config = format!("threads={threads},verbose=0");
+        if let Some(isa) = isa {
+            config += &format!(",isa={}", isa.name());
+        }
+        let config = CString::new(config).expect("no NUL");
         // SAFETY: a NUL-terminated configuration string.
         let raw = unsafe { rtcNewDevice(config.as_ptr()) };
         if raw.is_null() {
@@ -76,14 +105,66 @@ impl Device {
         let errors = Box::into_raw(Box::new(Mutex::new(Vec::new())));
         // SAFETY: a live device; the list outlives the registration (see Drop).
         unsafe { rtcSetDeviceErrorFunction(raw, Some(on_error), errors as *mut c_void) };
-        // SAFETY: a live device.
-        let native16 =
-            unsafe { rtcGetDeviceProperty(raw, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) } != 0;
+        let property = |p| {
+            // SAFETY: a live device, a property Embree 3 knows.
+            unsafe { rtcGetDeviceProperty(raw, p) != 0 }
+        };
+        let native = [
+            property(RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED),
+            property(RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED),
+            property(RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED),
+        ];
+        // Left to itself Embree runs the best code path the CPU has, which its native widths
+        // tell apart but for AVX from AVX2 and SSE2 from SSE4.2 (the CPU's best of each pair).
+        let isa = isa.unwrap_or_else(|| {
+            let best = Isa::best().unwrap_or(Isa::Sse2);
+            let of_width = |w: usize| Isa::on_cpu().into_iter().rfind(|i| i.native_width() == w);
+            match native {
+                [_, _, true] => of_width(16),
+                [_, true, false] => of_width(8),
+                _ => of_width(4),
+            }
+            .unwrap_or(best)
+        });
         Ok(Device {
             raw,
             errors,
-            packet_width: if native16 { 16 } else { 8 },
+            isa,
+            native,
+            faults,
+            inject_fault: AtomicBool::new(false),
         })
+    }
+
+    /// Embree's version, as major.minor.patch.
+    pub fn version(&self) -> String {
+        // SAFETY: a live device, properties Embree 3 knows.
+        let p = |k| unsafe { rtcGetDeviceProperty(self.raw, k) };
+        format!(
+            "{}.{}.{}",
+            p(RTC_DEVICE_PROPERTY_VERSION_MAJOR),
+            p(RTC_DEVICE_PROPERTY_VERSION_MINOR),
+            p(RTC_DEVICE_PROPERTY_VERSION_PATCH)
+        )
+    }
+
+    /// The fault-injection flag for a query's context: None unless a fault is to be injected
+    /// (`EmbreeBackend::with_fault_injected`), so a query pays one test of an Option.
+    #[inline(always)]
+    pub fn injection(&self) -> Option<&AtomicBool> {
+        self.inject_fault
+            .load(Ordering::Relaxed)
+            .then_some(&self.inject_fault)
+    }
+
+    /// The widest packet Embree traces natively here (1 if none).
+    pub fn native_width(&self) -> usize {
+        match self.native {
+            [_, _, true] => 16,
+            [_, true, false] => 8,
+            [true, false, false] => 4,
+            _ => 1,
+        }
     }
 
     /// Fail with the collected messages, if Embree reported any since the last check.
@@ -356,6 +437,15 @@ impl CommittedScene {
         RTCRay8,
         rtcIntersect8,
         rtcOccluded8
+    );
+    packet_queries!(
+        intersect4,
+        occluded4,
+        4,
+        RTCRayHit4,
+        RTCRay4,
+        rtcIntersect4,
+        rtcOccluded4
     );
 
     /// The closest hit of one ray.

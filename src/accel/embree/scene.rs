@@ -88,8 +88,9 @@ pub struct EmbreeScene {
     pub exact_runs: Option<ExactRuns>,
     /// Embree coordinates are rest-frame coordinates minus this.
     pub center: DVec3,
-    /// Whether packets may be traced with Embree's coherent flag (not into instances).
-    pub coherent_packets: bool,
+    /// Whether occlusion packets may be traced with Embree's coherent flag (not into
+    /// instances: `EmbreeAccel::context`).
+    pub coherent_occlusion: bool,
     /// What Embree's user geometry points into; dropped after the scene is released.
     _rounds: Option<Box<Shapes<Round>>>,
     _cuboids: Option<Box<Shapes<Aabb>>>,
@@ -198,7 +199,7 @@ impl EmbreeScene {
             maps,
             exact_runs,
             center,
-            coherent_packets: geo.implicit.is_empty(),
+            coherent_occlusion: geo.implicit.is_empty(),
             _rounds: rounds,
             _cuboids: cuboids,
             _blocks: blocks,
