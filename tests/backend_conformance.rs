@@ -44,3 +44,14 @@ conformance_suite!(
         mismatch: 0.002
     }
 );
+
+// And 4-wide (SSE's native width): lane_cull.rs culls four lanes at once.
+#[cfg(feature = "embree")]
+conformance_suite!(
+    embree_4,
+    rest_embree::accel::backend_by_name("embree-4").unwrap(),
+    Tolerance {
+        t_rel: 1e-9,
+        mismatch: 0.002
+    }
+);

@@ -34,6 +34,7 @@ pub(super) unsafe fn lanes_near(
         match n {
             16 => near::<16>(ray, lo, hi),
             8 => near::<8>(ray, lo, hi),
+            4 => near::<4>(ray, lo, hi),
             // Single rays come from Embree's per-ray traversal, which tested the box already.
             _ => u32::MAX,
         }
@@ -53,7 +54,7 @@ pub(super) unsafe fn lanes_near(
 }
 
 /// `near_box` in the widest vectors this CPU has: AVX2 runs eight lanes at once, the baseline
-/// x86-64 target four.
+/// x86-64 target four (SSE's packets are four wide).
 unsafe fn near<const N: usize>(ray: *const f32, lo: DVec3, hi: DVec3) -> u32 {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
@@ -75,10 +76,12 @@ unsafe fn near_avx2<const N: usize>(ray: *const f32, lo: DVec3, hi: DVec3) -> u3
 /// well would add work that rarely drops a lane.
 ///
 /// # Safety
-/// `ray` points to an N-wide SoA ray, N a multiple of 8 (at most 32).
+/// `ray` points to an N-wide SoA ray, N 4 or a multiple of 8 (at most 32).
 #[inline(always)]
 unsafe fn near_box<const N: usize>(ray: *const f32, lo: DVec3, hi: DVec3) -> u32 {
-    const { assert!(N.is_multiple_of(8) && N <= 32) };
+    const { assert!((N == 4 || N.is_multiple_of(8)) && N <= 32) };
+    // Lanes per step: eight (one AVX vector), or all four of a 4-wide packet.
+    let step = N.min(8);
     // SAFETY: fields ORG.. and DIR.. of an N-wide SoA ray are N floats each.
     let field = |k: usize| unsafe { &*(ray.add(k * N) as *const [f32; N]) };
     let (ox, oy, oz) = (field(ORG), field(ORG + 1), field(ORG + 2));
@@ -91,9 +94,9 @@ unsafe fn near_box<const N: usize>(ray: *const f32, lo: DVec3, hi: DVec3) -> u32
     let (ex, ey, ez) = (e.x as f32, e.y as f32, e.z as f32);
     let mut bits = 0u32;
     // Eight lanes at a time: one AVX vector, few enough values to stay in registers.
-    for k in (0..N).step_by(8) {
+    for k in (0..N).step_by(step) {
         let mut near = [0u8; 8];
-        for (j, v) in near.iter_mut().enumerate() {
+        for (j, v) in near.iter_mut().enumerate().take(step) {
             let i = k + j;
             let (x, y, z) = (dx[i], dy[i], dz[i]);
             let pad = PAD * (reach + ox[i].abs() + oy[i].abs() + oz[i].abs());
