@@ -291,6 +291,8 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result
     let render_s = first_render_s.min(fastest(repeat.saturating_sub(1), || {
         render_world_passes(&scene, &world, passes);
     }));
+    // No figure of a render the backend recorded a fault in.
+    world.check()?;
     let peak_mib = memory::peak_mib();
     let write_s = write_like_the_command(&scene, backend_name, passes, &frame)?;
     let (w, h) = scene.image.frame_size();
@@ -387,9 +389,14 @@ pub(crate) fn world_and_accel(
         fn cullers(&self) -> CullerFactory {
             self.inner.cullers()
         }
+        fn faults(&self) -> Option<Arc<crate::accel::Faults>> {
+            self.inner.faults()
+        }
     }
+    // As `--backend` makes it: the instruction set `REST_EMBREE_ISA` names, if any.
     let inner = crate::accel::embree_backend(name)
-        .ok_or_else(|| crate::Error::flag("--backend", format!("`{name}` is no Embree backend")))?;
+        .ok_or_else(|| crate::Error::flag("--backend", format!("`{name}` is no Embree backend")))?
+        .configured_by_env()?;
     let backend = Keeping {
         inner,
         built: Default::default(),
