@@ -9,10 +9,10 @@ out=$(mktemp)
 tests=(calibration physics_render orthographic extreme stress)
 args=()
 for t in "${tests[@]}"; do args+=(--test "$t"); done
-cargo test -q "${args[@]}" -- --nocapture --test-threads 1 2>/dev/null | grep -o 'ACCURACY|.*' > /tmp/accuracy-rows.txt
+cargo test --release -q "${args[@]}" -- --nocapture --test-threads 1 2>/dev/null | grep -o 'ACCURACY|.*' > /tmp/accuracy-rows.txt
 awk -F'|' '
   {
-    key = $2; unit[key] = $8; want[key] = $4; tol[key] = $7; cmd[key] = "cargo test --test " $9 " " $10 " -- --nocapture"
+    key = $2; unit[key] = $8; want[key] = $4; tol[key] = $7; cmd[key] = "cargo test --release --test " $9 " " $10 " -- --nocapture"
     got[key, $3] = $5; err = $6 + 0; if (!(key in worst) || err > worst[key]) worst[key] = err
     if (!(key in seen)) { seen[key] = 1; order[++n] = key }
   }
