@@ -34,6 +34,7 @@ FRAMES ?= film/frame-%04d.png
 FPS ?= 24
 MP4 ?= film.mp4
 film:
+	@command -v ffmpeg >/dev/null 2>&1 || { echo "make film: ffmpeg is not installed; on Debian: sudo apt-get install ffmpeg" >&2; exit 1; }
 	ffmpeg -y -framerate $(FPS) -i '$(FRAMES)' -pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' $(MP4)
 
 bench: setup

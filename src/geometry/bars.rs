@@ -47,7 +47,7 @@ impl BarArray {
         self.len() == 0
     }
 
-    /// The centre of bar (n[0], n[1]).
+    /// The centre of bar (`n[0]`, `n[1]`).
     pub fn node_at(&self, n: [u32; 3]) -> DVec3 {
         let (a1, a2) = self.plane();
         let [n1, n2] = self.counts;

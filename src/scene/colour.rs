@@ -5,7 +5,7 @@ use super::doc::Val;
 use super::reader::{SceneResult, Table};
 use crate::spectrum::{camera, Colour, Role, Spectrum};
 
-const FORMS: &str = "a number (grey), [r, g, b], { blackbody = T }, { line = NM, fwhm = NM } or { wavelengths = [...], values = [...] }";
+const FORMS: &str = "[r, g, b] (linear, e.g. [0.8, 0.8, 0.8]), a grey number (0.8), { blackbody = T }, { line = NM, fwhm = NM } or { wavelengths = [...], values = [...] }";
 
 impl Table<'_> {
     /// A colour for `role`. Reflectances take RGB and tables only.
@@ -13,6 +13,24 @@ impl Table<'_> {
         let Some(n) = self.get(key) else {
             return Ok(None);
         };
+        if !matches!(
+            n.val,
+            Val::Table(_) | Val::Array(_) | Val::Float(_) | Val::Int(_)
+        ) {
+            let named = if matches!(n.val, Val::Str(_)) {
+                " (colours have no names: red is [0.8, 0.1, 0.1])"
+            } else {
+                ""
+            };
+            return Err(self.error_at(
+                n,
+                key,
+                format!(
+                    "expected a colour, found {}{named}; a colour is {FORMS}",
+                    n.kind()
+                ),
+            ));
+        }
         if !matches!(n.val, Val::Table(_)) {
             let rgb = self.color(key)?.expect("present");
             return Ok(Some(Colour::rgb(rgb, role)));

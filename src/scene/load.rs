@@ -72,7 +72,7 @@ fn build(doc: &Doc) -> SceneResult<Scene> {
     let root = Table::root(doc)?;
     let camera = match root.table("camera")? {
         Some(t) => camera(&t)?,
-        None => return Err(root.error("camera", "missing: the scene needs a [camera] table")),
+        None => return Err(root.missing_table("camera", "the scene needs a [camera] table")),
     };
     let image = match root.table("image")? {
         Some(t) => image(&t)?,

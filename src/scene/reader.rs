@@ -138,10 +138,26 @@ impl<'a> Table<'a> {
                 key,
                 format!("must be a whole number from {min} to {max} (got {i})"),
             )),
+            // A number with a fraction: say which, and what would do.
+            Val::Float(f) => Err(self.error_at(
+                n,
+                key,
+                format!(
+                    "must be a whole number from {min} to {max}, written without a point (got {f:?}{})",
+                    if f.fract() != 0.0 && f.is_finite() {
+                        format!("; {} or {} would do", f.floor().max(min as f64), f.ceil().max(min as f64))
+                    } else {
+                        String::new()
+                    }
+                ),
+            )),
             _ => Err(self.error_at(
                 n,
                 key,
-                format!("expected a whole number, found {}", n.kind()),
+                format!(
+                    "expected a whole number from {min} to {max}, found {}",
+                    n.kind()
+                ),
             )),
         }
     }
@@ -322,13 +338,47 @@ impl<'a> Table<'a> {
                 if known.contains(&k.as_str()) {
                     return Err(self.error_at(n, k, "not used with the other keys given here"));
                 }
+                let what = if n.entries().is_some() {
+                    "unknown table"
+                } else {
+                    "unknown key"
+                };
                 let hint = closest(k, known)
-                    .map(|s| format!("; did you mean `{s}`?"))
+                    .map(|s| format!("\n  did you mean `{s}`?{}", case_note(k, s)))
                     .unwrap_or_else(|| format!("; known keys here: {}", known.join(", ")));
-                return Err(self.error_at(n, k, format!("unknown key{hint}")));
+                return Err(self.error_at(n, k, format!("{what}{hint}")));
             }
         }
         Ok(())
+    }
+
+    /// The error for a required table `wanted` that is missing: at a key written nearly so
+    /// (`[Camera]`, `[camra]`), if there is one, saying what was meant; else at the table.
+    pub fn missing_table(&self, wanted: &str, why: &str) -> SceneError {
+        let near = self
+            .entries()
+            .iter()
+            .find(|(k, _)| k != wanted && closest(k, &[wanted]).is_some());
+        match near {
+            Some((k, n)) => self.error_at(
+                n,
+                k,
+                format!(
+                    "unknown table\n  did you mean `[{wanted}]`?{} ({why})",
+                    case_note(k, wanted)
+                ),
+            ),
+            None => self.error(wanted, format!("missing: {why}")),
+        }
+    }
+}
+
+/// " Names are case-sensitive." where `typed` differs from `meant` in case alone.
+fn case_note(typed: &str, meant: &str) -> &'static str {
+    if typed != meant && typed.eq_ignore_ascii_case(meant) {
+        " Names are case-sensitive."
+    } else {
+        ""
     }
 }
 
@@ -336,7 +386,7 @@ impl<'a> Table<'a> {
 fn closest<'k>(key: &str, known: &[&'k str]) -> Option<&'k str> {
     known
         .iter()
-        .map(|k| (edit_distance(key, k), *k))
+        .map(|k| (edit_distance(&key.to_lowercase(), &k.to_lowercase()), *k))
         .filter(|(d, k)| *d <= 2.max(k.len() / 3))
         .min()
         .map(|(_, k)| k)
