@@ -455,6 +455,7 @@ fn a_panic_in_an_embree_callback_is_an_error_not_an_abort() {
         for needle in [
             scene.to_str().unwrap(),
             "callback panicked",
+            "Embree's",
             "the file was not written",
         ] {
             assert!(err.contains(needle), "{ext}: should say `{needle}`:\n{err}");
@@ -488,13 +489,19 @@ fn a_panic_in_an_embree_callback_is_an_error_not_an_abort() {
 #[test]
 fn embree_runs_the_instruction_set_the_environment_names() {
     let d = Dir::new("isa");
-    let scene = d.file("scene.toml", GOOD);
+    // The paper's lattice, traced through Embree's callbacks (a single box would be intersected
+    // directly).
+    let scene = d.file("scene.toml", include_str!("../scenes/lattice.toml"));
     let out = d.0.join("out.png");
     let render = [
         "render",
         scene.to_str().unwrap(),
         "-o",
         out.to_str().unwrap(),
+        "--width",
+        "48",
+        "--height",
+        "32",
     ];
     for (isa, width) in [
         ("sse2", "4"),
@@ -539,4 +546,71 @@ fn embree_runs_the_instruction_set_the_environment_names() {
     let (code, _, stdout) = status_with_env(&["backends"], &[]);
     assert_eq!(code, Some(0));
     assert!(stdout.contains("(the CPU's best;"), "{stdout}");
+}
+
+/// A newcomer's slips, each told what is wrong and what is accepted: a table name in the wrong
+/// case (at its own line, with what was meant on a line of its own), a colour by name, a
+/// number of samples with a point, a `--set` value the shell split at its spaces.
+#[test]
+fn slips_say_what_would_be_accepted() {
+    fails(
+        "camera-case",
+        &with("[camera]", "[Camera]"),
+        &[],
+        &[
+            "scene.toml:1:",
+            "key `Camera`: unknown table\n  did you mean `[camera]`?",
+            "case-sensitive",
+        ],
+    );
+    fails(
+        "colour-name",
+        &with("color = [0.8, 0.8, 0.8]", "color = \"red\""),
+        &[],
+        &[
+            "scene.toml:13",
+            "expected a colour, found a string",
+            "[r, g, b]",
+            "{ blackbody = T }",
+        ],
+    );
+    fails(
+        "samples-point",
+        &with("height = 32", "height = 32\nsamples = 4.5"),
+        &[],
+        &["image.samples", "whole number", "4 or 5 would do"],
+    );
+    let d = Dir::new("set-split");
+    let scene = d.file("scene.toml", GOOD);
+    let (code, err) = status(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        "out.png",
+        "--set",
+        "group.cube.velocity=[0.9,",
+        "0,",
+        "0]",
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("quote it whole: --set 'group.cube.velocity=[0.9, 0, 0]'"),
+        "{err}"
+    );
+}
+
+/// A still goes into a folder that does not exist yet, as a film's frames do.
+#[test]
+fn a_still_makes_its_folder() {
+    let d = Dir::new("still-folder");
+    let scene = d.file("scene.toml", GOOD);
+    let out = d.0.join("new/deeper/out.png");
+    let (ok, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.is_file());
 }

@@ -18,55 +18,65 @@ mod instanced_tree;
 
 pub(crate) use bvh::BvhBackend;
 pub(crate) use bvh32::Bvh32Backend;
-#[cfg(all(feature = "embree", test))]
-pub(crate) use embree::Isa;
 #[cfg(feature = "embree")]
 pub(crate) use embree::{BareRay, EmbreeAccel, EmbreeBackend};
+#[cfg(all(feature = "embree", test))]
+pub(crate) use embree::{Callback, Isa};
 pub use fan::{Fan, FanHits, NO_HIT};
 
 use crate::geometry::{Aabb, BoxTree, Geometry, LightBuffer};
 use glam::DVec3;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// What went wrong inside a backend where no error could be returned: Embree calls back into
 /// the renderer from C, where a panic must not unwind and a query has no result to fail with.
-/// The backend records the first fault here; the render checks it after every strip and fails
-/// rather than write a picture that may be wrong.
+/// The backend records each fault here; a world notes how many there were when it was made
+/// and its render fails if there are more (`World::check`), rather than write a picture that
+/// may be wrong. A backend that recorded one stays usable: later worlds start from there.
 #[derive(Debug, Default)]
 pub struct Faults {
-    any: AtomicBool,
-    first: Mutex<Option<String>>,
+    count: AtomicU64,
+    /// The latest fault's message.
+    latest: Mutex<Option<String>>,
 }
 
 impl Faults {
-    /// Record a fault (the first one's message is kept).
+    /// Record a fault.
     pub fn record(&self, what: impl FnOnce() -> String) {
-        if self.any.swap(true, Ordering::AcqRel) {
-            return;
+        if let Ok(mut latest) = self.latest.lock() {
+            *latest = Some(what());
         }
-        if let Ok(mut first) = self.first.lock() {
-            first.get_or_insert_with(what);
-        }
+        self.count.fetch_add(1, Ordering::AcqRel);
     }
 
-    /// Whether a fault was recorded.
-    pub fn any(&self) -> bool {
-        self.any.load(Ordering::Acquire)
+    /// How many faults were recorded so far.
+    pub fn count(&self) -> u64 {
+        self.count.load(Ordering::Acquire)
     }
 
-    /// An error if a fault was recorded.
-    pub fn check(&self) -> crate::Result<()> {
-        if !self.any() {
+    /// An error if a fault was recorded since there were `seen`.
+    pub fn check_since(&self, seen: u64) -> crate::Result<()> {
+        let now = self.count();
+        if now <= seen {
             return Ok(());
         }
         let what = self
-            .first
+            .latest
             .lock()
             .ok()
             .and_then(|f| f.clone())
             .unwrap_or_else(|| "a fault".to_string());
-        Err(crate::Error::backend(what))
+        Err(crate::Error::backend(if now - seen > 1 {
+            format!("{what} ({} faults in all)", now - seen)
+        } else {
+            what
+        }))
+    }
+
+    /// An error if any fault was recorded.
+    pub fn check(&self) -> crate::Result<()> {
+        self.check_since(0)
     }
 }
 

@@ -33,6 +33,7 @@ pub(crate) fn summary(quick: bool, backend: &str) -> crate::Result<String> {
         let t = Instant::now();
         let _ = render_world(&s, &world);
         rendering += t.elapsed().as_secs_f64();
+        world.check()?;
     }
     let whole = start.elapsed().as_secs_f64();
     // The same frames, each with a world of its own (as separate runs would build them).
@@ -41,6 +42,7 @@ pub(crate) fn summary(quick: bool, backend: &str) -> crate::Result<String> {
         let s = scene.film_frame(k).expect("a film");
         let world = World::build(&s, b.as_ref())?;
         let _ = render_world(&s, &world);
+        world.check()?;
     }
     let apart = start.elapsed().as_secs_f64();
     Ok(format!(

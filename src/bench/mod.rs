@@ -351,6 +351,8 @@ fn beside(
         one_s = one_s.min(fastest(repeat, || render(&one, &one_world)));
     }
     row.render_s = many_s;
+    many_world.check()?;
+    one_world.check()?;
     Ok(Beside {
         what: what.to_string(),
         build_s: one_row.build_s,
@@ -462,6 +464,7 @@ fn bare_embree(case: &Case, repeat: usize) -> crate::Result<Option<(u64, f64, f6
         layer_s = layer_s.min(fastest(repeat, layer));
         bare_s = bare_s.min(fastest(repeat, bare));
     }
+    world.check()?;
     Ok(Some((n, bare_s, layer_s)))
 }
 

@@ -37,6 +37,7 @@ pub(crate) fn summary(quick: bool, backend: &str) -> crate::Result<String> {
     };
     let one = time_on(1)?;
     let all = time_on(threads)?;
+    world.check()?;
     Ok(format!(
         "- threads, the lattice at 0.5c at {size}x{size}, 1 spp ({backend}): render {one:.3} s on 1 \
          thread, {all:.3} s on {threads} = {:.2}x as fast\n",

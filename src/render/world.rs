@@ -177,8 +177,9 @@ pub struct World {
     /// accelerator: needed to skip groups and to keep f32 coordinates small when rays come from
     /// afar; pure cost for one group seen from close by, whose rays all start near it.
     clip_rays: bool,
-    /// Where the backend records what went wrong while tracing (`check`).
-    faults: Option<Arc<Faults>>,
+    /// Where the backend records what went wrong while tracing, and how many faults it had
+    /// when this world was made (`check`).
+    faults: Option<(Arc<Faults>, u64)>,
 }
 
 /// The kinetic trees over the groups, made on first use: only rays that neither start at the
@@ -271,14 +272,19 @@ impl World {
             primary_tree,
             light_trees,
             clip_rays,
-            faults: backend.faults(),
+            faults: backend.faults().map(|f| {
+                let seen = f.count();
+                (f, seen)
+            }),
         })
     }
 
     /// An error if the backend recorded a fault while tracing (Embree's callbacks cannot
     /// return one): what was rendered since may be wrong.
     pub fn check(&self) -> crate::Result<()> {
-        self.faults.as_ref().map_or(Ok(()), |f| f.check())
+        self.faults
+            .as_ref()
+            .map_or(Ok(()), |(f, seen)| f.check_since(*seen))
     }
 
     /// The trees over many groups: kinetic (built on first use), apparent boxes for primary

@@ -6,12 +6,14 @@
 //! the paper's scenes at 0.9c (the lattice listed and instanced, the bar array, the passing
 //! spheres) and random scenes of 3 to 1,000 velocity groups of boxes, spheres and rods, with
 //! mirrors, glass and shadows toward lights at rest and moving, seen from a camera at rest and
-//! moving. And a panic in any callback is caught at the FFI boundary and fails the render.
+//! moving (every group through Embree, though the renderer would intersect a group of a few
+//! primitives directly). And a panic in any callback is caught at the FFI boundary and fails
+//! the render, naming the callback.
 
 #![cfg(feature = "embree")]
 
 use super::common::Rng;
-use crate::accel::{Backend, EmbreeBackend, Isa};
+use crate::accel::{Backend, Callback, EmbreeBackend, Isa};
 use crate::bench::paper;
 use crate::render::{render, Frame, RenderOptions, WorldOptions};
 use crate::scene::Scene;
@@ -96,6 +98,7 @@ fn agrees_everywhere(what: &str, scene: &Scene, world: WorldOptions) {
             Err(e) => failures.push(format!("{name}: {e}")),
         }
         assert!(backend.faults().unwrap().check().is_ok(), "{name}: a fault");
+        assert_eq!(backend.faults().unwrap().count(), 0, "{name}: a fault");
     }
     assert!(failures.is_empty(), "{what}:\n{}", failures.join("\n"));
 }
@@ -250,22 +253,23 @@ intensity = 0.6
     crate::scene::load_str(&format!("{n}-groups.toml"), &s, &[]).unwrap()
 }
 
+/// Every group through Embree: the renderer would intersect a group of a few primitives
+/// directly in f64, without its accelerator.
+fn through_embree() -> WorldOptions {
+    WorldOptions {
+        direct_max: 0,
+        ..WorldOptions::default()
+    }
+}
+
 #[test]
 fn three_groups_agree_on_every_isa() {
-    agrees_everywhere(
-        "3 groups",
-        &random_groups(3, 1, false),
-        WorldOptions::default(),
-    );
+    agrees_everywhere("3 groups", &random_groups(3, 1, false), through_embree());
 }
 
 #[test]
 fn twenty_groups_seen_by_a_moving_camera_agree_on_every_isa() {
-    agrees_everywhere(
-        "20 groups",
-        &random_groups(20, 2, true),
-        WorldOptions::default(),
-    );
+    agrees_everywhere("20 groups", &random_groups(20, 2, true), through_embree());
 }
 
 #[test]
@@ -273,10 +277,12 @@ fn a_hundred_groups_agree_on_every_isa() {
     agrees_everywhere(
         "100 groups",
         &random_groups(100, 3, false),
-        WorldOptions::default(),
+        through_embree(),
     );
     let s = random_groups(100, 4, true);
-    agrees_everywhere("100 groups, camera moving", &s, WorldOptions::default());
+    agrees_everywhere("100 groups, camera moving", &s, through_embree());
+    // And as the renderer runs by default: small groups in f64, through Embree's culler.
+    agrees_everywhere("100 groups, default", &s, WorldOptions::default());
 }
 
 #[test]
@@ -284,61 +290,49 @@ fn a_thousand_groups_agree_on_every_isa() {
     agrees_everywhere(
         "1000 groups",
         &random_groups(1000, 5, true),
-        WorldOptions::default(),
+        through_embree(),
     );
 }
 
-/// A panic inside a callback is caught before it reaches Embree, and the render fails with an
-/// error saying so: in the exact primitives' callbacks (primary rays through the fans, shadow
-/// rays), in the instanced blocks', and in the culler's over many groups.
+/// A panic inside any callback is caught before it reaches Embree, and the render fails with
+/// an error naming the callback, under each instruction set: the exact primitives' closest-hit
+/// (fans of primary rays) and occlusion (shadow rays) callbacks, the instanced blocks' two,
+/// and the culler's over many groups.
 #[test]
 fn a_panic_in_any_callback_fails_the_render() {
+    let lattice = small("lattice", &["group.lattice.velocity=[-0.9, 0, 0]"]);
+    let instanced = WorldOptions {
+        instance_over: 100,
+        ..WorldOptions::default()
+    };
+    let groups = random_groups(1000, 6, false);
     let cases = [
-        (
-            "the lattice (fans, shadows)",
-            small("lattice", &[]),
-            WorldOptions::default(),
-        ),
-        (
-            "the lattice instanced",
-            small("lattice", &[]),
-            WorldOptions {
-                instance_over: 100,
-                ..WorldOptions::default()
-            },
-        ),
-        (
-            "1000 groups (the culler)",
-            random_groups(1000, 6, false),
-            WorldOptions::default(),
-        ),
-        (
-            "20 groups without the fans",
-            random_groups(20, 7, false),
-            WorldOptions {
-                fused_primary: false,
-                ..WorldOptions::default()
-            },
-        ),
+        (Callback::Intersect, &lattice, WorldOptions::default()),
+        (Callback::Occluded, &lattice, WorldOptions::default()),
+        (Callback::BlockIntersect, &lattice, instanced),
+        (Callback::BlockOccluded, &lattice, instanced),
+        (Callback::Cull, &groups, WorldOptions::default()),
     ];
-    for (what, scene, world) in cases {
+    assert_eq!(cases.len(), Callback::ALL.len());
+    for (callback, scene, world) in cases {
         for isa in Isa::on_cpu() {
+            let what = format!("{} callback on {}", callback.name(), isa.name());
             let backend = EmbreeBackend::new()
                 .on_isa(isa)
                 .unwrap()
-                .with_fault_injected();
+                .with_fault_injected_in(Some(callback));
             let options = RenderOptions {
                 world,
                 ..RenderOptions::default()
             };
-            let e = render(&scene, &backend, &options)
+            let e = render(scene, &backend, &options)
                 .err()
-                .unwrap_or_else(|| panic!("{what} on {}: the render should fail", isa.name()))
+                .unwrap_or_else(|| panic!("{what}: the render should fail"))
                 .to_string();
-            assert!(e.contains("panicked"), "{what} on {}: {e}", isa.name());
+            let want = format!("Embree's {} callback panicked", callback.name());
+            assert!(e.contains(&want), "{what}: {e}");
+            // The backend stays usable: a new world on it renders.
+            render(scene, &backend, &options).unwrap_or_else(|e| panic!("{what}, again: {e}"));
         }
     }
-    // And without the fault, the same backend renders.
-    let backend = EmbreeBackend::new();
-    render(&small("lattice", &[]), &backend, &RenderOptions::default()).unwrap();
 }

@@ -5,6 +5,7 @@
 //! lose one.
 
 use super::exact::{self, Shape, Shapes};
+use super::fault::{guarded, Callback, Fault, Injection};
 use super::lane_cull::lanes_near;
 use super::packet::flush_denormals;
 use super::rtc::{self, field, CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
@@ -12,6 +13,7 @@ use crate::accel::BoxCuller;
 use crate::geometry::{Aabb, PACKET};
 use embree_sys::*;
 use glam::DVec3;
+use std::cell::Cell;
 use std::sync::Arc;
 
 pub struct EmbreeCuller {
@@ -44,11 +46,10 @@ struct CullContext<'a> {
     len: [f64; PACKET],
     shift: [f64; PACKET],
     slack: f64,
-    /// Whether a callback panicked (caught: no panic may unwind into Embree) or met a ray
-    /// that is not one of the query's.
-    fault: Option<&'static str>,
+    /// What went wrong in a callback (fault.rs).
+    fault: Cell<Fault>,
     /// The test hook of `EmbreeBackend::with_fault_injected` (`Device::injection`).
-    inject: Option<&'a std::sync::atomic::AtomicBool>,
+    inject: Option<&'a Injection>,
 }
 
 /// Offer box `prim` to every valid lane that may meet it (lane_cull.rs); a lane whose tmax
@@ -68,16 +69,8 @@ unsafe fn offer(
 ) {
     unsafe {
         let ctx = &mut *(context as *mut CullContext);
-        let run = std::panic::AssertUnwindSafe(|| {
-            let once = |f: &std::sync::atomic::AtomicBool| {
-                f.swap(false, std::sync::atomic::Ordering::Relaxed)
-            };
-            if ctx.inject.is_some_and(once) {
-                panic!(
-                    "a fault injected into an Embree callback ({})",
-                    super::FAULT_ENV
-                );
-            }
+        let (fault, inject) = (ctx.fault.clone(), ctx.inject);
+        guarded(Callback::Cull, &fault, inject, || {
             let boxes = &*(user as *const Shapes<Aabb>);
             let Some(b) = boxes.0.get(prim as usize) else {
                 return;
@@ -86,8 +79,7 @@ unsafe fn offer(
             for i in lanes_near(valid, ray, n, lo, hi) {
                 let r = *(ray.add(field::ID * n + i) as *const u32) as usize;
                 let (Some(&before), Some(&tmin)) = (ctx.tmax.get(r), ctx.tmin.get(r)) else {
-                    ctx.fault =
-                        Some("Embree called back with a ray that is not one of the query's");
+                    fault.set(Fault::StrayRay);
                     continue;
                 };
                 let t = (ctx.visit)(prim, r, before);
@@ -100,11 +92,7 @@ unsafe fn offer(
                 }
             }
         });
-        if std::panic::catch_unwind(run).is_err() {
-            ctx.fault = Some(
-                "a culling callback panicked while Embree traced rays (the panic was caught; its message is above)",
-            );
-        }
+        ctx.fault.set(fault.get());
     }
 }
 
@@ -251,7 +239,7 @@ impl BoxCuller for EmbreeCuller {
             len: lens,
             shift: shifts,
             slack: self.slack,
-            fault: None,
+            fault: Cell::new(Fault::None),
             inject: self.device.injection(),
         };
         ctx.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -259,8 +247,9 @@ impl BoxCuller for EmbreeCuller {
         // SAFETY: a committed scene, a 64-byte aligned valid mask of 16, the context above
         // (which the callbacks read as a CullContext) outliving the call.
         unsafe { scene.intersect16(&valid, raw, &mut rh) };
-        if let Some(what) = ctx.fault {
-            self.device.faults.record(|| what.to_string());
+        let fault = ctx.fault.get();
+        if fault != Fault::None {
+            self.device.faults.record(|| fault.message());
         }
     }
 }

@@ -7,6 +7,7 @@
 //! traced it 1.6-2.0x as fast as the f64 BVH with them, 4-5x with this. Boxes as twelve f32
 //! triangles each, refined in f64 after, were slower than one exact slab test.
 
+use super::fault::{self, Callback, Fault, Injection};
 use super::lane_cull::lanes_near;
 use super::lane_hits::{round_hits, Answers, LaneRays, MAX};
 use super::scale;
@@ -15,7 +16,6 @@ use crate::geometry::{capsule_hit, cuboid_hit, Aabb};
 use embree_sys::*;
 use glam::DVec3;
 use std::cell::Cell;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::OnceLock;
 
 /// A primitive Embree traces as user geometry, relative to the Embree scene's centre.
@@ -90,46 +90,13 @@ pub(super) struct ExactContext<'a> {
     /// What went wrong in a callback of this query, for the query to record (`Fault`).
     fault: Cell<Fault>,
     /// The test hook of `EmbreeBackend::with_fault_injected` (`Device::injection`).
-    inject: Option<&'a AtomicBool>,
+    inject: Option<&'a Injection>,
 }
 
-/// What can go wrong inside a callback, where nothing can be returned.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Fault {
-    None,
-    /// A panic, caught before it could unwind into Embree.
-    Panicked,
-    /// Embree called back with a ray whose id names no ray of the query.
-    StrayRay,
-}
-
-impl Fault {
-    /// What it means, for the render's error.
-    pub fn message(self) -> &'static str {
-        match self {
-            Fault::None => "no fault",
-            Fault::Panicked => "a user-geometry callback panicked while Embree traced rays (the panic was caught; its message is above)",
-            Fault::StrayRay => "Embree called back with a ray that is not one of the query's",
-        }
-    }
-}
-
-/// Run a callback's body: a panic is caught here, before it could unwind into Embree's C++
-/// (where it would abort the process), and recorded as the query's fault.
+/// Run a callback's body for this query (`fault::guarded`).
 #[inline(always)]
-pub(super) fn guarded(ctx: &ExactContext, body: impl FnOnce()) {
-    let run = || {
-        if ctx.inject.is_some_and(|f| f.swap(false, Ordering::Relaxed)) {
-            panic!(
-                "a fault injected into an Embree callback ({})",
-                super::FAULT_ENV
-            );
-        }
-        body()
-    };
-    if std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).is_err() {
-        ctx.fault.set(Fault::Panicked);
-    }
+pub(super) fn guarded(callback: Callback, ctx: &ExactContext, body: impl FnOnce()) {
+    fault::guarded(callback, &ctx.fault, ctx.inject, body)
 }
 
 /// Per-lane storage of an `ExactContext` for up to N rays.
@@ -170,7 +137,7 @@ impl<'a> ExactContext<'a> {
         lanes: &'a Lanes<N>,
         center: DVec3,
         pullback: f64,
-        inject: Option<&'a AtomicBool>,
+        inject: Option<&'a Injection>,
     ) -> Self {
         ExactContext {
             rtc: initial_context(coherent),
@@ -454,7 +421,7 @@ pub(super) unsafe extern "C" fn intersect<S: Shape>(args: *const RTCIntersectFun
     unsafe {
         let args = &*args;
         let ctx = &*(args.context as *const ExactContext);
-        guarded(ctx, || {
+        guarded(Callback::Intersect, ctx, || {
             let Some(prim) = shape::<S>(args.geometryUserPtr, args.primID) else {
                 return;
             };
@@ -501,7 +468,7 @@ pub(super) unsafe extern "C" fn occluded<S: Shape>(args: *const RTCOccludedFunct
     unsafe {
         let args = &*args;
         let ctx = &*(args.context as *const ExactContext);
-        guarded(ctx, || {
+        guarded(Callback::Occluded, ctx, || {
             let Some(prim) = shape::<S>(args.geometryUserPtr, args.primID) else {
                 return;
             };

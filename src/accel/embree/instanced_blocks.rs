@@ -9,6 +9,7 @@
 use super::exact::{
     everything, guarded, lane_hits_within, outward, report_hit, ExactContext, Round, Shape,
 };
+use super::fault::Callback;
 use super::rtc::field::TFAR;
 use super::rtc::{CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
 use super::scene::f3;
@@ -220,7 +221,7 @@ unsafe extern "C" fn block_intersect<S: FromPrimitive>(
     unsafe {
         let args = &*args;
         let ctx = &*(args.context as *const ExactContext);
-        guarded(ctx, || {
+        guarded(Callback::BlockIntersect, ctx, || {
             let s = shapes(args.geometryUserPtr);
             let inst = (*args.context).instID[0];
             let Some(c) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {
@@ -243,7 +244,7 @@ unsafe extern "C" fn block_occluded<S: FromPrimitive>(args: *const RTCOccludedFu
     unsafe {
         let args = &*args;
         let ctx = &*(args.context as *const ExactContext);
-        guarded(ctx, || {
+        guarded(Callback::BlockOccluded, ctx, || {
             let s = shapes(args.geometryUserPtr);
             let inst = (*args.context).instID[0];
             let Some(c) = s.prim::<S>(inst, args.primID, ctx.is_bare()) else {

@@ -17,6 +17,7 @@ mod exact;
 mod f64x4;
 #[cfg(target_arch = "x86_64")]
 mod fan_kernel;
+mod fault;
 mod instanced_blocks;
 mod isa;
 mod lane_cull;
@@ -26,6 +27,7 @@ mod rtc;
 mod scene;
 
 pub use bare::BareRay;
+pub use fault::Callback;
 pub use isa::{Isa, ENV as ISA_ENV};
 
 use super::{Accelerator, Backend, BoxCuller, CullerFactory, Fan, FanHits, Faults, Hit, Ray};
@@ -44,7 +46,7 @@ pub struct EmbreeBackend {
     faults: Arc<Faults>,
     /// A test hook: a user-geometry callback panics (`REST_EMBREE_FAULT=callback`), to prove
     /// that the panic is caught at the FFI boundary and the render fails with an error.
-    inject_fault: bool,
+    inject_fault: Option<Option<Callback>>,
 }
 
 /// The environment variable of the fault-injection test hook (`EmbreeBackend::configured_by_env`).
@@ -57,7 +59,7 @@ impl EmbreeBackend {
             packet_width: None,
             isa: None,
             faults: Arc::default(),
-            inject_fault: false,
+            inject_fault: None,
         }
     }
 
@@ -78,6 +80,8 @@ impl EmbreeBackend {
     pub fn on_isa(self, isa: Isa) -> crate::Result<Self> {
         Ok(Self {
             isa: Some(isa.checked()?),
+            // A device already made runs another.
+            device: OnceLock::new(),
             ..self
         })
     }
@@ -85,8 +89,14 @@ impl EmbreeBackend {
     /// The same backend with a panic in the first user-geometry callback that runs (a test of
     /// the FFI boundary).
     pub fn with_fault_injected(self) -> Self {
+        self.with_fault_injected_in(None)
+    }
+
+    /// The same backend with a panic in the first run of `callback` (None: of any).
+    pub fn with_fault_injected_in(self, callback: Option<Callback>) -> Self {
         Self {
-            inject_fault: true,
+            inject_fault: Some(callback),
+            device: OnceLock::new(),
             ..self
         }
     }
@@ -134,9 +144,9 @@ impl EmbreeBackend {
             .get_or_init(|| {
                 let threads = rayon::current_num_threads();
                 let device = Device::new(threads, self.isa, self.faults.clone())?;
-                device
-                    .inject_fault
-                    .store(self.inject_fault, std::sync::atomic::Ordering::Relaxed);
+                if let Some(callback) = self.inject_fault {
+                    device.inject_fault.arm(callback);
+                }
                 Ok(Arc::new(device))
             })
             .clone()

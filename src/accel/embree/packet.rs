@@ -1,6 +1,7 @@
 //! Ray packets and single rays through Embree's C API.
 
-use super::exact::{ExactContext, Fault, Lanes};
+use super::exact::{ExactContext, Lanes};
+use super::fault::Fault;
 use super::{BareRay, EmbreeAccel, EmbreeRay};
 use crate::accel::{Hit, Ray};
 use embree_sys::*;
@@ -305,7 +306,7 @@ impl EmbreeAccel {
     pub(super) fn settle(&self, ctx: &ExactContext) {
         let fault = ctx.fault();
         if fault != Fault::None {
-            self.device.faults.record(|| fault.message().to_string());
+            self.device.faults.record(|| fault.message());
         }
     }
 

@@ -8,12 +8,12 @@
 //!   gives a [`CommittedScene`], the only kind that is shared between threads and traced.
 //! - [`field`]: where Embree's SoA rays keep each field, for the user-geometry callbacks.
 
+use super::fault::Injection;
 use super::isa::Isa;
 use crate::accel::Faults;
 use crate::{Error, Result};
 use embree_sys::*;
 use std::ffi::{c_char, c_void, CStr, CString};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// Fields of Embree's SoA ray (`RTCRayN`), each `N` f32 lanes wide, by index: lane i of field
@@ -45,7 +45,7 @@ const _: () = {
 
 pub struct Device {
     raw: RTCDevice,
-    errors: *mut Mutex<Vec<String>>,
+    errors: *mut ErrorSink,
     /// The instruction set Embree runs (`isa.rs`).
     pub isa: Isa,
     /// Whether Embree traces packets of 4, 8 and 16 rays natively here (any other width it
@@ -53,9 +53,8 @@ pub struct Device {
     pub native: [bool; 3],
     /// What went wrong in a callback while tracing (checked by the render).
     pub faults: Arc<Faults>,
-    /// The test hook of `EmbreeBackend::with_fault_injected`: set, the next callback to run
-    /// panics (once, so the log shows one panic).
-    pub inject_fault: AtomicBool,
+    /// The test hook of `EmbreeBackend::with_fault_injected` (fault.rs).
+    pub inject_fault: Injection,
 }
 
 // SAFETY: Embree devices may be used from any thread (Embree's API is thread-safe for device
@@ -74,13 +73,25 @@ unsafe extern "C" fn on_error(user: *mut c_void, code: RTCError, msg: *const c_c
                 .to_string_lossy()
                 .into_owned()
         };
-        // SAFETY: `user` is the device's error list, registered in `Device::new` and
+        // SAFETY: `user` is the device's error sink, registered in `Device::new` and
         // unregistered before it is freed.
-        let list = unsafe { &*(user as *const Mutex<Vec<String>>) };
-        if let Ok(mut l) = list.lock() {
-            l.push(format!("{code:?}: {text}"));
+        let sink = unsafe { &*(user as *const ErrorSink) };
+        let message = format!("{code:?}: {text}");
+        // Also a fault: an error inside a query leaves its rays untouched (read as misses),
+        // and only the render's check of the faults would notice.
+        sink.faults
+            .record(|| format!("Embree reported an error: {message}"));
+        if let Ok(mut l) = sink.list.lock() {
+            l.push(message);
         }
     });
+}
+
+/// Where Embree's error callback writes: the messages `Device::check` reports after a build
+/// or commit, and the faults the render checks.
+struct ErrorSink {
+    list: Mutex<Vec<String>>,
+    faults: Arc<Faults>,
 }
 
 impl Device {
@@ -102,7 +113,10 @@ impl Device {
                 "Embree could not create a device ({code:?})"
             )));
         }
-        let errors = Box::into_raw(Box::new(Mutex::new(Vec::new())));
+        let errors = Box::into_raw(Box::new(ErrorSink {
+            list: Mutex::new(Vec::new()),
+            faults: faults.clone(),
+        }));
         // SAFETY: a live device; the list outlives the registration (see Drop).
         unsafe { rtcSetDeviceErrorFunction(raw, Some(on_error), errors as *mut c_void) };
         let property = |p| {
@@ -132,7 +146,7 @@ impl Device {
             isa,
             native,
             faults,
-            inject_fault: AtomicBool::new(false),
+            inject_fault: Injection::default(),
         })
     }
 
@@ -151,10 +165,8 @@ impl Device {
     /// The fault-injection flag for a query's context: None unless a fault is to be injected
     /// (`EmbreeBackend::with_fault_injected`), so a query pays one test of an Option.
     #[inline(always)]
-    pub fn injection(&self) -> Option<&AtomicBool> {
-        self.inject_fault
-            .load(Ordering::Relaxed)
-            .then_some(&self.inject_fault)
+    pub fn injection(&self) -> Option<&Injection> {
+        self.inject_fault.armed().then_some(&self.inject_fault)
     }
 
     /// The widest packet Embree traces natively here (1 if none).
@@ -171,6 +183,7 @@ impl Device {
     pub fn check(&self, what: &str) -> Result<()> {
         // SAFETY: the list lives as long as the device.
         let mut list = unsafe { &*self.errors }
+            .list
             .lock()
             .map_err(|_| Error::backend("Embree error list poisoned"))?;
         // SAFETY: a live device.
