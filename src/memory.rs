@@ -87,13 +87,17 @@ fn exceeds(need: u64, what: &str, limit: Option<(u64, &str)>) -> Option<String> 
     })
 }
 
-/// A size for people: GiB or MiB.
+/// A size for people: GiB, MiB, KiB or bytes (never "0 MiB" for a size that is not 0).
 pub fn human(bytes: u64) -> String {
-    let gib = bytes as f64 / f64::from(1u32 << 30);
-    if gib >= 1.0 {
-        format!("{gib:.1} GiB")
+    let b = bytes as f64;
+    if b >= f64::from(1u32 << 30) {
+        format!("{:.1} GiB", b / f64::from(1u32 << 30))
+    } else if b >= f64::from(1u32 << 20) {
+        format!("{:.0} MiB", b / f64::from(1u32 << 20))
+    } else if b >= 1024.0 {
+        format!("{:.0} KiB", b / 1024.0)
     } else {
-        format!("{:.0} MiB", bytes as f64 / f64::from(1u32 << 20))
+        format!("{bytes} bytes")
     }
 }
 
@@ -137,6 +141,8 @@ mod tests {
         }
         assert_eq!(human(3 << 29), "1.5 GiB");
         assert_eq!(human(200 << 20), "200 MiB");
+        assert_eq!(human(1 << 10), "1 KiB");
+        assert_eq!(human(5), "5 bytes");
     }
 
     #[test]

@@ -614,3 +614,80 @@ fn a_still_makes_its_folder() {
     assert!(ok, "{err}");
     assert!(out.is_file());
 }
+
+/// A special file is neither replaced nor read forever: an output that is, or links to, a FIFO
+/// or a device (`-o /dev/null`) is refused and left as it is; a scene path that is a device
+/// ends with an error (`/dev/urandom`: not text; `/dev/zero`: text without end).
+#[cfg(unix)]
+#[test]
+fn special_files_are_neither_replaced_nor_read_forever() {
+    use std::os::unix::fs::FileTypeExt;
+    let d = Dir::new("special");
+    let scene = d.file("scene.toml", GOOD);
+    let fifo = d.0.join("fifo.png");
+    assert!(std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let link = d.0.join("link.png");
+    std::os::unix::fs::symlink(&fifo, &link).unwrap();
+    // `-o /dev/null` itself is refused for its name (no .png or .exr); a link named so is not.
+    let null = d.0.join("null.exr");
+    std::os::unix::fs::symlink("/dev/null", &null).unwrap();
+    for (out, kind) in [
+        (fifo.as_path(), "a FIFO"),
+        (link.as_path(), "a FIFO"),
+        (null.as_path(), "a character device"),
+    ] {
+        let (code, err) = status(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, Some(1), "{}: {err}", out.display());
+        assert!(
+            err.contains(&format!(
+                "it is not a regular file ({kind}); it was left as it is"
+            )),
+            "{}: {err}",
+            out.display()
+        );
+    }
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+    for (source, says) in [
+        ("/dev/urandom", "not UTF-8 text"),
+        (
+            "/dev/zero",
+            "not a regular file, and more than 256 MiB came from it",
+        ),
+    ] {
+        let out = d.0.join("out.png");
+        let (code, err) = status(&["render", source, "-o", out.to_str().unwrap()]);
+        assert_eq!(code, Some(1), "{source}: {err}");
+        assert!(
+            err.contains(source) && err.contains(says),
+            "{source}: {err}"
+        );
+        assert!(!out.exists());
+    }
+}
+
+/// Counts and sizes said as they are: a film one frame over the limit names its real number
+/// of frames, and a memory limit below a MiB is not "0 MiB".
+#[test]
+fn counts_and_sizes_are_said_exactly() {
+    // Frames at 0, 1, ..., 1,000,000: one more than the 1,000,000 allowed.
+    fails(
+        "film-count",
+        &format!("{GOOD}\n[film]\nstart = 0\nend = 1000000\nfps = 1\n"),
+        &[],
+        &["the film would have 1000001 frames; at most 1000000"],
+    );
+    fails("memory-1k", GOOD, &["--max-memory", "1K"], &["1 KiB"]);
+}

@@ -294,3 +294,86 @@ fn bad_farms_are_clear_errors() {
 fn out_pattern(dir: &Path) -> std::path::PathBuf {
     dir.join("g-##.exr")
 }
+
+/// An output name is text in the job scripts, never shell: `$(...)` and backticks in it run
+/// nothing when the tasks run, the tiles and the whole image get that very name, and a `%` is
+/// not taken by SLURM's `#SBATCH --output` pattern. A line break in it is refused by name.
+#[test]
+fn output_names_are_not_shell_or_slurm_patterns() {
+    let d = Dir::new("farm-names");
+    let still = d.file("still.toml", GOOD);
+    for (k, name) in [
+        "x$(touch${IFS}PWNED).exr",
+        "y`touch${IFS}PWNED2`;touch${IFS}PWNED3;%j.exr",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let out = d.0.join(name);
+        let (ok, err) = farm(
+            &d.0,
+            &["farm", "slurm", s(&still), "-o", s(&out), "--tiles", "2x1"],
+        );
+        assert!(ok, "{name}: {err}");
+        let logs = d.0.join("rest-embree-farm");
+        let scripts: Vec<_> = std::fs::read_dir(&logs)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "sbatch"))
+            .collect();
+        let tiles = scripts
+            .iter()
+            .find(|p| p.to_string_lossy().ends_with("-tiles.sbatch"))
+            .unwrap();
+        let assemble = scripts
+            .iter()
+            .find(|p| p.to_string_lossy().ends_with("-assemble.sbatch"))
+            .unwrap();
+        for p in &scripts {
+            let text = std::fs::read_to_string(p).unwrap();
+            for line in text.lines().filter(|l| l.starts_with("#SBATCH --output=")) {
+                // The log folder's own `%` (none here) doubled; the patterns SLURM is meant
+                // to fill are its own.
+                assert!(!line.contains("%j.exr"), "{line}");
+            }
+        }
+        for task in 0..2 {
+            let st = Command::new("bash")
+                .arg(tiles)
+                .current_dir(&d.0)
+                .env("SLURM_ARRAY_TASK_ID", task.to_string())
+                .status()
+                .unwrap();
+            assert!(st.success(), "{name}: task {task}");
+        }
+        let st = Command::new("bash")
+            .arg(assemble)
+            .current_dir(&d.0)
+            .status()
+            .unwrap();
+        assert!(st.success(), "{name}: assemble");
+        assert!(out.is_file(), "{name}: the whole image under its own name");
+        for pwned in ["PWNED", "PWNED2", "PWNED3"] {
+            assert!(!d.0.join(pwned).exists(), "{name}: the name ran a command");
+            assert!(
+                !std::path::Path::new(pwned).exists(),
+                "{name}: ran a command"
+            );
+        }
+        std::fs::remove_dir_all(&logs).unwrap();
+        let _ = k;
+    }
+    let (ok, err) = farm(
+        &d.0,
+        &[
+            "farm",
+            "slurm",
+            s(&still),
+            "-o",
+            s(&d.0.join("a\nb.exr")),
+            "--dry-run",
+        ],
+    );
+    assert!(!ok);
+    assert!(err.contains("has a line break"), "{err}");
+}

@@ -69,16 +69,36 @@ struct Job {
     tasks: u64,
 }
 
+/// `text` for a `#SBATCH --output` line, which sbatch reads itself (no shell): its own
+/// `%` patterns (`%j`, `%A`) written `%%` where the text means a `%`.
+fn slurm_pattern(text: &str) -> String {
+    text.replace('%', "%%")
+}
+
+/// A job name of the output's stem: letters, digits, `.`, `_` and `-`, the rest `_`.
+fn job_name(stem: &str) -> String {
+    stem.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
 fn script(name: &str, logs: &Path, array: Option<u64>, body: &str) -> String {
     let mut s = String::from("#!/bin/bash\n");
     let _ = writeln!(s, "#SBATCH --job-name={name}");
+    let logs = slurm_pattern(&logs.display().to_string());
     match array {
         Some(n) => {
             let _ = writeln!(s, "#SBATCH --array=0-{}", n - 1);
-            let _ = writeln!(s, "#SBATCH --output={}/{name}-%A_%a.out", logs.display());
+            let _ = writeln!(s, "#SBATCH --output={logs}/{name}-%A_%a.out");
         }
         None => {
-            let _ = writeln!(s, "#SBATCH --output={}/{name}-%j.out", logs.display());
+            let _ = writeln!(s, "#SBATCH --output={logs}/{name}-%j.out");
         }
     }
     s.push_str("# Written by `rest-embree farm slurm`. Watch: squeue --me, sacct -j JOBID; stop: scancel JOBID.\n");
@@ -103,11 +123,21 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
         crate::accel::backend_by_name(b).map_err(|e| e.on_flag("--backend"))?;
     }
     let output = absolute(&args.output)?;
-    if output.to_string_lossy().contains(char::is_whitespace) {
+    if let Some(c) = output
+        .to_string_lossy()
+        .chars()
+        .find(|c| c.is_whitespace() || c.is_control())
+    {
+        let what = match c {
+            ' ' => "a space".to_string(),
+            '\n' => "a line break".to_string(),
+            '\t' => "a tab".to_string(),
+            c => format!("the character {c:?}"),
+        };
         return Err(Error::flag(
             "-o",
             format!(
-                "`{}` has a space, which the job script's #SBATCH --output line cannot hold: choose a path without spaces",
+                "{:?} has {what}, which the job script's #SBATCH --output line cannot hold: choose a path without spaces or control characters",
                 output.display()
             ),
         ));
@@ -125,7 +155,7 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
         stem
     };
     let logs = dir.join("rest-embree-farm");
-    let name = format!("rest-embree-{stem}");
+    let name = format!("rest-embree-{}", job_name(&stem));
 
     let mut common = format!(
         "exe={}\nscene={}\n",
@@ -188,9 +218,11 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
                     tasks: 1,
                 });
             } else {
-                let pattern = tile("${SLURM_ARRAY_TASK_ID}").display().to_string();
+                // The tile's name quoted as a whole (a `$(...)` in the output's name is text),
+                // then the task's number.
+                let prefix = quote(&dir.join(format!("{stem}.tile-")).display().to_string());
                 let body = format!(
-                    "{common}exec \"$exe\" render \"$scene\" -o \"{pattern}\" --tiles {columns}x{rows} --tile \"$SLURM_ARRAY_TASK_ID\"{flags}\n"
+                    "{common}tile={prefix}\nexec \"$exe\" render \"$scene\" -o \"${{tile}}${{SLURM_ARRAY_TASK_ID}}.exr\" --tiles {columns}x{rows} --tile \"$SLURM_ARRAY_TASK_ID\"{flags}\n"
                 );
                 jobs.push(Job {
                     file: logs.join(format!("{stem}-tiles.sbatch")),

@@ -40,6 +40,14 @@ pub(crate) fn write_whole(
         if m.is_dir() {
             return Err(refuse("it is a directory".into()));
         }
+        // A device, FIFO or socket (`-o /dev/null`, or a link to one) would be replaced by a
+        // regular file: refused, left as it is.
+        if !m.is_file() {
+            return Err(refuse(format!(
+                "it is not a regular file ({}); it was left as it is",
+                kind_of(m)
+            )));
+        }
         if m.permissions().readonly() {
             return Err(refuse("the file is read-only; it was left as it is".into()));
         }
@@ -91,6 +99,29 @@ fn through_links(path: &Path) -> Result<PathBuf, String> {
         }
     }
     Err("too many levels of symbolic links".into())
+}
+
+/// What a file that is not a regular one is, in words.
+fn kind_of(m: &std::fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = m.file_type();
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    let _ = m;
+    "a special file"
 }
 
 fn partial_name(target: &Path, pid: u32) -> PathBuf {

@@ -28,14 +28,62 @@ pub fn load_file(
             return Err(SceneError::new(shown, "", why));
         }
     }
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        SceneError::new(
-            shown.clone(),
-            "",
-            format!("cannot read the scene file: {e}"),
-        )
-    })?;
+    let text = read_bounded(path, &shown)?;
     load_str(&shown, &text, overrides)
+}
+
+/// The most a scene path that is not a regular file (a FIFO, `<(...)`, a device) is read: it
+/// has no length to check beforehand, and `/dev/urandom` would never end.
+const MAX_STREAMED_SCENE: u64 = 256 << 20;
+
+/// The scene file's text, read a piece at a time: it ends with an error, not a hang or an
+/// abort, where the file is not UTF-8 text, is larger than memory allows
+/// (`BYTES_PER_SCENE_BYTE`) or, not being a regular file, runs past `MAX_STREAMED_SCENE`.
+fn read_bounded(path: &std::path::Path, shown: &str) -> Result<String, SceneError> {
+    use std::io::Read;
+    let fail = |why: String| SceneError::new(shown, "", why);
+    let mut file =
+        std::fs::File::open(path).map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
+    let regular = file.metadata().map(|m| m.is_file()).unwrap_or(false);
+    if file.metadata().is_ok_and(|m| m.is_dir()) {
+        return Err(fail("cannot read the scene file: it is a directory".into()));
+    }
+    let mut text = Vec::new();
+    let mut piece = vec![0u8; 1 << 16];
+    // Bytes known to be whole UTF-8 so far (a piece may end inside a character).
+    let mut checked = 0;
+    loop {
+        let n = match file.read(&mut piece) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(fail(format!("cannot read the scene file: {e}"))),
+        };
+        text.extend_from_slice(&piece[..n]);
+        match std::str::from_utf8(&text[checked..]) {
+            Ok(_) => checked = text.len(),
+            Err(e) if e.error_len().is_some() => {
+                return Err(fail(format!(
+                    "not UTF-8 text (an invalid byte at byte {}): a scene is a TOML text file",
+                    checked + e.valid_up_to()
+                )))
+            }
+            Err(e) => checked += e.valid_up_to(),
+        }
+        let len = text.len() as u64;
+        if !regular && len > MAX_STREAMED_SCENE {
+            return Err(fail(format!(
+                "not a regular file, and more than {} came from it: a scene is read whole",
+                crate::memory::human(MAX_STREAMED_SCENE)
+            )));
+        }
+        let need = len.saturating_mul(crate::memory::BYTES_PER_SCENE_BYTE);
+        let what = format!("reading a scene file of over {}", crate::memory::human(len));
+        if let Some(why) = crate::memory::too_much(need, &what) {
+            return Err(fail(why));
+        }
+    }
+    String::from_utf8(text).map_err(|_| fail("not UTF-8 text: it ends inside a character".into()))
 }
 
 /// As [`load_file`], from text; `file` names it in errors.
@@ -430,7 +478,11 @@ fn film(t: &Table, camera: &Camera) -> SceneResult<Film> {
         let key = if t.has("fps") { "fps" } else { "step" };
         return Err(t.error(
             key,
-            format!("the film would have {n:.0} frames; at most {MAX_FRAMES} are allowed"),
+            // Frames 0 ..= n: n + 1 of them.
+            format!(
+                "the film would have {:.0} frames; at most {MAX_FRAMES} are allowed",
+                n + 1.0
+            ),
         ));
     }
     t.finish(&["start", "end", "fps", "step"])?;
