@@ -11,6 +11,7 @@
 //! `toml_edit` on hostile input.
 
 use super::doc::{Form, Lines, Node, Origin, Val};
+use std::collections::HashMap;
 use toml_parser::decoder::{Encoding, ScalarKind};
 use toml_parser::lexer::{Token, TokenKind};
 use toml_parser::parser::{EventReceiver, RecursionGuard, ValidateWhitespace};
@@ -220,6 +221,9 @@ struct Builder<'i, 'l> {
     open: Vec<Open>,
     /// A value parsed on its own.
     value: Option<Node>,
+    /// Where each key of `current` is among its entries: a table of a million keys is read in
+    /// linear time, not by a search of its entries per key.
+    current_keys: HashMap<String, usize>,
 }
 
 fn table(origin: Origin, form: Form) -> Node {
@@ -248,6 +252,7 @@ impl<'i, 'l> Builder<'i, 'l> {
             in_header: None,
             open: Vec::new(),
             value: None,
+            current_keys: HashMap::new(),
         }
     }
 
@@ -266,7 +271,8 @@ impl<'i, 'l> Builder<'i, 'l> {
             None if self.place.lines.is_none() => self.value = Some(node),
             None => {
                 let key = std::mem::take(&mut self.doc_key);
-                insert(&mut self.current, key, node, self.place, error);
+                let index = Some(&mut self.current_keys);
+                insert_indexed(&mut self.current, index, key, node, self.place, error);
             }
         }
     }
@@ -274,6 +280,7 @@ impl<'i, 'l> Builder<'i, 'l> {
     /// The key/value lines of the last header are done: hang its table in the root.
     fn finish_table(&mut self) -> Option<ParseError> {
         let done = std::mem::replace(&mut self.current, table(self.place.fixed, Form::TABLE));
+        self.current_keys.clear();
         let Some(header) = self.header.take() else {
             self.root = done;
             return None;
@@ -342,6 +349,12 @@ impl<'i, 'l> Builder<'i, 'l> {
             }
         }
         self.header = Some(header);
+        self.current_keys.clear();
+        if let Val::Table(entries) = &fresh.val {
+            for (i, (k, _)) in entries.iter().enumerate() {
+                self.current_keys.insert(k.clone(), i);
+            }
+        }
         self.current = fresh;
         None
     }
@@ -360,7 +373,19 @@ fn fitted(mut node: Node) -> Node {
 /// Walk `path` from `table`, making implicit tables where nothing is (dotted ones when the path is
 /// a dotted key), and entering the last table of an array of tables.
 fn descend<'t>(
+    node: &'t mut Node,
+    path: &[Key],
+    dotted: bool,
+    place: Place,
+) -> Result<&'t mut Node, ParseError> {
+    descend_indexed(node, None, path, dotted, place)
+}
+
+/// `descend`, with `index` (where each key of `node` is among its entries, kept up to date)
+/// for the first step.
+fn descend_indexed<'t>(
     mut node: &'t mut Node,
+    mut index: Option<&mut HashMap<String, usize>>,
     path: &[Key],
     dotted: bool,
     place: Place,
@@ -370,7 +395,17 @@ fn descend<'t>(
         let Val::Table(entries) = &mut node.val else {
             return Err(err("cannot extend a value with a dotted key", key.at));
         };
-        let i = match entries.iter().position(|(k, _)| *k == key.name) {
+        let found = match index.take() {
+            Some(index) => {
+                let found = index.get(&key.name).copied();
+                if found.is_none() {
+                    index.insert(key.name.clone(), entries.len());
+                }
+                found
+            }
+            None => entries.iter().position(|(k, _)| *k == key.name),
+        };
+        let i = match found {
             Some(i) => i,
             None => {
                 let mut form = Form::TABLE.with(Form::IMPLICIT);
@@ -419,8 +454,14 @@ fn descend<'t>(
 }
 
 /// Put `value` at the dotted key `key` of `table`.
-fn insert(
+fn insert(table: &mut Node, key: Vec<Key>, value: Node, place: Place, error: &mut dyn ErrorSink) {
+    insert_indexed(table, None, key, value, place, error)
+}
+
+/// `insert`, with `index` (where each key of `table` is among its entries, kept up to date).
+fn insert_indexed(
     table: &mut Node,
+    mut index: Option<&mut HashMap<String, usize>>,
     key: Vec<Key>,
     mut value: Node,
     place: Place,
@@ -429,7 +470,12 @@ fn insert(
     let Some((last, path)) = key.split_last() else {
         return;
     };
-    let parent = match descend(table, path, true, place) {
+    // The index is the table's own: it serves the first step of a dotted key, or the key.
+    let (step, own) = match path.is_empty() {
+        true => (None, index.take()),
+        false => (index.take(), None),
+    };
+    let parent = match descend_indexed(table, step, path, true, place) {
         Ok(p) => p,
         Err(e) => return error.report_error(e),
     };
@@ -440,8 +486,15 @@ fn insert(
     let Val::Table(entries) = &mut parent.val else {
         return;
     };
-    if entries.iter().any(|(k, _)| *k == last.name) {
+    let taken = match &own {
+        Some(index) => index.contains_key(&last.name),
+        None => entries.iter().any(|(k, _)| *k == last.name),
+    };
+    if taken {
         return error.report_error(err("duplicate key", last.at));
+    }
+    if let Some(index) = own {
+        index.insert(last.name.clone(), entries.len());
     }
     value.origin = place.at(last.at);
     entries.push((last.name.clone(), value));
