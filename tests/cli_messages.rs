@@ -230,8 +230,9 @@ fn files_are_never_lost() {
     assert!(err.contains("read-only"), "{err}");
     assert_eq!(std::fs::read_to_string(&kept).unwrap(), "keep");
     // A partial file of a run that was killed (no process has this id) goes with the next run.
-    let stale = d.file(".out.png.partial-4194305", "half");
     let out = d.0.join("out.png");
+    let stale = rest_embree::output::file::partial_path(&out, 4_194_305);
+    std::fs::write(&stale, "half").unwrap();
     let (code, err) = status(&["render", s, "-o", out.to_str().unwrap(), "-q"]);
     assert_eq!(code, Some(0), "{err}");
     assert!(
@@ -325,7 +326,7 @@ fn a_stopped_render_leaves_no_partial_file() {
         ])
         .spawn()
         .unwrap();
-    let partial = d.0.join(format!(".out.png.partial-{}", child.id()));
+    let partial = rest_embree::output::file::partial_path(&d.0.join("out.png"), child.id());
     let start = Instant::now();
     while !partial.exists() {
         assert!(

@@ -1,9 +1,11 @@
 //! Writing a file so that no file is lost and none is left half-written: the bytes go to a
-//! hidden file beside the target (`.NAME.partial-PID`), are synced to the disk, and are renamed
+//! hidden file beside the target (`.NAME.partial-MACHINE-PID`), are synced to the disk, and are renamed
 //! over the target only when complete, with the target's permissions. A symbolic link is
 //! written through (the link stays, its target is replaced); a read-only target or a directory
-//! is refused. Partial files of runs that died (killed, or the machine stopped) are removed by
-//! the next write to the same name; the command line removes its own on Ctrl-C and SIGTERM
+//! is refused, and so is a device, FIFO or socket. Partial files of this machine's runs that
+//! died (killed, or the machine stopped) are removed by the next write to the same name; another
+//! node's on a shared file system, or another container's, are left to their writers
+//! ([`partial_path`]); the command line removes its own on Ctrl-C and SIGTERM
 //! ([`remove_partial_files`]).
 
 use crate::{Cause, Error};
@@ -124,16 +126,67 @@ fn kind_of(m: &std::fs::Metadata) -> &'static str {
     "a special file"
 }
 
-fn partial_name(target: &Path, pid: u32) -> PathBuf {
+/// The partial file process `pid` of this machine writes `target` through:
+/// `.NAME.partial-MACHINE-PID`, MACHINE naming the host, its boot and the PID namespace, so
+/// that a run that finds it can tell whether its writer is a process it can see (and whether
+/// that one still runs) or one on another node of a shared file system, or in another
+/// container, which it must leave alone.
+pub fn partial_path(target: &Path, pid: u32) -> PathBuf {
     let name = target
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    target.with_file_name(format!(".{name}.partial-{pid}"))
+    target.with_file_name(format!(".{name}.partial-{}-{pid}", machine()))
 }
 
-/// Remove the partial files of `target` left by processes that no longer run (Linux: no
-/// /proc/PID). Elsewhere, or where it cannot tell, it leaves them.
+fn partial_name(target: &Path, pid: u32) -> PathBuf {
+    partial_path(target, pid)
+}
+
+/// This machine as partial files name it: the host name, the first 8 digits of the boot id and
+/// the PID namespace's number (Linux; elsewhere the host name alone), in letters, digits, `.`
+/// and `_`.
+fn machine() -> String {
+    static MACHINE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    MACHINE
+        .get_or_init(|| {
+            let read = |p: &str| std::fs::read_to_string(p).unwrap_or_default();
+            let host = read("/proc/sys/kernel/hostname");
+            let host = if host.trim().is_empty() {
+                std::env::var("HOSTNAME").unwrap_or_else(|_| "host".into())
+            } else {
+                host
+            };
+            let boot: String = read("/proc/sys/kernel/random/boot_id")
+                .chars()
+                .filter(char::is_ascii_hexdigit)
+                .take(8)
+                .collect();
+            let ns = std::fs::read_link("/proc/self/ns/pid")
+                .map(|l| {
+                    l.to_string_lossy()
+                        .chars()
+                        .filter(char::is_ascii_digit)
+                        .collect::<String>()
+                })
+                .unwrap_or_default();
+            [host.trim(), &boot, &ns]
+                .iter()
+                .filter(|p| !p.is_empty())
+                .map(|p| {
+                    p.chars()
+                        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+                        .collect::<String>()
+                })
+                .collect::<Vec<_>>()
+                .join(".")
+        })
+        .clone()
+}
+
+/// Remove the partial files of `target` left by processes of this machine that no longer run
+/// (Linux: no /proc/PID). Another machine's, another container's, or where it cannot tell, it
+/// leaves.
 fn remove_stale_partials(target: &Path) {
     let (Some(dir), Some(name)) = (target.parent(), target.file_name()) else {
         return;
@@ -146,7 +199,7 @@ fn remove_stale_partials(target: &Path) {
     if !Path::new("/proc/self").exists() {
         return;
     }
-    let prefix = format!(".{}.partial-", name.to_string_lossy());
+    let prefix = format!(".{}.partial-{}-", name.to_string_lossy(), machine());
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };
@@ -248,13 +301,22 @@ mod tests {
         // Process 1 always runs: its partial file may be in the middle of being written.
         let live = partial_name(&target, 1);
         let other = partial_name(&d.join("other.exr"), 4_194_305);
-        for f in [&dead, &live, &other] {
+        // Another node's (or container's), or one of a version that did not name the
+        // machine: its process cannot be seen from here.
+        let elsewhere = d.join(".out.exr.partial-node7.0123abcd.4026531836-4194305");
+        let unnamed = d.join(".out.exr.partial-4194305");
+        for f in [&dead, &live, &other, &elsewhere, &unnamed] {
             std::fs::write(f, "half").unwrap();
         }
         write_whole(&target, bytes("whole")).unwrap();
         assert!(!dead.exists(), "a dead run's partial file is removed");
         assert!(live.exists(), "a running process's partial file is left");
         assert!(other.exists(), "another file's partials are not touched");
+        assert!(
+            elsewhere.exists() && unnamed.exists(),
+            "other machines' are left"
+        );
+        assert!(machine().contains('.'), "{}", machine());
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "whole");
     }
 }
