@@ -63,6 +63,36 @@ fn assembled_tiles_are_the_whole_render() {
     assert!(!ok && err.contains("uncovered"), "{err}");
     let (ok, err) = run(&["assemble", "-o", s(&bad), s(&tiles[0]), s(&tiles[0])]);
     assert!(!ok && err.contains("overlaps"), "{err}");
+    // A tile of another render (another view time) among them is refused.
+    let other = d.0.join("other.exr");
+    render(
+        &[
+            &[
+                "render",
+                s(&scene),
+                "-o",
+                s(&other),
+                "--tiles",
+                "3x2",
+                "--tile",
+                "0",
+                "--time",
+                "10.5",
+            ][..],
+            &size,
+        ]
+        .concat(),
+    );
+    let mut mixed = vec!["assemble", "-o", s(&bad)];
+    mixed.extend(
+        tiles
+            .iter()
+            .filter(|t| !t.ends_with("t0.exr"))
+            .map(|t| s(t)),
+    );
+    mixed.push(s(&other));
+    let (ok, err) = run(&mixed);
+    assert!(!ok && err.contains("another render"), "{err}");
     assert!(!bad.exists());
 }
 

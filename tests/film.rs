@@ -131,8 +131,12 @@ fn a_killed_film_resumed_gives_the_files_of_an_uninterrupted_one() {
         before < 25,
         "the film was killed before its end ({before} frames)"
     );
-    // A frame already there is not rendered again: mark one and see it kept.
-    std::fs::write(cut.join("frame-000.exr"), b"kept").unwrap();
+    // A finished frame of this render is not rendered again; anything else in a frame's place
+    // is: garbage (frame 0), a frame cut short (1), another frame's file (2, frame 3's).
+    std::fs::write(cut.join("frame-000.exr"), b"garbage").unwrap();
+    let one = std::fs::read(cut.join("frame-001.exr")).unwrap();
+    std::fs::write(cut.join("frame-001.exr"), &one[..one.len() / 2]).unwrap();
+    std::fs::copy(whole.join("frame-003.exr"), cut.join("frame-002.exr")).unwrap();
     let (ok, err) = run(&[
         "render",
         scene.to_str().unwrap(),
@@ -143,13 +147,22 @@ fn a_killed_film_resumed_gives_the_files_of_an_uninterrupted_one() {
     assert!(ok, "{err}");
     assert!(
         err.contains(&format!(
-            "{} frames rendered, {before} already there",
-            25 - before
+            "{} frames rendered, {} already there",
+            25 - before + 3,
+            before - 3
         )),
         "{err}"
     );
-    assert_eq!(std::fs::read(cut.join("frame-000.exr")).unwrap(), b"kept");
-    std::fs::copy(whole.join("frame-000.exr"), cut.join("frame-000.exr")).unwrap();
+    for (k, why) in [
+        (0, "not a readable EXR"),
+        (1, "cut short or damaged"),
+        (2, "from another render"),
+    ] {
+        assert!(
+            err.contains(&format!("frame {k}: ")) && err.contains(why),
+            "frame {k}: {err}"
+        );
+    }
     let mut names: Vec<String> = std::fs::read_dir(&cut)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -222,4 +235,58 @@ fn bad_films_are_clear_errors() {
         "fps = 4\nspeed = 2",
         &["film.speed", "unknown key"],
     );
+}
+
+/// The same for PNG frames: one cut short and one of another render (other samples) are
+/// rendered again, the rest kept, and the film ends as an uninterrupted one.
+#[test]
+fn a_png_film_resumed_renders_again_what_is_not_its_own() {
+    let d = Dir::new("film-png-resume");
+    let scene = d.file("film.toml", &film(0.3, ""));
+    let pattern = |dir: &str| d.0.join(dir).join("f-#.png").to_str().unwrap().to_string();
+    render(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        &pattern("whole"),
+        "-q",
+    ]);
+    render(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        &pattern("cut"),
+        "-q",
+    ]);
+    let other = ["--set", "image.samples=2", "-q"];
+    let mut args = vec!["render", scene.to_str().unwrap(), "-o"];
+    let other_pattern = pattern("other");
+    args.push(&other_pattern);
+    args.extend(other);
+    render(&args);
+    let cut = d.0.join("cut");
+    let one = std::fs::read(cut.join("f-1.png")).unwrap();
+    std::fs::write(cut.join("f-1.png"), &one[..one.len() - 40]).unwrap();
+    std::fs::copy(d.0.join("other/f-2.png"), cut.join("f-2.png")).unwrap();
+    let frames = std::fs::read_dir(&cut).unwrap().count();
+    let (ok, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        &pattern("cut"),
+        "--resume",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains(&format!("2 frames rendered, {} already there", frames - 2)),
+        "{err}"
+    );
+    for k in 0..frames {
+        let name = format!("f-{k}.png");
+        assert_eq!(
+            std::fs::read(cut.join(&name)).unwrap(),
+            std::fs::read(d.0.join("whole").join(&name)).unwrap(),
+            "{name}"
+        );
+    }
 }

@@ -112,13 +112,25 @@ pub(super) fn run(
     let build = t0.elapsed().as_secs_f64();
     let (mut rendered, mut skipped) = (0u64, 0u64);
     let mut render_secs = 0.0;
+    let shown: Vec<String> = args.overrides().into_iter().map(|(s, _)| s).collect();
     for k in first..=last {
         let path = pattern.path(k);
-        if args.resume && path.exists() {
-            skipped += 1;
-            continue;
-        }
         let frame_scene = scene.film_frame(k).expect("a film");
+        // A frame is done only if its file is a finished image of this very frame
+        // (`output::finished`); anything else in its place is rendered again.
+        if args.resume && std::fs::symlink_metadata(&path).is_ok() {
+            let id = crate::output::header::render_id(&frame_scene, backend_name, &shown);
+            match crate::output::finished(&path, format, frame_scene.image.frame_size(), &id) {
+                Ok(()) => {
+                    skipped += 1;
+                    continue;
+                }
+                Err(why) => eprintln!(
+                    "frame {k}: {} is not a finished frame of this render ({why}): rendering it again",
+                    path.display()
+                ),
+            }
+        }
         let t1 = std::time::Instant::now();
         let world = render::World::aim(&frame_scene, &rest, backend)?;
         let stats = render_to_file(&frame_scene, &world, backend_name, format, args, &path)?;

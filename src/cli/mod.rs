@@ -347,7 +347,9 @@ fn render_to_file(
         }
         output::Format::Png => {
             let alpha = scene.image.is_transparent();
-            let written = output::write_png_in_strips(path, (w, h), alpha, |put| {
+            let shown: Vec<String> = args.overrides().into_iter().map(|(s, _)| s).collect();
+            let id = output::header::render_id(scene, backend_name, &shown);
+            let written = output::write_png_in_strips(path, (w, h), alpha, Some(&id), |put| {
                 let strip = memory::STRIP_PIXELS;
                 let colour = Passes::Colour;
                 stats = render::render_world_in_strips(scene, world, colour, strip, progress, put)?;

@@ -16,6 +16,20 @@ fn bad(path: &Path, why: impl Into<String>) -> crate::Error {
     crate::Error::image(path, format!("tile {}: {why}", path.display()), None)
 }
 
+/// The render a tile says it is of (`header::render_id`), if it says.
+fn render_id(tile: &Tile) -> Option<String> {
+    tile.layer_data
+        .attributes
+        .other
+        .iter()
+        .chain(tile.attributes.other.iter())
+        .find(|(name, _)| **name == *super::header::RENDER_ID)
+        .and_then(|(_, v)| match v {
+            AttributeValue::Text(t) => Some(t.to_string()),
+            _ => None,
+        })
+}
+
 /// Join `tiles` into `output`.
 pub fn assemble(tiles: &[PathBuf], output: &Path) -> crate::Result<()> {
     let Some(first_path) = tiles.first() else {
@@ -59,6 +73,18 @@ pub fn assemble(tiles: &[PathBuf], output: &Path) -> crate::Result<()> {
             return Err(bad(
                 path,
                 "its full image (display window) differs from the first tile's",
+            ));
+        }
+        // Tiles of one render share its id (another view time, β or backend has another).
+        if render_id(&tile) != render_id(&first) {
+            return Err(bad(
+                path,
+                format!(
+                    "it is of another render than {} (renderId {} against {})",
+                    first_path.display(),
+                    render_id(&tile).unwrap_or_else(|| "none".into()),
+                    render_id(&first).unwrap_or_else(|| "none".into())
+                ),
             ));
         }
         let layer = &tile.layer_data;

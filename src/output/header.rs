@@ -143,6 +143,10 @@ pub fn attributes(
     if let Some(m) = world_to_ndc(cam, &scene.image) {
         attributes.push(("worldToNDC".into(), A::Matrix(as_f32(m))));
     }
+    attributes.push((
+        RENDER_ID.into(),
+        A::Text(render_id(scene, backend, overrides)),
+    ));
     // OpenEXR has no empty list of strings.
     for (name, list) in [
         ("renderOverrides", overrides.to_vec()),
@@ -153,6 +157,48 @@ pub fn attributes(
         }
     }
     attributes
+}
+
+/// The header attribute (and PNG text) holding `render_id`.
+pub const RENDER_ID: &str = "renderId";
+
+/// What identifies a render's settings, as hex: a hash of the whole scene as loaded (every
+/// value, the view time and the image settings but the crop included, overrides applied), the
+/// backend and the overrides as given. Two files with the same id are frames of the same render settings:
+/// `--resume` skips only a frame whose file says so. The hash is std's (SipHash with fixed
+/// keys), fed the scene's debug text as it is formatted, with no copy of it; another build of
+/// the compiler may hash differently, which costs a frame rendered again, nothing more.
+pub fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> String {
+    use std::fmt::Write as _;
+    use std::hash::Hasher;
+    struct Feed(std::hash::DefaultHasher);
+    impl std::fmt::Write for Feed {
+        fn write_str(&mut self, s: &str) -> std::fmt::Result {
+            self.0.write(s.as_bytes());
+            Ok(())
+        }
+    }
+    let mut feed = Feed(std::hash::DefaultHasher::new());
+    // Field by field, the image without its crop: the tiles of one render share its id.
+    let image = crate::scene::ImageSettings {
+        crop: None,
+        ..scene.image.clone()
+    };
+    let Scene {
+        camera,
+        render,
+        materials,
+        lights,
+        groups,
+        objects,
+        film,
+        image: _,
+    } = scene;
+    let _ = write!(
+        feed,
+        "{camera:?}|{image:?}|{render:?}|{materials:?}|{lights:?}|{groups:?}|{objects:?}|{film:?}|{backend}|{overrides:?}"
+    );
+    format!("{:016x}", feed.0.finish())
 }
 
 /// The names of the scene's objects and materials for the Cryptomatte manifests: an object's

@@ -6,6 +6,8 @@ pub mod cryptomatte;
 mod exr_block;
 mod exr_out;
 pub mod file;
+mod finished;
+pub use finished::finished;
 pub mod header;
 mod png_out;
 mod srgb8;
@@ -176,14 +178,16 @@ pub enum Attribute {
 
 /// Write a PNG of `width` × `height` whose rows `fill` hands on in strips, top to bottom, as
 /// it renders them: the image is never held whole.
+/// `render_id` (`header::render_id`), if given, goes into a text chunk.
 pub(crate) fn write_png_in_strips(
     path: &Path,
     (width, height): (u32, u32),
     alpha: bool,
+    render_id: Option<&str>,
     fill: impl FnOnce(&mut png_out::Strips) -> Result<(), Cause>,
 ) -> crate::Result<()> {
     file::write_whole(path, |tmp| {
-        png_out::write_strips(tmp, width, height, alpha, fill)
+        png_out::write_strips(tmp, width, height, alpha, render_id, fill)
     })
 }
 

@@ -14,7 +14,9 @@ pub type Strips<'a> = dyn FnMut(&Frame) -> Result<(), Cause> + 'a;
 /// [`write_strips`]).
 pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), Cause> {
     let alpha = frame.pixels.iter().any(|p| p.alpha != 1.0);
-    write_strips(path, frame.width, frame.height, alpha, |put| put(frame))
+    write_strips(path, frame.width, frame.height, alpha, None, |put| {
+        put(frame)
+    })
 }
 
 /// Write a `width` × `height` image whose rows `fill` hands to its sink in strips, top to
@@ -26,6 +28,7 @@ pub fn write_strips(
     width: u32,
     height: u32,
     alpha: bool,
+    render_id: Option<&str>,
     fill: impl FnOnce(&mut Strips) -> Result<(), Cause>,
 ) -> std::result::Result<(), Cause> {
     let file = std::fs::File::create(path).map_err(cause)?;
@@ -50,6 +53,10 @@ pub fn write_strips(
     let software = concat!("rest-embree ", env!("CARGO_PKG_VERSION"));
     enc.add_text_chunk("Software".into(), software.into())
         .map_err(cause)?;
+    if let Some(id) = render_id {
+        enc.add_text_chunk(super::header::RENDER_ID.into(), id.into())
+            .map_err(cause)?;
+    }
     let mut w = enc.write_header().map_err(cause)?;
     let mut stream = w.stream_writer().map_err(cause)?;
     let mut rows = 0u64;

@@ -63,7 +63,7 @@ fn a_png_written_in_strips_is_the_whole_frame() {
     let world = World::build(&s, backend_by_name("bvh").unwrap().as_ref()).unwrap();
     let (whole, _) = render_world_passes(&s, &world, Passes::Colour);
     let path = std::env::temp_dir().join(format!("rest-embree-strips-{}.png", std::process::id()));
-    crate::output::write_png_in_strips(&path, (whole.width, whole.height), false, |put| {
+    crate::output::write_png_in_strips(&path, (whole.width, whole.height), false, None, |put| {
         render_world_in_strips(&s, &world, Passes::Colour, 1, None, |b: &Frame| put(b)).map(|_| ())
     })
     .unwrap();

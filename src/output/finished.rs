@@ -1,0 +1,103 @@
+//! Whether a file is a finished image of a render, for a film's `--resume`: a regular file that
+//! reads to its end as the format says (every EXR chunk its offset table promises, every PNG
+//! row), of the frame's size, that names the same render (`header::render_id`, an EXR
+//! attribute and a PNG text chunk). A file that is empty, cut short, garbage, a directory, the
+//! wrong size or another render's is not, whatever its name.
+
+use super::header::RENDER_ID;
+use super::Format;
+use std::io::BufReader;
+use std::path::Path;
+
+/// Ok if `path` is a finished `format` image of `size` (the frame's) from render `id`; else
+/// why not.
+pub fn finished(path: &Path, format: Format, size: (u32, u32), id: &str) -> Result<(), String> {
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err("not a regular file".into());
+    }
+    if meta.len() == 0 {
+        return Err("empty".into());
+    }
+    match format {
+        Format::Png => png(path, size, id),
+        Format::Exr => exr(path, size, id),
+    }
+}
+
+fn png(path: &Path, size: (u32, u32), id: &str) -> Result<(), String> {
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut reader = png::Decoder::new(BufReader::new(file))
+        .read_info()
+        .map_err(|e| format!("not a readable PNG ({e})"))?;
+    let info = reader.info();
+    if (info.width, info.height) != size {
+        return Err(format!(
+            "{}x{}, not the frame's {}x{}",
+            info.width, info.height, size.0, size.1
+        ));
+    }
+    let said = info
+        .uncompressed_latin1_text
+        .iter()
+        .find(|t| t.keyword == RENDER_ID)
+        .map(|t| t.text.clone());
+    if said.as_deref() != Some(id) {
+        return Err("from another render (or none said)".into());
+    }
+    let mut rows = 0;
+    while let Some(_row) = reader
+        .next_row()
+        .map_err(|e| format!("cut short or damaged ({e})"))?
+    {
+        rows += 1;
+    }
+    if rows != size.1 {
+        return Err(format!("{rows} rows of {}", size.1));
+    }
+    Ok(())
+}
+
+fn exr(path: &Path, size: (u32, u32), id: &str) -> Result<(), String> {
+    use exr::meta::attribute::AttributeValue;
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let reader = exr::block::read(BufReader::new(file), false)
+        .map_err(|e| format!("not a readable EXR ({e})"))?;
+    let headers = reader.headers();
+    if headers.len() != 1 {
+        return Err(format!("{} layers, not one", headers.len()));
+    }
+    let header = &headers[0];
+    let window = header.layer_size;
+    if (window.0 as u32, window.1 as u32) != size {
+        return Err(format!(
+            "{}x{}, not the frame's {}x{}",
+            window.0, window.1, size.0, size.1
+        ));
+    }
+    let said = header
+        .own_attributes
+        .other
+        .iter()
+        .find(|(name, _)| *name == RENDER_ID)
+        .and_then(|(_, v)| match v {
+            AttributeValue::Text(t) => Some(t.to_string()),
+            _ => None,
+        });
+    if said.as_deref() != Some(id) {
+        return Err("from another render (or none said)".into());
+    }
+    let expected = header.chunk_count;
+    let mut chunks = 0;
+    for chunk in reader
+        .all_chunks(false)
+        .map_err(|e| format!("cut short or damaged ({e})"))?
+    {
+        chunk.map_err(|e| format!("cut short or damaged ({e})"))?;
+        chunks += 1;
+    }
+    if chunks != expected {
+        return Err(format!("{chunks} of its {expected} blocks"));
+    }
+    Ok(())
+}
