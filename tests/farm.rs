@@ -407,3 +407,35 @@ fn output_names_are_not_shell_or_slurm_patterns() {
     assert!(!ok);
     assert!(err.contains("has a line break"), "{err}");
 }
+
+/// A grid of more tiles than a job array takes (SLURM's MaxArraySize, read with scontrol where
+/// it can be, else SLURM's default of 1001) is refused before anything is written or
+/// submitted, with a grid that fits.
+#[test]
+fn a_grid_larger_than_a_job_array_is_refused() {
+    let d = Dir::new("farm-array");
+    let still = d.file("still.toml", GOOD);
+    let out = d.0.join("big.exr");
+    let (ok, err) = farm(
+        &d.0,
+        &[
+            "farm",
+            "slurm",
+            s(&still),
+            "-o",
+            s(&out),
+            "--tiles",
+            "250x200",
+            "--set",
+            "image.width=1000",
+            "--set",
+            "image.height=1000",
+        ],
+    );
+    assert!(!ok);
+    assert!(
+        err.contains("50000 tiles") && err.contains("MaxArraySize") && err.contains("--tiles "),
+        "{err}"
+    );
+    assert!(!d.0.join("submitted").exists() && !d.0.join("rest-embree-farm").exists());
+}

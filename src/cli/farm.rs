@@ -13,6 +13,33 @@ use std::path::{Path, PathBuf};
 /// runs of consecutive frames per task.
 const MAX_TASKS: u64 = 1000;
 
+/// SLURM's default `MaxArraySize`: job arrays of indices 0 to 1000.
+const DEFAULT_MAX_ARRAY_SIZE: u64 = 1001;
+
+/// The cluster's `MaxArraySize` (`scontrol show config`), and whether it was read there (else
+/// SLURM's default).
+fn max_array_size() -> (u64, bool) {
+    let read = std::process::Command::new("scontrol")
+        .args(["show", "config"])
+        .stdin(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .and_then(|o| {
+            String::from_utf8_lossy(&o.stdout).lines().find_map(|l| {
+                let (key, value) = l.split_once('=')?;
+                (key.trim() == "MaxArraySize")
+                    .then(|| value.trim().parse::<u64>().ok())
+                    .flatten()
+            })
+        });
+    match read {
+        Some(n) => (n, true),
+        None => (DEFAULT_MAX_ARRAY_SIZE, false),
+    }
+}
+
 #[derive(Subcommand, Debug)]
 pub(crate) enum Scheduler {
     /// Submit to SLURM: a job array (one task per frame of a film, or per tile of a still) and,
@@ -204,6 +231,22 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
                 ));
             }
             let tasks = u64::from(columns) * u64::from(rows);
+            // One task a tile, in one job array: no more than the cluster takes.
+            let (max, read) = max_array_size();
+            if tasks > max {
+                let side = (max as f64).sqrt().floor() as u64;
+                return Err(Error::flag(
+                    "--tiles",
+                    format!(
+                        "{columns}x{rows} is {tasks} tiles, one task each, and the cluster's job arrays take at most {max} tasks (MaxArraySize {max}{}): choose fewer tiles, e.g. --tiles {side}x{side}",
+                        if read {
+                            ", from scontrol show config"
+                        } else {
+                            ": SLURM's default, as scontrol could not say"
+                        }
+                    ),
+                ));
+            }
             let tile = |i: &str| dir.join(format!("{stem}.tile-{i}.exr"));
             if grid.is_none() {
                 let _ = writeln!(common, "out={}", quote(&output.display().to_string()));
