@@ -692,3 +692,24 @@ fn counts_and_sizes_are_said_exactly() {
     );
     fails("memory-1k", GOOD, &["--max-memory", "1K"], &["1 KiB"]);
 }
+
+/// A scene file whose values would not fit in the memory allowed is refused before it is
+/// parsed, naming the file and the limit, though its text alone would fit: 200,000 vertices
+/// of 8 bytes are 1.6 MB of text and about 150 MiB of tree.
+#[test]
+fn a_scene_whose_values_do_not_fit_is_refused_before_parsing() {
+    let vertices = vec!["[0,0,0]"; 200_000].join(",");
+    let text = format!(
+        "{GOOD}\n[[group]]\nname = \"mesh\"\n[[group.object]]\ntype = \"mesh\"\nvertices = [{vertices}]\nindices = [[0, 1, 2]]\n"
+    );
+    fails(
+        "values-too-big",
+        &text,
+        &["--max-memory", "60M"],
+        &[
+            "scene.toml",
+            "every value kept with its line",
+            "--max-memory",
+        ],
+    );
+}

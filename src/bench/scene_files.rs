@@ -79,9 +79,11 @@ pub(crate) fn scene_file_here(kind: &str, size: usize) -> String {
     match (loaded, before, after) {
         (Ok(_), Some(b), Some(a)) => format!(
             "- scene file, {what} ({mb:.1} MB): read in {secs:.2} s, peak memory {:.0} MiB \
-             above its text = {:.1} bytes per byte of the file",
+             above its text = {:.1} bytes per byte of the file; the estimate a render checks \
+             against its memory, an upper bound, {:.0} MiB",
             a - b,
-            (a - b) * 1048576.0 / text.len() as f64
+            (a - b) * 1048576.0 / text.len() as f64,
+            crate::memory::scene_bytes(text.as_bytes()) as f64 / 1048576.0
         ),
         (Ok(_), _, _) => format!("- scene file, {what} ({mb:.1} MB): read in {secs:.2} s"),
         (Err(e), _, _) => format!("- scene file, {what}: not read: {e}"),

@@ -19,8 +19,7 @@ pub fn load_file(
     overrides: &[(String, String)],
 ) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
-    // Parsing keeps every value with its place in the file (`BYTES_PER_SCENE_BYTE`). Refused
-    // here rather than aborted halfway.
+    // The text alone first (`BYTES_PER_SCENE_BYTE`), before it is read; its values after.
     if let Ok(m) = std::fs::metadata(path) {
         let need = m.len().saturating_mul(crate::memory::BYTES_PER_SCENE_BYTE);
         let what = format!("reading a scene file of {}", crate::memory::human(m.len()));
@@ -29,6 +28,15 @@ pub fn load_file(
         }
     }
     let text = read_bounded(path, &shown)?;
+    // The tree is refused here, by the file's count of values, rather than aborted halfway.
+    let need = crate::memory::scene_bytes(text.as_bytes());
+    let what = format!(
+        "reading the scene file ({}, every value kept with its line)",
+        crate::memory::human(text.len() as u64)
+    );
+    if let Some(why) = crate::memory::too_much(need, &what) {
+        return Err(SceneError::new(shown, "", why));
+    }
     load_str(&shown, &text, overrides)
 }
 
