@@ -285,10 +285,11 @@ fn renders_beyond_the_memory_limit_are_refused() {
     let (code, err) = status(&["render", s, "-o", o, "--max-memory", "64M", "-q"]);
     assert_eq!(code, Some(0), "a small render fits: {err}");
     assert!(out.exists());
-    // A scene file too large to read within the limit (here 100 kB of comment at 1 MiB).
+    // A scene file too large to read within the limit (here 200 kB of comment at 1 MiB: its
+    // text, at 8 bytes of memory per byte, before a value is counted).
     let padded = d.file(
         "padded.toml",
-        &format!("{GOOD}\n#{}\n", "x".repeat(100_000)),
+        &format!("{GOOD}\n#{}\n", "x".repeat(200_000)),
     );
     let p = padded.to_str().unwrap();
     let (code, err) = status(&["render", p, "-o", o, "--max-memory", "1M"]);
