@@ -714,3 +714,46 @@ fn a_scene_whose_values_do_not_fit_is_refused_before_parsing() {
         ],
     );
 }
+
+/// Colours given as RGB that a scene shows far shifted (a dark-blue sky approached at 0.5c:
+/// D = 1.73 ahead) are warned of once, saying why; not where the colour is grey (exactly flat)
+/// or the Doppler shift is off.
+#[test]
+fn far_shifted_rgb_colours_are_warned_of() {
+    let scene = "[camera]\nposition = [0, 0, 0]\nlook_at = [0, 10, 0]\nvelocity = [0, 0.5, 0]\n\
+                 [image]\nwidth = 16\nheight = 16\nbackground = [0.02, 0.05, 0.3]\n\
+                 [[group]]\nname = \"g\"\n[[group.object]]\ntype = \"sphere\"\ncenter = [0, 10, 0]\nradius = 1\n";
+    let d = Dir::new("shift-warning");
+    let out = d.0.join("out.png");
+    let o = out.to_str().unwrap();
+    let blue = d.file("blue.toml", scene);
+    let (ok, err) = run(&["render", blue.to_str().unwrap(), "-o", o, "-q"]);
+    assert!(ok, "{err}");
+    assert_eq!(
+        err.matches("warning: colours given as RGB").count(),
+        1,
+        "{err}"
+    );
+    for needle in [
+        "D = 1.73",
+        "the background",
+        "0.50c",
+        "outside 380-780 nm",
+        "section 6.1",
+    ] {
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    let grey = d.file("grey.toml", &scene.replace("[0.02, 0.05, 0.3]", "0.2"));
+    let (ok, err) = run(&["render", grey.to_str().unwrap(), "-o", o, "-q"]);
+    assert!(ok && !err.contains("warning"), "{err}");
+    let (ok, err) = run(&[
+        "render",
+        blue.to_str().unwrap(),
+        "-o",
+        o,
+        "-q",
+        "--set",
+        "render.doppler=false",
+    ]);
+    assert!(ok && !err.contains("warning"), "{err}");
+}

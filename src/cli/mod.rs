@@ -632,6 +632,9 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         scene.image.crop = Some(tiles::tile_crop(&scene, format, grid, index, &shown)?);
     }
     fits_in_memory(&scene, format, args)?;
+    if let Some(w) = render::extrapolation_warning(&scene) {
+        eprintln!("{w}");
+    }
     if scene.film.is_some() || args.frames.is_some() {
         return film::run(&scene, backend.as_ref(), &backend_name, format, args);
     }

@@ -191,3 +191,60 @@ pub fn needs_spectra(scene: &Scene) -> bool {
     }
     frames.iter().any(|f| *f != frames[0])
 }
+
+/// The Doppler factor from which on most of the camera's 380-780 nm left a source beyond one
+/// end of the band: 580 D > 780 (beyond the red end), or 580 D < 380 (beyond the violet end).
+const MOSTLY_OUTSIDE: (f64, f64) = (380.0 / 580.0, 780.0 / 580.0);
+
+/// A warning where a scene's colours given as RGB (not grey) may be seen so far shifted that
+/// most of what the camera sees of them comes from outside 380-780 nm, where an RGB colour says
+/// nothing and its uplifted spectrum is held at its end values (docs/physics.md §6.1): the
+/// largest Doppler factor between the camera and a group or the background, from their
+/// relative rapidity, against [`MOSTLY_OUTSIDE`]. A bound: a group seen only sideways may
+/// never show it.
+pub fn extrapolation_warning(scene: &Scene) -> Option<String> {
+    use crate::spacetime::Velocity;
+    if !scene.render.doppler {
+        return None;
+    }
+    let coloured = |c: &crate::spectrum::Colour| {
+        c.from_rgb && !c.is_black() && !(c.rgb.x == c.rgb.y && c.rgb.y == c.rgb.z)
+    };
+    let materials = scene.materials.iter().any(|m| {
+        coloured(&m.color) || coloured(&m.specular) || m.emission.as_ref().is_some_and(coloured)
+    });
+    let cam = &scene.camera.velocity;
+    // The rapidity between two velocities: cosh φ = γ_u γ_v (1 − u·v).
+    let between = |v: &Velocity| {
+        let c = cam.gamma() * v.gamma() * (1.0 - cam.beta_vec().dot(v.beta_vec()));
+        c.max(1.0).acosh()
+    };
+    let mut worst: Option<(f64, String)> = None;
+    let mut consider = |phi: f64, what: String| {
+        if worst.as_ref().is_none_or(|(w, _)| phi > *w) {
+            worst = Some((phi, what));
+        }
+    };
+    if coloured(&scene.image.background) {
+        consider(between(&Velocity::ZERO), "the background".to_string());
+    }
+    if materials {
+        for g in scene.groups.iter().filter(|g| !g.geometry.is_empty()) {
+            consider(between(&g.velocity), format!("group `{}`", g.name));
+        }
+    }
+    let (phi, what) = worst?;
+    let d = phi.exp();
+    (d > MOSTLY_OUTSIDE.1).then(|| {
+        format!(
+            "warning: colours given as RGB may be seen shifted by up to D = {d:.2} ({what} moves at \
+             {:.2}c relative to the camera): from D = {:.2} on (or below {:.2}) most of what the \
+             camera sees of them left at wavelengths outside 380-780 nm, where an RGB colour says \
+             nothing and its spectrum is held at its end values; give such a colour as a spectrum \
+             to say what it is there (docs/physics.md, section 6.1)",
+            phi.tanh(),
+            MOSTLY_OUTSIDE.1,
+            MOSTLY_OUTSIDE.0
+        )
+    })
+}

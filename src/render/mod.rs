@@ -16,7 +16,7 @@ mod shade;
 mod tile;
 mod world;
 
-pub use band::needs_spectra;
+pub use band::{extrapolation_warning, needs_spectra};
 pub use frame::{pass, Frame, Mattes, PixelValue, CHANNELS, DEPTH_FAR, MATTE_RANKS};
 pub use world::{WorldOptions, INSTANCE_OVER};
 
