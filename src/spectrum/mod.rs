@@ -119,6 +119,30 @@ pub fn planck(nm: f64, kelvin: f64) -> f64 {
 }
 
 impl Spectrum {
+    /// The spectrum's mean over the camera bin centred at `nm` (edges nm·e^{∓h},
+    /// [`camera::bin_half_ln`]): the value at `nm` for every kind but a line, which is
+    /// integrated over the bin (erf) and divided by its width, so that a line far narrower than
+    /// a bin is read as the light it holds wherever its centre falls, not as its peak or as
+    /// nothing. For lines as wide as a bin or wider it is the value at `nm` to within the
+    /// quadrature's own error.
+    pub fn bin_mean(&self, nm: f64) -> f64 {
+        match self {
+            Spectrum::Line {
+                centre,
+                fwhm,
+                scale,
+            } => {
+                let h = camera::bin_half_ln();
+                let (a, b) = (nm * (-h).exp(), nm * h.exp());
+                let sigma = fwhm / (2.0 * (2.0 * std::f64::consts::LN_2).sqrt());
+                let below =
+                    |x: f64| 0.5 * libm::erfc(-(x - centre) / (sigma * std::f64::consts::SQRT_2));
+                scale * (below(b) - below(a)) / (b - a)
+            }
+            _ => self.at(nm),
+        }
+    }
+
     /// The value at wavelength `nm` (nanometres, > 0).
     pub fn at(&self, nm: f64) -> f64 {
         match self {
@@ -232,7 +256,7 @@ impl Colour {
     /// emitter), or under the white (as a reflectance).
     pub fn spectral(spectrum: Spectrum, role: Role) -> Colour {
         let rgb = match role {
-            Role::Emitter => camera::rgb_of(|nm| spectrum.at(nm)),
+            Role::Emitter => camera::rgb_of(|nm| spectrum.bin_mean(nm)),
             Role::Reflectance => camera::rgb_of(|nm| spectrum.at(nm) * camera::white(nm)),
         };
         Colour::new(rgb, spectrum, false)

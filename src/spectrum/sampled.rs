@@ -29,7 +29,8 @@ impl Sampled {
             Spectrum::Blackbody { kelvin, scale } => Sampled(std::array::from_fn(|i| {
                 scale * super::planck(shift * l[i], *kelvin)
             })),
-            _ => Sampled(std::array::from_fn(|i| spectrum.at(shift * l[i]))),
+            // Lines as their mean over each bin (`Spectrum::bin_mean`), tables as sampled.
+            _ => Sampled(std::array::from_fn(|i| spectrum.bin_mean(shift * l[i]))),
         }
     }
 }
