@@ -19,15 +19,16 @@ demo: setup
 	./target/release/rest-embree render scenes/passing_spheres.toml -o $(OUT)/passing-spheres.png
 	@echo "demo: wrote $(OUT)/lattice-0.9.png, $(OUT)/lattice-0.9.exr and $(OUT)/passing-spheres.png"
 
-# Every test, optimised, with the Embree backend and without it; between them, a real one-node
-# SLURM cluster runs a film and a tiled still through `rest-embree farm slurm`
-# (scripts/slurm-test.sh; it needs root, and says so when skipped). `--release` builds the
-# tests in target/release beside `make demo`'s binary, on the same optimised dependencies: one
-# optimised build of everything, not a second one in target/debug with full debug info.
+# Every test, optimised, without the Embree backend and with it; then a real one-node SLURM
+# cluster runs a film and a tiled still through `rest-embree farm slurm` (scripts/slurm-test.sh;
+# it needs root, and says so when skipped). `--release` builds the tests in target/release
+# beside `make demo`'s binary, on the same optimised dependencies: one optimised build of
+# everything, not a second one in target/debug with full debug info. The build without Embree
+# goes first, so the binary left in target/release is the one with it.
 test: setup
+	$(CARGO) test --release --no-default-features
 	$(CARGO) test --release --workspace
 	scripts/slurm-test.sh target/release/rest-embree
-	$(CARGO) test --release --no-default-features
 
 # A film's frames as an MP4 (ffmpeg): make film FRAMES='film/frame-%04d.png' FPS=24 MP4=film.mp4
 FRAMES ?= film/frame-%04d.png
