@@ -29,7 +29,7 @@ impl EmbreeAccel {
     pub fn trace_bare(&self, rays: &[BareRay]) -> usize {
         flush_denormals();
         // No f64 rays: user geometry tests Embree's own f32 rays.
-        let lanes = Lanes::<16>::new(&[]);
+        let lanes = Lanes::<16>::new(&[], self.pullback);
         let mut context = self.context(Query::Intersect, &[], &lanes);
         let ctx = context.raw();
         let mut hits = 0;
@@ -69,6 +69,7 @@ impl BareRay {
             tnear: 0.0,
             tfar: f32::INFINITY,
             active: true,
+            offset: 0.0,
         }
     }
 }

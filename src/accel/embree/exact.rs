@@ -82,9 +82,10 @@ pub(super) struct ExactContext<'a> {
     rays: &'a [Ray],
     /// Embree coordinates are the caller's minus this.
     center: DVec3,
-    /// Embree's t = t · scale(len) + pullback (the caller's ray was pulled back, and
-    /// normalised where its length is far from 1: `scale`, `Ray::len`).
-    pullback: f64,
+    /// Embree's t = t · scale(len) + offset, by ray (the caller's ray was pulled back, moved
+    /// up to the scene from afar, and normalised where its length is far from 1: `scale`,
+    /// `Ray::len`, `EmbreeRay::offset`).
+    offset: &'a [Cell<f64>],
     /// The exact t of the closest user-geometry hit so far in each lane (starts at tmax).
     best: &'a [Cell<f64>],
     /// What went wrong in a callback of this query, for the query to record (`Fault`).
@@ -102,12 +103,16 @@ pub(super) fn guarded(callback: Callback, ctx: &ExactContext, body: impl FnOnce(
 /// Per-lane storage of an `ExactContext` for up to N rays.
 pub(super) struct Lanes<const N: usize> {
     pub best: [Cell<f64>; N],
+    /// Each ray's Embree t = t · scale + offset (`EmbreeRay::offset`); the pullback until the
+    /// query sets it.
+    pub offset: [Cell<f64>; N],
 }
 
 impl<const N: usize> Lanes<N> {
-    pub fn new(rays: &[Ray]) -> Self {
+    pub fn new(rays: &[Ray], pullback: f64) -> Self {
         Lanes {
             best: std::array::from_fn(|i| Cell::new(rays.get(i).map_or(f64::INFINITY, |r| r.tmax))),
+            offset: std::array::from_fn(|_| Cell::new(pullback)),
         }
     }
 }
@@ -136,14 +141,13 @@ impl<'a> ExactContext<'a> {
         rays: &'a [Ray],
         lanes: &'a Lanes<N>,
         center: DVec3,
-        pullback: f64,
         inject: Option<&'a Injection>,
     ) -> Self {
         ExactContext {
             rtc: initial_context(coherent),
             rays: &rays[..rays.len().min(N)],
             center,
-            pullback,
+            offset: &lanes.offset,
             best: &lanes.best,
             fault: Cell::new(Fault::None),
             inject,
@@ -243,8 +247,13 @@ pub(super) fn everything() -> RTCBounds {
 
 /// The f32 box holding the f64 box (lo, hi): rounded outward.
 pub(super) fn outward(lo: DVec3, hi: DVec3) -> RTCBounds {
-    let down = |x: f64| (x as f32).next_down();
-    let up = |x: f64| (x as f32).next_up();
+    // Padded by 16 f32 ulps of the box's largest coordinate, not one: Embree's packet
+    // traversal without FMA (SSE, AVX) rounds its slab tests coarser than its single rays and
+    // lost rays grazing an edge. The exact test decides every hit, so a wider box only costs
+    // a callback now and then.
+    let pad = 16.0 * f64::from(f32::EPSILON) * lo.abs().max(hi.abs()).max_element();
+    let down = |x: f64| ((x - pad) as f32).next_down();
+    let up = |x: f64| ((x + pad) as f32).next_up();
     RTCBounds {
         lower_x: down(lo.x),
         lower_y: down(lo.y),
@@ -345,8 +354,8 @@ unsafe fn embree_t(
     if ctx.rays.is_empty() {
         return Some((t as f32).clamp(tmin as f32, tmax as f32));
     }
-    let (ray, best) = (ctx.rays.get(r)?, ctx.best.get(r)?);
-    let te = (t * scale(ray.len) + ctx.pullback) as f32;
+    let (ray, best, offset) = (ctx.rays.get(r)?, ctx.best.get(r)?, ctx.offset.get(r)?);
+    let te = (t * scale(ray.len) + offset.get()) as f32;
     // Embree's tfar may have been lowered by one of its own primitives.
     let tfar = unsafe { *base.add(TFAR * n + i) };
     (te <= tfar).then(|| {

@@ -122,7 +122,7 @@ macro_rules! fan_packet {
                             len: out.s[first + i],
                         }
                     });
-                    let lanes = Lanes::<N>::new(&rays[..n]);
+                    let lanes = Lanes::<N>::new(&rays[..n], self.pullback);
                     let mut valid = Valid([0i32; N]);
                     for i in 0..n {
                         rh.ray.tfar[i] = f32::INFINITY;
@@ -158,6 +158,7 @@ macro_rules! fan_packet {
                                     rh.hit.geomID[i],
                                     rh.hit.primID[i],
                                     ctx.exact_t(i),
+                                    self.pullback,
                                 )
                             })
                             .flatten();

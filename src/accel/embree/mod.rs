@@ -132,6 +132,7 @@ impl EmbreeBackend {
             // How far a ray's origin is pulled back before the f32 cast, so geometry flush with
             // the bounds (where the renderer put the origin) is not lost to f32 rounding.
             pullback: 1e-4 * diag.max(1e-6),
+            diag,
             device,
         })
     }
@@ -223,6 +224,8 @@ pub struct EmbreeAccel {
     geometry: Arc<Geometry>,
     width: usize,
     pullback: f64,
+    /// The diagonal of the geometry's bounds.
+    diag: f64,
     /// Where faults in callbacks are recorded (and whether to inject one).
     device: Arc<Device>,
 }
@@ -235,6 +238,9 @@ struct EmbreeRay {
     tnear: f32,
     tfar: f32,
     active: bool,
+    /// Embree's t = t · scale + offset for this ray: the pullback, less how far (in Embree's
+    /// units) the origin was moved up to the scene's bounds (`embree_ray`).
+    offset: f64,
 }
 
 /// Directions this long, within a factor of the unit, Embree traces as they are (`scale`).
@@ -288,11 +294,29 @@ impl EmbreeAccel {
         if !r.is_active() {
             return EmbreeRay::default();
         }
-        let o = r.origin - self.scene.center;
         let (d, k) = (r.dir, scale(r.len));
-        let (o, du, tnear) =
-            lane_geometry([o.x, o.y, o.z], [d.x, d.y, d.z], k, r.tmin, self.pullback);
-        let tfar = r.tmax * k + self.pullback;
+        // A ray from far off is moved, in f64, up to where it enters the scene's bounds: f32
+        // then rounds coordinates of the scene's size, not of its distance. Embree's code paths
+        // without FMA (SSE, AVX) lose packet rays that graze a box from 10⁵ away otherwise,
+        // which single rays and AVX2's find. Near rays are traced as they are.
+        let far = self
+            .geometry
+            .bounds()
+            .clip(r.origin, d.recip(), r.tmin, r.tmax);
+        let shift = match far {
+            Some((enter, _)) if enter * r.len > 4.0 * self.diag => enter,
+            _ => 0.0,
+        };
+        let offset = self.pullback - shift * k;
+        let o = r.origin + shift * d - self.scene.center;
+        let (o, du, tnear) = lane_geometry(
+            [o.x, o.y, o.z],
+            [d.x, d.y, d.z],
+            k,
+            r.tmin - shift,
+            self.pullback,
+        );
+        let tfar = r.tmax * k + offset;
         EmbreeRay {
             org: o.map(|x| x as f32),
             dir: du.map(|x| x as f32),
@@ -303,20 +327,30 @@ impl EmbreeAccel {
                 f32::INFINITY
             },
             active: true,
+            offset,
         }
     }
 
     /// Embree's hit back in the caller's units: exact already for user geometry (`exact_t`,
     /// from the context), else refined in f64 on the primitive that was hit (Embree's t is
-    /// t · `scale(r.len)` + pullback).
+    /// t · `scale(r.len)` + `offset`, `EmbreeRay::offset`).
     #[inline(always)]
-    fn to_hit(&self, r: &Ray, t_embree: f32, geom: u32, prim: u32, exact_t: f64) -> Option<Hit> {
+    #[allow(clippy::too_many_arguments)]
+    fn to_hit(
+        &self,
+        r: &Ray,
+        t_embree: f32,
+        geom: u32,
+        prim: u32,
+        exact_t: f64,
+        offset: f64,
+    ) -> Option<Hit> {
         let k = scale(r.len);
         let (prim, exact) = self.scene.prim(geom, prim)?;
         if exact {
             return (exact_t > r.tmin && exact_t < r.tmax).then_some(Hit { t: exact_t, prim });
         }
-        let t = (t_embree as f64 - self.pullback) / k;
+        let t = (t_embree as f64 - offset) / k;
         let slack = 1e-4 * t.abs().max(self.pullback / k) + 4.0 * self.pullback / k;
         let p = self.geometry.prim(prim);
         let refined = p.intersect(

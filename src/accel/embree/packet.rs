@@ -82,10 +82,11 @@ macro_rules! packet_fns {
             pub(super) fn $isect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
                 $RayHitN::with(|rh| {
                     let mut valid = Valid([0i32; $n]);
-                    let lanes = Lanes::<$n>::new(rays);
+                    let lanes = Lanes::<$n>::new(rays, self.pullback);
                     for (i, r) in rays.iter().enumerate() {
                         let e = self.embree_ray(r);
                         fill_lane(&mut rh.ray, i, &e, &mut valid.0);
+                        lanes.offset[i].set(e.offset);
                         rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                     }
                     deactivate_from(&mut rh.ray, rays.len());
@@ -119,6 +120,7 @@ macro_rules! packet_fns {
                                 rh.hit.geomID[i],
                                 rh.hit.primID[i],
                                 ctx.exact_t(i),
+                                lanes.offset[i].get(),
                             )
                         } else {
                             None
@@ -130,10 +132,11 @@ macro_rules! packet_fns {
             pub(super) fn $occl(&self, rays: &[Ray], out: &mut [bool]) {
                 $RayN::with(|ray| {
                     let mut valid = Valid([0i32; $n]);
-                    let lanes = Lanes::<$n>::new(rays);
+                    let lanes = Lanes::<$n>::new(rays, self.pullback);
                     for (i, r) in rays.iter().enumerate() {
                         let e = self.embree_ray(r);
                         fill_lane(ray, i, &e, &mut valid.0);
+                        lanes.offset[i].set(e.offset);
                     }
                     deactivate_from(ray, rays.len());
                     let mut ctx = self.context(Query::Occluded, rays, &lanes);
@@ -291,14 +294,7 @@ impl EmbreeAccel {
             Query::Single => false,
         };
         let inject = self.device.injection();
-        ExactContext::new(
-            coherent,
-            rays,
-            lanes,
-            self.scene.center,
-            self.pullback,
-            inject,
-        )
+        ExactContext::new(coherent, rays, lanes, self.scene.center, inject)
     }
 
     /// Record what went wrong in the query's callbacks, if anything, for the render to report.
@@ -323,14 +319,15 @@ impl EmbreeAccel {
             },
         };
         let rays = std::slice::from_ref(r);
-        let lanes = Lanes::<1>::new(rays);
+        let lanes = Lanes::<1>::new(rays, e.offset);
         let mut ctx = self.context(Query::Single, rays, &lanes);
         unsafe { self.scene.rtc.intersect1(ctx.raw(), &mut rh) };
         self.settle(&ctx);
         if rh.hit.geomID == RTC_INVALID_GEOMETRY_ID {
             return None;
         }
-        self.to_hit(r, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, ctx.exact_t(0))
+        let t = ctx.exact_t(0);
+        self.to_hit(r, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, t, e.offset)
     }
 
     pub(super) fn occluded1(&self, r: &Ray) -> bool {
@@ -340,7 +337,7 @@ impl EmbreeAccel {
         }
         let mut ray = single(&e);
         let rays = std::slice::from_ref(r);
-        let lanes = Lanes::<1>::new(rays);
+        let lanes = Lanes::<1>::new(rays, e.offset);
         let mut ctx = self.context(Query::Single, rays, &lanes);
         unsafe { self.scene.rtc.occluded1(ctx.raw(), &mut ray) };
         self.settle(&ctx);
