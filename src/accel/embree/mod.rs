@@ -124,7 +124,8 @@ impl EmbreeBackend {
         let device = self.device()?;
         let width = self.packet_width.unwrap_or(device.native_width());
         let scene = scene::EmbreeScene::build(device.clone(), &geometry)?;
-        let diag = geometry.bounds().diagonal();
+        let bounds = geometry.bounds();
+        let diag = bounds.diagonal();
         Ok(EmbreeAccel {
             scene,
             geometry,
@@ -132,6 +133,7 @@ impl EmbreeBackend {
             // How far a ray's origin is pulled back before the f32 cast, so geometry flush with
             // the bounds (where the renderer put the origin) is not lost to f32 rounding.
             pullback: 1e-4 * diag.max(1e-6),
+            bounds,
             diag,
             device,
         })
@@ -224,7 +226,9 @@ pub struct EmbreeAccel {
     geometry: Arc<Geometry>,
     width: usize,
     pullback: f64,
-    /// The diagonal of the geometry's bounds.
+    /// The geometry's bounds (`Geometry::bounds` walks the primitives: made once), and their
+    /// diagonal.
+    bounds: Aabb,
     diag: f64,
     /// Where faults in callbacks are recorded (and whether to inject one).
     device: Arc<Device>,
@@ -299,10 +303,7 @@ impl EmbreeAccel {
         // then rounds coordinates of the scene's size, not of its distance. Embree's code paths
         // without FMA (SSE, AVX) lose packet rays that graze a box from 10⁵ away otherwise,
         // which single rays and AVX2's find. Near rays are traced as they are.
-        let far = self
-            .geometry
-            .bounds()
-            .clip(r.origin, d.recip(), r.tmin, r.tmax);
+        let far = self.bounds.clip(r.origin, d.recip(), r.tmin, r.tmax);
         let shift = match far {
             Some((enter, _)) if enter * r.len > 4.0 * self.diag => enter,
             _ => 0.0,
