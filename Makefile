@@ -24,8 +24,11 @@ demo: setup
 # it needs root, and says so when skipped). `--release` builds the tests in target/release
 # beside `make demo`'s binary, on the same optimised dependencies: one optimised build of
 # everything, not a second one in target/debug with full debug info. The build without Embree
-# goes first, so the binary left in target/release is the one with it.
+# goes first, so the binary left in target/release is the one with it. Blender 5 (bpy, from
+# PyPI) downloads in the background meanwhile, for the last check: every documented pass as
+# Blender's compositor takes it (scripts/blender-test.sh).
 test: setup
+	@mkdir -p target && (scripts/blender-test.sh --install >target/bpy-install.log 2>&1 &)
 	$(CARGO) test --release --no-default-features
 	$(CARGO) test --release --workspace
 	@# The backend's conformance suite (grazing packets against single rays, analytic hits)
@@ -38,6 +41,7 @@ test: setup
 	  fi; \
 	done
 	scripts/slurm-test.sh target/release/rest-embree
+	scripts/blender-test.sh target/release/rest-embree
 
 # A film's frames as an MP4 (ffmpeg): make film FRAMES='film/frame-%04d.png' FPS=24 MP4=film.mp4
 FRAMES ?= film/frame-%04d.png

@@ -38,19 +38,19 @@ fn good_scene_writes_png_and_exr_with_the_passes() {
         "G",
         "B",
         "A",
-        "relativity.lookback",
-        "relativity.doppler",
-        "object_id",
-        "depth.Z",
+        "lookback.V",
+        "doppler.V",
+        "object_id.V",
+        "Z",
     ] {
         let c = ch
             .get(name)
             .unwrap_or_else(|| panic!("channel {name} missing; have {:?}", ch.keys()));
         assert!(c.iter().all(|v| v.is_finite()), "channel {name} is finite");
     }
-    let ids = &ch["object_id"];
-    let lookback = &ch["relativity.lookback"];
-    let doppler = &ch["relativity.doppler"];
+    let ids = &ch["object_id.V"];
+    let lookback = &ch["lookback.V"];
+    let doppler = &ch["doppler.V"];
     let hit = ids
         .iter()
         .position(|&i| i == 1.0)
@@ -336,7 +336,7 @@ fn set_addresses_entries_by_name_and_overrides_any_value() {
     let (ok, err) = run(&args);
     assert!(ok, "{err}");
     let (_, _, ch) = rest_embree::output::read_exr_channels(Path::new(&out)).unwrap();
-    let bg = ch["object_id"].iter().position(|&i| i == 0.0).unwrap();
+    let bg = ch["object_id.V"].iter().position(|&i| i == 0.0).unwrap();
     assert_eq!((ch["R"][bg], ch["G"][bg], ch["B"][bg]), (0.25, 0.5, 1.0));
     assert!(ch["A"].iter().all(|&a| a == 1.0), "opaque: alpha 1");
 }

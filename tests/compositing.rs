@@ -33,8 +33,8 @@ fn channels_types_compression_and_header_as_openimageio_reads_them() {
     let info = oiiotool(&["--info", "-v", plain.to_str().unwrap()]);
     for needle in [
         "46 channel, float openexr",
-        "channel list: R, G, B, A, material_id, object_id, primitive_id, CryptoMaterial00.R, CryptoMaterial00.G, CryptoMaterial00.B, CryptoMaterial00.A, CryptoMaterial01.R",
-        "CryptoObject02.A, N.X, N.Y, N.Z, P.X, P.Y, P.Z, Pcam.X, Pcam.Y, Pcam.Z, Pref.X, Pref.Y, Pref.Z, depth.Z, relativity.doppler, relativity.lookback",
+        "channel list: R, G, B, A, Z, CryptoMaterial00.R, CryptoMaterial00.G, CryptoMaterial00.B, CryptoMaterial00.A, CryptoMaterial01.R",
+        "CryptoObject02.A, N.X, N.Y, N.Z, P.X, P.Y, P.Z, Pcam.X, Pcam.Y, Pcam.Z, Pref.X, Pref.Y, Pref.Z, doppler.V, lookback.V, material_id.V, object_id.V, primitive_id.V",
         "/name: \"CryptoObject\"",
         "/name: \"CryptoMaterial\"",
         "compression: \"zip\"",
@@ -61,11 +61,11 @@ fn channels_types_compression_and_header_as_openimageio_reads_them() {
         "R (half)",
         "A (half)",
         "N.X (half)",
-        "relativity.doppler (half)",
-        "depth.Z (float)",
-        "relativity.lookback (float)",
+        "doppler.V (half)",
+        "Z (float)",
+        "lookback.V (float)",
         "P.X (float)",
-        "object_id (float)",
+        "object_id.V (float)",
         "CryptoObject00.R (float)",
         "compression: \"piz\"",
     ] {
@@ -75,6 +75,68 @@ fn channels_types_compression_and_header_as_openimageio_reads_them() {
     assert_eq!(code, Some(1), "{err}");
     assert!(
         err.contains("--compression") && err.contains("zip"),
+        "{err}"
+    );
+}
+
+/// `--passes` and `[image] passes` choose the channels; the colour of a render without passes
+/// (which skips the centre rays) equals the full render's; an unknown name is refused with
+/// the accepted ones.
+#[test]
+fn passes_choose_the_channels() {
+    let d = Dir::new("exr-passes");
+    let scene = d.file("scene.toml", GOOD);
+    let s = scene.to_str().unwrap();
+    let list = |file: &str, args: &[&str]| {
+        let out = d.0.join(file);
+        let o = out.to_str().unwrap();
+        let mut all = vec!["render", s, "-o", o, "-q", "--samples", "4"];
+        all.extend_from_slice(args);
+        let (code, err) = status(&all);
+        assert_eq!(code, Some(0), "{err}");
+        let info = oiiotool(&["--info", "-v", o]);
+        let line = info.lines().find(|l| l.contains("channel list:")).unwrap();
+        line.split("channel list:")
+            .nth(1)
+            .unwrap()
+            .trim()
+            .to_string()
+    };
+    assert_eq!(list("none.exr", &["--passes", "none"]), "R, G, B, A");
+    assert_eq!(
+        list("some.exr", &["--passes", "depth,relativity"]),
+        "R, G, B, A, Z, doppler.V, lookback.V"
+    );
+    assert_eq!(
+        list("ids.exr", &["--set", "image.passes=[\"ids\", \"normal\"]"]),
+        "R, G, B, A, N.X, N.Y, N.Z, material_id.V, object_id.V, primitive_id.V"
+    );
+    let crypto = list("crypto.exr", &["--passes", "cryptomatte"]);
+    assert!(
+        crypto.starts_with("R, G, B, A, CryptoMaterial00.R"),
+        "{crypto}"
+    );
+    assert!(!crypto.contains("N.X"), "{crypto}");
+    assert_eq!(list("all.exr", &[]).split(", ").count(), 46);
+    let (_, _, none) = rest_embree::output::read_exr_channels(&d.0.join("none.exr")).unwrap();
+    let (_, _, all) = rest_embree::output::read_exr_channels(&d.0.join("all.exr")).unwrap();
+    for c in ["R", "G", "B", "A"] {
+        assert_eq!(none[c], all[c], "channel {c}");
+    }
+    let o = d.0.join("bad.exr");
+    let (code, err) = status(&[
+        "render",
+        s,
+        "-o",
+        o.to_str().unwrap(),
+        "--passes",
+        "depth,dopler",
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--passes depth,dopler")
+            && err.contains("`dopler` is not a pass")
+            && err.contains("lookback, doppler"),
         "{err}"
     );
 }
@@ -132,7 +194,7 @@ fn over_a_plate_equals_the_plate_as_background() {
     }
 }
 
-/// depth.Z is the distance along the camera's look axis in its rest frame: the calibration
+/// Z (depth) is the distance along the camera's look axis in its rest frame: the calibration
 /// cube's near face lies in the plane y = 10, and a motion along x (of the cube or of the
 /// camera) leaves that distance as it is.
 #[test]

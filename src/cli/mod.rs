@@ -124,6 +124,12 @@ pub(crate) struct RenderArgs {
     /// depth, lookback and ids stay full floats).
     #[arg(long)]
     pub half: bool,
+    /// The passes an EXR holds beside colour and alpha, comma-separated (`none` for colour and
+    /// alpha alone; see `[image] passes`): depth, lookback, doppler, object_id, material_id,
+    /// primitive_id, normal, position, rest_position, camera_position, cryptomatte; or the
+    /// shorthands all (the default), ids, relativity.
+    #[arg(long, value_name = "LIST")]
+    pub passes: Option<String>,
     /// An EXR's compression: zip (default), zips, piz, rle or none.
     #[arg(long, value_name = "NAME", value_parser = exr_compression)]
     pub compression: Option<output::Compression>,
@@ -168,6 +174,19 @@ impl RenderArgs {
             self.samples.map(|x| x.to_string()),
         );
         flag("time", "camera.time", self.time.map(|x| format!("{x:?}")));
+        if let Some(list) = &self.passes {
+            // Shown as typed; applied as the TOML array of its names.
+            let names: Vec<String> = list
+                .split(',')
+                .map(str::trim)
+                .filter(|n| !n.is_empty())
+                .map(|n| format!("{n:?}"))
+                .collect();
+            v.push((
+                format!("--passes {list}"),
+                format!("image.passes=[{}]", names.join(", ")),
+            ));
+        }
         for s in &self.set {
             v.push((format!("--set {s}"), s.clone()));
         }
@@ -300,14 +319,12 @@ fn render_to_file(
             };
             let written = output::write_exr_in_strips(path, (w, h), true, &exr, |put| {
                 let strip = memory::STRIP_PIXELS;
-                stats = render::render_world_in_strips(
-                    scene,
-                    world,
-                    Passes::All,
-                    strip,
-                    progress,
-                    put,
-                )?;
+                // Colour and alpha alone need no centre ray per pixel.
+                let passes = match scene.image.passes.is_empty() {
+                    true => Passes::Colour,
+                    false => Passes::All,
+                };
+                stats = render::render_world_in_strips(scene, world, passes, strip, progress, put)?;
                 Ok(())
             });
             progress.inspect(|p| p.finish());

@@ -2,6 +2,7 @@ use super::exr_block::{BlockSource, Layout};
 use super::file::cause;
 use super::{cryptomatte, Attribute, ExrOptions};
 use crate::render::{Frame, CHANNELS};
+use crate::scene::Pass;
 use crate::{Cause, Error};
 use exr::prelude::*;
 use smallvec::SmallVec;
@@ -10,16 +11,27 @@ use std::path::Path;
 
 /// Channels that may be stored as half floats (`--half`): colour, coverage, normals and the
 /// Doppler factor. Positions, depth, lookback and ids keep full precision.
-const MAY_BE_HALF: [&str; 8] = [
-    "R",
-    "G",
-    "B",
-    "A",
-    "N.X",
-    "N.Y",
-    "N.Z",
-    "relativity.doppler",
-];
+const MAY_BE_HALF: [&str; 8] = ["R", "G", "B", "A", "N.X", "N.Y", "N.Z", "doppler.V"];
+
+/// The pass a channel of [`CHANNELS`] belongs to (named for what Nuke and Blender make of
+/// it: docs/output-passes.md); None for colour and alpha, which are always written.
+fn pass_of(channel: &str) -> Option<Pass> {
+    let layer = channel.split('.').next().unwrap_or(channel);
+    Some(match layer {
+        "R" | "G" | "B" | "A" => return None,
+        "Z" => Pass::Depth,
+        "lookback" => Pass::Lookback,
+        "doppler" => Pass::Doppler,
+        "object_id" => Pass::ObjectId,
+        "material_id" => Pass::MaterialId,
+        "primitive_id" => Pass::PrimitiveId,
+        "N" => Pass::Normal,
+        "P" => Pass::Position,
+        "Pref" => Pass::RestPosition,
+        "Pcam" => Pass::CameraPosition,
+        _ => unreachable!("a channel of CHANNELS: {channel}"),
+    })
+}
 
 /// Strips of rows, top to bottom, handed to a sink that encodes them.
 pub type Strips<'a> = dyn FnMut(&Frame) -> std::result::Result<(), Cause> + 'a;
@@ -43,6 +55,7 @@ pub(super) fn channels(
 ) -> (AnyChannels<FlatSamples>, Vec<(String, Attribute)>) {
     let channels: Vec<AnyChannel<FlatSamples>> = CHANNELS
         .iter()
+        .filter(|name| pass_of(name).is_none_or(|p| options.passes.has(p)))
         .map(|&name| {
             let values = frame.channel(name).expect("known channel");
             let samples = if options.half && MAY_BE_HALF.contains(&name) {
@@ -55,6 +68,7 @@ pub(super) fn channels(
         .collect();
     let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels.into_iter().collect();
     let mut extra = Vec::new();
+    let mattes = mattes && options.passes.has(Pass::Cryptomatte);
     if let (Some(names), true) = (&options.mattes, mattes) {
         let kinds: [(&str, cryptomatte::Pick, &[String]); 2] = [
             (cryptomatte::LAYERS[0], |m| &m.object, &names.objects),
@@ -534,7 +548,7 @@ mod tests {
                 .unwrap();
                 let (rw, rh, channels) = read_channels(&path).unwrap();
                 assert_eq!((rw, rh), (w as usize, h as usize));
-                for name in ["R", "G", "B", "depth.Z", "object_id", "P.Z"] {
+                for name in ["R", "G", "B", "Z", "object_id.V", "P.Z"] {
                     let want = frame.channel(name).unwrap();
                     let got = &channels[name];
                     let same = want

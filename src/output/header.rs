@@ -4,7 +4,7 @@
 //!
 //! The matrices describe the camera at the imaging event, its position and axes, as if at rest.
 //! They are exact for a camera at rest in the world frame. A moving camera sees the world
-//! aberrated, which no 4 × 4 matrix expresses; for it, `Pcam` and `depth.Z` hold the positions
+//! aberrated, which no 4 × 4 matrix expresses; for it, `Pcam` and `Z` (depth) hold the positions
 //! it sees.
 
 use super::cryptomatte::MatteNames;

@@ -79,6 +79,8 @@ pub struct ExrOptions {
     pub mattes: Option<cryptomatte::MatteNames>,
     /// Where a cropped frame sits in the full image; None: the frame is the full image.
     pub placement: Option<Placement>,
+    /// The passes beside colour and alpha.
+    pub passes: crate::scene::PassSet,
 }
 
 impl ExrOptions {
@@ -95,6 +97,7 @@ impl ExrOptions {
             attributes: header::attributes(scene, backend, scene_file, overrides),
             mattes: Some(header::matte_names(scene)),
             placement: Placement::of(&scene.image),
+            passes: scene.image.passes,
             ..Default::default()
         }
     }

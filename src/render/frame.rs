@@ -134,12 +134,12 @@ pub const CHANNELS: [&str; 22] = [
     "G",
     "B",
     "A",
-    "depth.Z",
-    "relativity.lookback",
-    "relativity.doppler",
-    "object_id",
-    "material_id",
-    "primitive_id",
+    "Z",
+    "lookback.V",
+    "doppler.V",
+    "object_id.V",
+    "material_id.V",
+    "primitive_id.V",
     "N.X",
     "N.Y",
     "N.Z",
@@ -184,9 +184,9 @@ mod tests {
             ("G", 2.0),
             ("B", 3.0),
             ("A", 4.0),
-            ("relativity.lookback", 5.0),
-            ("relativity.doppler", 6.0),
-            ("object_id", 7.0),
+            ("lookback.V", 5.0),
+            ("doppler.V", 6.0),
+            ("object_id.V", 7.0),
             ("N.X", 8.0),
             ("N.Y", 9.0),
             ("N.Z", 10.0),
@@ -196,17 +196,17 @@ mod tests {
             ("Pref.X", 14.0),
             ("Pref.Y", 15.0),
             ("Pref.Z", 16.0),
-            ("depth.Z", 17.0),
+            ("Z", 17.0),
             ("Pcam.X", 18.0),
             ("Pcam.Y", 19.0),
             ("Pcam.Z", 20.0),
-            ("material_id", 21.0),
-            ("primitive_id", 22.0),
+            ("material_id.V", 21.0),
+            ("primitive_id.V", 22.0),
         ];
         assert_eq!(want.len(), CHANNELS.len());
         for (name, v) in want {
             assert_eq!(frame.channel(name), Some(vec![v]), "{name}");
         }
-        assert_eq!(frame.channel("Z"), None);
+        assert_eq!(frame.channel("depth.Z"), None);
     }
 }

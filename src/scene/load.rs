@@ -4,7 +4,7 @@ use super::doc::Doc;
 use super::model::*;
 use super::objects::{add_object, OBJECT_KEYS};
 use super::reader::{SceneResult, Table};
-use super::SceneError;
+use super::{PassSet, SceneError};
 use crate::geometry::Geometry;
 use crate::spacetime::Velocity;
 use crate::spectrum::{Colour, Role};
@@ -139,6 +139,7 @@ fn build(doc: &Doc) -> SceneResult<Scene> {
             background: Colour::grey(0.0, Role::Emitter),
             crop: None,
             transparent: None,
+            passes: PassSet::ALL,
         },
     };
     let render = match root.table("render")? {
@@ -428,6 +429,19 @@ fn image(t: &Table) -> SceneResult<ImageSettings> {
             Some(_) => Some(t.bool_or("transparent", true)?),
             None => None,
         },
+        passes: match t.strings("passes")? {
+            Some((n, names)) => PassSet::from_names(names).map_err(|bad| {
+                t.error_at(
+                    n,
+                    "passes",
+                    format!(
+                        "`{bad}` is not a pass; the passes are {} (colour and alpha are always written)",
+                        PassSet::accepted()
+                    ),
+                )
+            })?,
+            None => PassSet::ALL,
+        },
     };
     let (fw, fh) = s.frame_size();
     if fw as u64 * fh as u64 > 1 << 28 {
@@ -448,6 +462,7 @@ fn image(t: &Table) -> SceneResult<ImageSettings> {
         "background",
         "crop",
         "transparent",
+        "passes",
     ])?;
     Ok(s)
 }

@@ -8,6 +8,7 @@ mod error;
 mod load;
 mod model;
 mod objects;
+mod pass_set;
 mod procedural;
 mod reader;
 pub(crate) mod toml_tree;
@@ -18,3 +19,4 @@ pub use model::{
     Camera, Film, FrameSpacing, Group, ImageSettings, Light, Material, ObjectInfo, Projection,
     RenderSettings, Scene, MAX_FRAMES, MAX_RAYS,
 };
+pub use pass_set::{Pass, PassSet};

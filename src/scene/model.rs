@@ -119,6 +119,8 @@ pub struct ImageSettings {
     /// alpha the coverage) or composited in (alpha 1). None: transparent, except for a PNG
     /// written by the command line (see [`ImageSettings::is_transparent`]).
     pub transparent: Option<bool>,
+    /// The passes an EXR holds beside colour and alpha.
+    pub passes: super::PassSet,
 }
 
 impl ImageSettings {

@@ -177,6 +177,32 @@ impl<'a> Table<'a> {
             .ok_or_else(|| self.error(key, "missing: give a string"))
     }
 
+    /// An array of strings, with its node (for errors about an element).
+    pub fn strings(&self, key: &str) -> SceneResult<Option<(&'a Node, Vec<&'a str>)>> {
+        let Some(n) = self.get(key) else {
+            return Ok(None);
+        };
+        let Val::Array(items) = &n.val else {
+            return Err(self.error_at(
+                n,
+                key,
+                format!("expected an array of strings, found {}", n.kind()),
+            ));
+        };
+        let strings = items
+            .iter()
+            .map(|e| match &e.val {
+                Val::Str(s) => Ok(s.as_str()),
+                _ => Err(self.error_at(
+                    e,
+                    key,
+                    format!("expected an array of strings, found {} in it", e.kind()),
+                )),
+            })
+            .collect::<SceneResult<_>>()?;
+        Ok(Some((n, strings)))
+    }
+
     /// An array of numbers of exactly `len` elements.
     pub fn numbers(&self, key: &str, len: usize) -> SceneResult<Option<Vec<f64>>> {
         let Some(n) = self.get(key) else {

@@ -1,0 +1,91 @@
+#!/bin/bash
+# Blender 5 reads the default EXR as docs/output-passes.md says: bpy (Blender as a Python
+# module, from PyPI) opens a render in the compositor, finds each documented pass by its name
+# and writes it out; each must equal, bit for bit, the channels of the file it came from
+# (compared by OpenImageIO's idiff). bpy goes into a cache of its own
+# (~/.cache/rest-embree/bpy5, about 1 GB), installed once.
+#
+#   scripts/blender-test.sh [path/to/rest-embree]    run the test
+#   scripts/blender-test.sh --install                only install bpy (make test starts this
+#                                                    in the background while it builds)
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/.." && pwd)
+cache=${REST_EMBREE_CACHE:-$HOME/.cache/rest-embree}
+site=$cache/bpy5
+mkdir -p "$cache"
+
+# One install at a time (the background one, then the test's wait for it).
+install() {
+    exec 9>"$cache/bpy5.lock"
+    flock 9
+    if [ -f "$site/.complete" ]; then return 0; fi
+    rm -rf "$site"
+    echo "blender-test: installing bpy 5 (Blender as a Python module) into $site" >&2
+    python3 -m pip install -q --disable-pip-version-check --root-user-action=ignore --target "$site" 'bpy>=5,<6' \
+        && touch "$site/.complete"
+}
+
+if [ "${1:-}" = --install ]; then
+    install
+    exit
+fi
+
+exe=$(realpath "${1:-$root/target/release/rest-embree}")
+[ -x "$exe" ] || { echo "blender-test: no binary at $exe (cargo build --release)" >&2; exit 1; }
+if ! install; then
+    echo "blender-test: FAILED: could not install bpy 5 for $(python3 --version 2>&1)" \
+        "(bpy 5 needs Python 3.11 and pip)" >&2
+    exit 1
+fi
+
+work=$(mktemp -d /tmp/rest-embree-blender.XXXXXX)
+trap 'rm -rf "$work"' EXIT
+
+# A moving cube, half the frame background: every pass has hits and misses; two samples so the
+# mattes have shares.
+w=24 h=16
+"$exe" render "$root/scenes/calibration_cube.toml" -o "$work/render.exr" -q \
+    --width $w --height $h --samples 2
+
+# Blender's pass name, the channels Blender puts it in, the file's channels.
+rows=(
+    "Combined R,G,B,A R,G,B,A"
+    "Alpha R A"
+    "Depth R Z"
+    "lookback R lookback.V"
+    "doppler R doppler.V"
+    "object_id R object_id.V"
+    "material_id R material_id.V"
+    "primitive_id R primitive_id.V"
+    "N R,G,B N.X,N.Y,N.Z"
+    "P R,G,B P.X,P.Y,P.Z"
+    "Pref R,G,B Pref.X,Pref.Y,Pref.Z"
+    "Pcam R,G,B Pcam.X,Pcam.Y,Pcam.Z"
+)
+for k in Object Material; do
+    for r in 00 01 02; do
+        c=Crypto$k$r
+        rows+=("$c R,G,B,A $c.R,$c.G,$c.B,$c.A")
+    done
+done
+passes=()
+for row in "${rows[@]}"; do passes+=("${row%% *}"); done
+
+PYTHONPATH=$site python3 "$root/scripts/blender_passes.py" "$work/render.exr" "$work" $w $h \
+    "${passes[@]}" >"$work/blender.log" 2>&1 || { cat "$work/blender.log" >&2; exit 1; }
+grep '^blender-test:' "$work/blender.log" >&2
+
+failed=0
+for row in "${rows[@]}"; do
+    read -r pass theirs ours <<<"$row"
+    oiiotool "$work/$pass.exr" --ch "$theirs" -o "$work/a.exr"
+    oiiotool "$work/render.exr" --ch "$ours" --chnames "$theirs" -o "$work/b.exr"
+    if idiff -q -fail 0 -warn 0 "$work/a.exr" "$work/b.exr" >/dev/null; then
+        echo "blender-test: $pass equals the file's $ours" >&2
+    else
+        echo "blender-test: FAILED: Blender's $pass differs from the file's $ours" >&2
+        failed=1
+    fi
+done
+exit $failed
