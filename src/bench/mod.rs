@@ -10,6 +10,7 @@
 //! primitive tests), so the relativistic layer's overhead is a ratio measured in the same run.
 
 mod csv_table;
+mod exr_writing;
 mod film_cost;
 mod memory;
 mod plot;
@@ -25,7 +26,7 @@ use crate::compare::{compare, Comparison};
 use crate::render::{
     render_world, render_world_passes, trace_primary, Frame, Passes, World, WorldOptions,
 };
-use crate::scene::Scene;
+use crate::scene::{PassSet, Scene};
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -130,7 +131,8 @@ pub(crate) struct Row {
     /// Making the scene (parsing its file, or generating it).
     pub load_s: f64,
     /// Writing the first render's frame as the command line would: an EXR with every pass,
-    /// or a PNG of the colour alone (`colour-only` settings).
+    /// or a PNG of the colour alone (`colour-only` settings), or an EXR of colour and alpha
+    /// (`rgba`).
     pub write_s: f64,
     /// Against the f64 BVH at the same samples per pixel.
     pub vs_same: Option<Comparison>,
@@ -162,21 +164,25 @@ impl Row {
 }
 
 /// What a setting may switch off or leave out, beside its backend's name: each word is one.
-pub(crate) const SETTING_WORDS: [(&str, &str); 7] = [
+pub(crate) const SETTING_WORDS: [(&str, &str); 8] = [
     ("no-cull", "bounds and screen culling"),
     ("no-tree", "the trees over many groups"),
     ("no-merge", "merging groups of one velocity"),
     ("no-fused", "fans of primary rays"),
     ("colour-only", "the EXR passes (a PNG's render)"),
+    (
+        "rgba",
+        "the EXR passes, but to an EXR of colour and alpha (--passes none)",
+    ),
     ("instanced", "every lattice instanced, however small"),
     ("listed", "every lattice listed primitive by primitive"),
 ];
 
 /// A setting: a backend name, then any of [`SETTING_WORDS`]; an unknown word is an error, so a
 /// misspelt setting is never measured as another under its name.
-pub(crate) fn parse_setting(setting: &str) -> crate::Result<(&str, WorldOptions, Passes)> {
+pub(crate) fn parse_setting(setting: &str) -> crate::Result<(&str, WorldOptions, Written)> {
     let mut o = WorldOptions::default();
-    let mut passes = Passes::All;
+    let mut passes = Written::Exr(PassSet::ALL);
     let mut parts = setting.split_whitespace();
     let backend = parts.next().unwrap_or("embree");
     for p in parts {
@@ -185,7 +191,8 @@ pub(crate) fn parse_setting(setting: &str) -> crate::Result<(&str, WorldOptions,
             "no-tree" => o.group_tree = false,
             "no-merge" => o.merge_equal_velocities = false,
             "no-fused" => o.fused_primary = false,
-            "colour-only" => passes = Passes::Colour,
+            "colour-only" => passes = Written::Png,
+            "rgba" => passes = Written::Exr(PassSet::NONE),
             "instanced" => o.instance_over = 0,
             "listed" => o.instance_over = u64::MAX,
             other => {
@@ -204,6 +211,25 @@ pub(crate) fn parse_setting(setting: &str) -> crate::Result<(&str, WorldOptions,
         }
     }
     Ok((backend, o, passes))
+}
+
+/// The file a setting's render is written to, as `render -o` would write it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Written {
+    /// An EXR with these passes.
+    Exr(PassSet),
+    /// A PNG: colour alone.
+    Png,
+}
+
+impl Written {
+    /// What the renderer fills in for this file.
+    pub(crate) fn passes(self) -> Passes {
+        match self {
+            Written::Exr(set) if !set.is_empty() => Passes::All,
+            _ => Passes::Colour,
+        }
+    }
 }
 
 fn with_spp(scene: &Scene, spp: u32) -> Scene {
@@ -239,18 +265,20 @@ fn fastest(repeat: usize, mut f: impl FnMut()) -> f64 {
 fn write_like_the_command(
     scene: &Scene,
     backend_name: &str,
-    passes: Passes,
+    written: Written,
     frame: &Frame,
 ) -> crate::Result<f64> {
     use crate::output;
-    let ext = if passes == Passes::Colour {
-        "png"
-    } else {
-        "exr"
+    let (ext, passes) = match written {
+        Written::Png => ("png", PassSet::NONE),
+        Written::Exr(set) => ("exr", set),
     };
     let path = std::env::temp_dir().join(format!("rest-embree-bench-{}.{ext}", std::process::id()));
     let t = Instant::now();
-    let exr = output::ExrOptions::for_render(scene, backend_name, "bench", &[]);
+    let exr = output::ExrOptions {
+        passes,
+        ..output::ExrOptions::for_render(scene, backend_name, "bench", &[])
+    };
     let written = output::write_with(frame, &path, &exr);
     let secs = t.elapsed().as_secs_f64();
     let _ = std::fs::remove_file(&path);
@@ -258,7 +286,8 @@ fn write_like_the_command(
 }
 
 fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result<(Row, Frame)> {
-    let (backend_name, options, passes) = parse_setting(setting)?;
+    let (backend_name, options, written) = parse_setting(setting)?;
+    let passes = written.passes();
     let backend = backend_by_name(backend_name)?;
     let scene = with_spp(&case.scene, spp);
     memory::reset_peak();
@@ -294,7 +323,7 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result
     // No figure of a render the backend recorded a fault in.
     world.check()?;
     let peak_mib = memory::peak_mib();
-    let write_s = write_like_the_command(&scene, backend_name, passes, &frame)?;
+    let write_s = write_like_the_command(&scene, backend_name, written, &frame)?;
     let (w, h) = scene.image.frame_size();
     Ok((
         Row {
@@ -335,7 +364,8 @@ fn beside(
 ) -> crate::Result<Beside> {
     let alone = Case::new(&case.name, one.clone(), &[setting]).without_hi_reference();
     let (one_row, _) = measure(&alone, setting, 1, repeat)?;
-    let (backend_name, options, passes) = parse_setting(setting)?;
+    let (backend_name, options, written) = parse_setting(setting)?;
+    let passes = written.passes();
     let backend = backend_by_name(backend_name)?;
     let (many, one) = (with_spp(&case.scene, 1), with_spp(one, 1));
     let many_world = World::build_with(&many, backend.as_ref(), options)?;
@@ -496,7 +526,10 @@ pub(crate) fn run(
             if backend_by_name(parse_setting(setting)?.0).is_err() {
                 continue;
             }
-            let plain = matches!(setting.as_str(), "embree" | "bvh" | "embree colour-only");
+            let plain = matches!(
+                setting.as_str(),
+                "embree" | "bvh" | "embree colour-only" | "embree rgba"
+            );
             let spps: Vec<u32> = std::iter::once(1)
                 .chain(case.extra_spp.iter().copied().filter(|_| plain))
                 .collect();
@@ -634,23 +667,32 @@ pub(crate) fn summary(rows: &[Row]) -> String {
             );
         }
     }
-    // Colour alone (a PNG) against every pass (an EXR).
+    // Every pass (the default EXR) against an EXR of colour and alpha and a PNG (colour alone):
+    // the render, and the whole command (its file written).
     for all in rows.iter().filter(|r| r.setting == "embree") {
-        let colour = rows
-            .iter()
-            .find(|r| r.case == all.case && r.spp == all.spp && r.setting == "embree colour-only");
-        if let Some(c) = colour {
-            let _ = writeln!(
-                s,
-                "- {} at {} spp (embree): render time with every pass {:.3} s, colour only {:.3} s \
-                 ({:.2}x as fast)",
-                all.case,
-                all.spp,
-                all.render_s,
-                c.render_s,
-                all.render_s / c.render_s
-            );
-        }
+        let find = |setting: &str| {
+            rows.iter()
+                .find(|r| r.case == all.case && r.spp == all.spp && r.setting == setting)
+        };
+        let (Some(rgba), Some(png)) = (find("embree rgba"), find("embree colour-only")) else {
+            continue;
+        };
+        let _ = writeln!(
+            s,
+            "- {} at {} spp (embree): render time with every pass {:.3} s, colour only {:.3} s \
+             ({:.2}x as fast); whole command to the default EXR {:.3} s, to an EXR of colour and \
+             alpha {:.3} s ({:.2}x as fast), to a PNG {:.3} s ({:.2}x)",
+            all.case,
+            all.spp,
+            all.render_s,
+            rgba.render_s,
+            all.render_s / rgba.render_s,
+            all.whole_s(),
+            rgba.whole_s(),
+            all.whole_s() / rgba.whole_s(),
+            png.whole_s(),
+            all.whole_s() / png.whole_s(),
+        );
     }
     // Rows against the scene measured beside them: many groups against the same boxes in one
     // group, light as a camera records it against the RGB render.
@@ -688,6 +730,7 @@ pub(crate) fn summary(rows: &[Row]) -> String {
 }
 
 pub(crate) use csv_table::csv;
+pub(crate) use exr_writing::summary as exr_writing;
 pub(crate) use film_cost::summary as film_cost;
 pub(crate) use memory::{peak_mib, reset_peak};
 pub(crate) use plot::plot_svg;

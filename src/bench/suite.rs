@@ -175,15 +175,16 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
         )
         .beside("the same scene in RGB (both effects off)", rgb))
     }));
-    // What the EXR passes cost: a PNG takes colour alone (with several samples the passes have
-    // a ray of their own through each pixel's centre).
+    // What the EXR passes cost: the default EXR, an EXR of colour and alpha alone, and a PNG
+    // (colour alone); without passes no ray of their own goes through each pixel's centre when
+    // there are several samples.
     out.push(LazyCase::new("lattice beta=0.9, passes", move || {
         let mut s = size(px);
         s.push("group.lattice.velocity=[-0.9,0,0]".into());
         Ok(Case::new(
             "lattice beta=0.9, passes",
             paper("lattice", &s)?,
-            &["embree", "embree colour-only"],
+            &["embree", "embree rgba", "embree colour-only"],
         )
         .with_spp(&[4]))
     }));
