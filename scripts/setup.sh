@@ -3,7 +3,7 @@
 # backend's bindings) and a C compiler. Uses sudo when not root; does nothing when all is there.
 set -euo pipefail
 
-packages=(libembree-dev libclang-dev gcc openimageio-tools)
+packages=(libembree-dev libclang-dev gcc g++ pkg-config libopenexr-dev openimageio-tools)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -439,3 +439,163 @@ fn a_grid_larger_than_a_job_array_is_refused() {
     );
     assert!(!d.0.join("submitted").exists() && !d.0.join("rest-embree-farm").exists());
 }
+
+/// `oiiotool` with `args`; a missing tool is a set-up error, said so.
+fn oiiotool(args: &[&str]) {
+    let out = Command::new("oiiotool")
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("oiiotool ({e}): run scripts/setup.sh (openimageio-tools)"));
+    assert!(
+        out.status.success(),
+        "oiiotool {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Tiles that are not what `render` writes, or not of one render, are refused before anything
+/// is written, each with its name and why: whatever a header claims (a display window of 1e9
+/// squared, pixels outside it, tiles, mipmaps, a lossy compression, parts, a line order), a
+/// file cut short, junk, an empty file, a FIFO, a directory. Tiles with odd names join, and
+/// what assemble writes passes OpenEXR's own validator.
+#[test]
+fn hostile_tiles_are_refused() {
+    let d = Dir::new("hostile-tiles");
+    let scene = d.file("scene.toml", GOOD);
+    let size = ["--width", "40", "--height", "24"];
+    let tile = |name: &str, i: usize, extra: &[&str]| {
+        let t = d.0.join(name);
+        let i = i.to_string();
+        let mut args = vec![
+            "render",
+            s(&scene),
+            "-o",
+            s(&t),
+            "--tiles",
+            "2x1",
+            "--tile",
+            &i,
+        ];
+        args.extend_from_slice(&size);
+        args.extend_from_slice(extra);
+        render(&args);
+        t
+    };
+    // Odd names join; the result is the whole render, and valid.
+    let t0 = tile("tile one ünï\ncode.exr", 0, &[]);
+    let t1 = tile("-t1.exr", 1, &[]);
+    let whole = d.0.join("whole.exr");
+    render(&[&["render", s(&scene), "-o", s(&whole)][..], &size].concat());
+    let joined = d.0.join("joined \"quoted\".exr");
+    render(&["assemble", "-o", s(&joined), "--", s(&t0), s(&t1)]);
+    assert!(std::fs::read(&joined).unwrap() == std::fs::read(&whole).unwrap());
+    assert!(
+        common::exrcheck::valid(&joined),
+        "exrcheck rejects the assembled file"
+    );
+
+    let made = |name: &str, make: &dyn Fn(&Path)| {
+        let p = d.0.join(name);
+        make(&p);
+        p
+    };
+    let from_t0 = |args: &'static [&'static str]| {
+        let t0 = t0.clone();
+        move |p: &Path| {
+            let mut all = vec![s(&t0)];
+            all.extend_from_slice(args);
+            all.extend(["-o", s(p)]);
+            oiiotool(&all);
+        }
+    };
+    let bytes = std::fs::read(&t0).unwrap();
+    let cases: Vec<(PathBuf, &str)> = vec![
+        (
+            made(
+                "huge.exr",
+                &from_t0(&["--fullsize", "1000000000x1000000000"]),
+            ),
+            "display window) is 1000000000x1000000000",
+        ),
+        (
+            made("outside.exr", &from_t0(&["--origin", "+1000+0"])),
+            "lie outside the 40x24 full image",
+        ),
+        (
+            made("tiled.exr", &from_t0(&["--tile", "16", "16"])),
+            "stored in tiles",
+        ),
+        (
+            made("mip.exr", &|p: &Path| oiiotool(&[s(&t0), "-otex", s(p)])),
+            "mipmap",
+        ),
+        (
+            made("dwaa.exr", &from_t0(&["--compression", "dwaa"])),
+            "lossy",
+        ),
+        (
+            made("parts.exr", &|p: &Path| {
+                oiiotool(&[s(&t0), s(&t0), "--siappend", "-o", s(p)])
+            }),
+            "2 parts",
+        ),
+        (
+            made("cut.exr", &|p: &Path| {
+                std::fs::write(p, &bytes[..bytes.len() / 2]).unwrap()
+            }),
+            "not a readable EXR",
+        ),
+        (
+            made("last-block-cut.exr", &|p: &Path| {
+                std::fs::write(p, &bytes[..bytes.len() - 10]).unwrap()
+            }),
+            "cannot be read",
+        ),
+        (
+            made("junk.exr", &|p: &Path| {
+                std::fs::write(p, vec![0x5a; 5000]).unwrap()
+            }),
+            "not a readable EXR",
+        ),
+        (
+            made("empty.exr", &|p: &Path| std::fs::write(p, b"").unwrap()),
+            "not a readable EXR",
+        ),
+        (
+            made("fifo.exr", &|p: &Path| {
+                assert!(Command::new("mkfifo").arg(p).status().unwrap().success())
+            }),
+            "a FIFO",
+        ),
+        (
+            made("dir.exr", &|p: &Path| std::fs::create_dir(p).unwrap()),
+            "a directory",
+        ),
+        (
+            made("decreasing.exr", &|p: &Path| decreasing_copy(&t0, p)),
+            "not stored top to bottom",
+        ),
+        (tile("colour.exr", 0, &["--passes", "none"]), "channels"),
+    ];
+    let out = d.0.join("out.exr");
+    for (bad, needle) in &cases {
+        let (code, err) = status(&["assemble", "-o", s(&out), "--", s(bad), s(&t1)]);
+        assert_eq!(code, Some(1), "{}: {err}", bad.display());
+        assert!(
+            err.contains(&bad.display().to_string()) && err.contains(needle),
+            "{}: wanted `{needle}` in: {err}",
+            bad.display()
+        );
+        assert!(!out.exists(), "{}: nothing is written", bad.display());
+    }
+}
+
+use std::path::PathBuf;
+
+/// `from` written again with its blocks stored bottom to top (a valid EXR, not one render writes).
+fn decreasing_copy(from: &Path, to: &Path) {
+    use exr::prelude::*;
+    let mut image = read_all_flat_layers_from_file(from).unwrap();
+    image.layer_data[0].encoding.line_order = LineOrder::Decreasing;
+    image.write().to_file(to).unwrap();
+}

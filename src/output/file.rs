@@ -104,7 +104,7 @@ fn through_links(path: &Path) -> Result<PathBuf, String> {
 }
 
 /// What a file that is not a regular one is, in words.
-fn kind_of(m: &std::fs::Metadata) -> &'static str {
+pub(crate) fn kind_of(m: &std::fs::Metadata) -> &'static str {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;

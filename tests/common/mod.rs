@@ -4,6 +4,7 @@
 mod basics;
 pub mod cli;
 pub mod conformance;
+pub mod exrcheck;
 pub use basics::*;
 
 use rest_embree::render::Frame;
