@@ -96,6 +96,38 @@ fn assembled_tiles_are_the_whole_render() {
     assert!(!bad.exists());
 }
 
+/// `scene` with a 32768 x 32768 image: 2^30 pixels, four times what one render's frame holds.
+fn huge_image(scene: &str) -> String {
+    let text = scene.replace("width = 48\nheight = 32", "width = 32768\nheight = 32768");
+    assert_ne!(text, scene, "the scene's [image] size is replaced");
+    text
+}
+
+/// An image larger than one render's frame renders in tiles (each a frame), and is refused
+/// whole, or in tiles still too large, naming the key or the flags.
+#[test]
+fn an_image_larger_than_a_frame_renders_in_tiles() {
+    let d = Dir::new("huge-tiles");
+    let scene = d.file("huge.toml", &huge_image(GOOD));
+    let out = d.0.join("t.exr");
+    let base = ["render", s(&scene), "-o", s(&out), "--passes", "none"];
+    let (code, err) = status(&base);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("key `image.width`") && err.contains("--tiles"),
+        "{err}"
+    );
+    let (code, err) = status(&[&base[..], &["--tiles", "1x2", "--tile", "1"]].concat());
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--tiles 1x2 --tile 1") && err.contains("finer grid"),
+        "{err}"
+    );
+    render(&[&base[..], &["--tiles", "64x64", "--tile", "4095"]].concat());
+    let (w, h, _) = rest_embree::output::read_exr_channels(&out).unwrap();
+    assert_eq!((w, h), (512, 512));
+}
+
 #[test]
 fn bad_tiles_are_clear_errors() {
     fails(
@@ -260,8 +292,13 @@ fn bad_farms_are_clear_errors() {
         &format!("{GOOD}\n[film]\nstart = 9.0\nend = 10.0\nfps = 2\n"),
     );
     let still = d.file("still.toml", GOOD);
+    let huge = d.file("huge.toml", &huge_image(GOOD));
     let out = d.0.join("f-##.exr");
     for (args, needle) in [
+        (
+            vec![s(&huge), "-o", "x.exr", "--tiles", "2x1"],
+            "up to 16384x32768",
+        ),
         (
             vec![s(&film), "-o", s(&out), "--frames", "1..7"],
             "frames 0..2",

@@ -144,7 +144,12 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
         .map(|s| (format!("--set {s}"), s.clone()))
         .collect();
     // Everything a task would refuse is refused here, before anything is submitted.
-    let scene = scene::load_file(&scene_path, &overrides)?;
+    // A tiled image may be larger than one frame; each tile's frame is checked below.
+    let frame = match args.tiles {
+        Some(_) => scene::FrameSize::InTiles,
+        None => scene::FrameSize::Checked,
+    };
+    let scene = scene::load_file_as(&scene_path, &overrides, frame)?;
     let format = output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
     if let Some(b) = &args.backend {
         crate::accel::backend_by_name(b).map_err(|e| e.on_flag("--backend"))?;

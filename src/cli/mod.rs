@@ -612,7 +612,12 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         ));
     }
     memory::set_limit(args.max_memory);
-    let mut scene = scene::load_file(&args.scene, &args.overrides())?;
+    // A tiled image may be larger than one frame; its tile's frame is checked below.
+    let frame = match args.tiles {
+        Some(_) => scene::FrameSize::InTiles,
+        None => scene::FrameSize::Checked,
+    };
+    let mut scene = scene::load_file_as(&args.scene, &args.overrides(), frame)?;
     // A PNG is opaque (the background composited, alpha 1) unless the scene asks for
     // `transparent = true` (then RGBA); an EXR is transparent unless it asks otherwise.
     if format == output::Format::Png {

@@ -26,7 +26,21 @@ pub(super) fn tile_crop(
         return Err(Error::flag(shown, why));
     }
     let size = (scene.image.width, scene.image.height);
-    crop(size, grid, index).map_err(|m| Error::flag(shown, m))
+    let c = crop(size, grid, index).map_err(|m| Error::flag(shown, m))?;
+    // Every tile of the grid must be one render's frame, not only this one: the grid is
+    // refused as a whole, by any of its tasks and before a farm submits it.
+    let (tw, th) = (size.0.div_ceil(grid.0), size.1.div_ceil(grid.1));
+    if u64::from(tw) * u64::from(th) > scene::MAX_FRAME_PIXELS {
+        return Err(Error::flag(
+            shown,
+            format!(
+                "tiles of the {}x{} image in a {}x{} grid are up to {tw}x{th}, too large for \
+                 one render (at most 2^28 pixels): use a finer grid",
+                size.0, size.1, grid.0, grid.1
+            ),
+        ));
+    }
+    Ok(c)
 }
 
 /// `NxM`: N columns, M rows.

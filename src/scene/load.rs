@@ -18,6 +18,24 @@ pub fn load_file(
     path: &std::path::Path,
     overrides: &[(String, String)],
 ) -> Result<Scene, SceneError> {
+    load_file_as(path, overrides, FrameSize::Checked)
+}
+
+/// Whether loading refuses a frame larger than one render holds ([`MAX_FRAME_PIXELS`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameSize {
+    /// Refused at the key that sets it.
+    Checked,
+    /// Left to the caller, who renders the image in tiles and checks each tile's frame.
+    InTiles,
+}
+
+/// As [`load_file`], the frame's size checked as `frame` says.
+pub fn load_file_as(
+    path: &std::path::Path,
+    overrides: &[(String, String)],
+    frame: FrameSize,
+) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
     // The text alone first (`BYTES_PER_SCENE_BYTE`), before it is read; its values after.
     if let Ok(m) = std::fs::metadata(path) {
@@ -37,7 +55,7 @@ pub fn load_file(
     if let Some(why) = crate::memory::too_much(need, &what) {
         return Err(SceneError::new(shown, "", why));
     }
-    load_str(&shown, &text, overrides)
+    load_str_as(&shown, &text, overrides, frame)
 }
 
 /// The most a scene path that is not a regular file (a FIFO, `<(...)`, a device) is read: it
@@ -100,11 +118,20 @@ pub fn load_str(
     text: &str,
     overrides: &[(String, String)],
 ) -> Result<Scene, SceneError> {
+    load_str_as(file, text, overrides, FrameSize::Checked)
+}
+
+fn load_str_as(
+    file: &str,
+    text: &str,
+    overrides: &[(String, String)],
+    frame: FrameSize,
+) -> Result<Scene, SceneError> {
     let mut doc = Doc::parse(file, text)?;
     for (shown, set) in overrides {
         doc.apply_set(shown, set, superseded)?;
     }
-    build(&doc)
+    build(&doc, frame)
 }
 
 /// The keys an override replaces in its table: the other ways of giving the same setting, so
@@ -124,14 +151,14 @@ fn superseded(table: &[&str], key: &str) -> &'static [&'static str] {
     }
 }
 
-fn build(doc: &Doc) -> SceneResult<Scene> {
+fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     let root = Table::root(doc)?;
     let camera = match root.table("camera")? {
         Some(t) => camera(&t)?,
         None => return Err(root.missing_table("camera", "the scene needs a [camera] table")),
     };
     let image = match root.table("image")? {
-        Some(t) => image(&t)?,
+        Some(t) => image(&t, frame)?,
         None => ImageSettings {
             width: 512,
             height: 512,
@@ -401,7 +428,7 @@ fn camera(t: &Table) -> SceneResult<Camera> {
     })
 }
 
-fn image(t: &Table) -> SceneResult<ImageSettings> {
+fn image(t: &Table, frame: FrameSize) -> SceneResult<ImageSettings> {
     let width = t.uint("width", Some(512), 1, 1 << 20)? as u32;
     let height = t.uint("height", Some(512), 1, 1 << 20)? as u32;
     let crop = t
@@ -444,7 +471,8 @@ fn image(t: &Table) -> SceneResult<ImageSettings> {
         },
     };
     let (fw, fh) = s.frame_size();
-    if fw as u64 * fh as u64 > 1 << 28 {
+    let whole = s.crop.is_none() && frame == FrameSize::InTiles;
+    if fw as u64 * fh as u64 > MAX_FRAME_PIXELS && !whole {
         let (key, n) = ["width", "height", "crop"]
             .into_iter()
             .find_map(|k| t.get(k).map(|n| (k, n)))
@@ -452,7 +480,10 @@ fn image(t: &Table) -> SceneResult<ImageSettings> {
         return Err(t.error_at(
             n,
             key,
-            format!("a {fw}x{fh} frame is too large (at most 2^28 pixels; render it in crops)"),
+            format!(
+                "a {fw}x{fh} frame is too large (at most 2^28 pixels; render it in tiles, \
+                 `--tiles NxM`, or crops)"
+            ),
         ));
     }
     t.finish(&[

@@ -14,9 +14,9 @@ mod reader;
 pub(crate) mod toml_tree;
 
 pub use error::SceneError;
-pub use load::{load_file, load_str};
+pub use load::{load_file, load_file_as, load_str, FrameSize};
 pub use model::{
     Camera, Film, FrameSpacing, Group, ImageSettings, Light, Material, ObjectInfo, Projection,
-    RenderSettings, Scene, MAX_FRAMES, MAX_RAYS,
+    RenderSettings, Scene, MAX_FRAMES, MAX_FRAME_PIXELS, MAX_RAYS,
 };
 pub use pass_set::{Pass, PassSet};

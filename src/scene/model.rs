@@ -102,6 +102,9 @@ impl Film {
     }
 }
 
+/// The most pixels one render's frame (the image, or its crop) may have.
+pub const MAX_FRAME_PIXELS: u64 = 1 << 28;
+
 /// The image: its size, samples, background and crop.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImageSettings {
