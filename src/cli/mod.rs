@@ -41,6 +41,11 @@ pub(crate) enum Command {
         /// The tiles, in any order.
         #[arg(required = true)]
         tiles: Vec<PathBuf>,
+        /// The most memory joining may use, e.g. 2G (default: the machine's available memory);
+        /// joining is done in bands of rows, and refused before it starts if even that needs
+        /// more.
+        #[arg(long, value_name = "SIZE", value_parser = memory::parse_size)]
+        max_memory: Option<u64>,
     },
     /// Render on a cluster through its scheduler: `farm slurm SCENE -o OUT ...`.
     Farm {
@@ -248,7 +253,14 @@ fn run(cli: Cli) -> ExitCode {
         })),
         Command::Render(args) => report(run_render(&args)),
         Command::Bench(args) => report(run_bench(&args)),
-        Command::Assemble { output, tiles } => report(run_assemble(&output, &tiles)),
+        Command::Assemble {
+            output,
+            tiles,
+            max_memory,
+        } => {
+            memory::set_limit(max_memory);
+            report(run_assemble(&output, &tiles))
+        }
         Command::Farm { scheduler } => report(farm::run(&scheduler)),
         Command::BenchSceneFile { kind, size } => {
             println!("{}", bench::scene_file_here(&kind, size));

@@ -378,16 +378,17 @@ impl BlockSource for Band {
     }
 }
 
-/// What joining the tiles holds at once: a band of rows twice (the rows, and their blocks
-/// being compressed) and a decoded block of every tile (at most 32 lines each).
-fn held_bytes(tiles: &[TileHeader], band_rows: usize, pixel_bytes: usize, w: usize) -> u64 {
-    let band = (band_rows * w * pixel_bytes) as u64;
-    let blocks: u64 = tiles
-        .iter()
-        .map(|t| (t.size.0 * pixel_bytes * BAND_ALIGN) as u64)
-        .sum();
-    2 * band + blocks
+/// What joining the tiles holds at most, an upper bound: a band of rows four times over (the
+/// rows, each block's copy, its compressed chunk, and slack for the writer's buffers), the
+/// decoded and compressed blocks of the tiles the band crosses (they cover the width once per
+/// row of tiles, and a band may cross two rows of tiles), and the program itself.
+fn held_bytes(band_rows: usize, pixel_bytes: usize, w: usize) -> u64 {
+    let row = (w * pixel_bytes) as u64;
+    4 * band_rows as u64 * row + 4 * BAND_ALIGN as u64 * row + PROGRAM_BYTES
 }
+
+/// The program beside the image's bytes (code, libraries, threads' stacks), generously.
+const PROGRAM_BYTES: u64 = 64 << 20;
 
 /// Join `tiles` into `output`.
 pub fn assemble(tiles: &[PathBuf], output: &Path) -> crate::Result<()> {
@@ -407,7 +408,7 @@ pub fn assemble(tiles: &[PathBuf], output: &Path) -> crate::Result<()> {
     let sizes = sample_bytes(&first.channels);
     let pixel_bytes: usize = sizes.iter().sum();
     let band_rows = (BAND_BYTES / (w * pixel_bytes).max(1) / BAND_ALIGN).max(1) * BAND_ALIGN;
-    let need = held_bytes(&headers, band_rows, pixel_bytes, w);
+    let need = held_bytes(band_rows, pixel_bytes, w);
     let what = format!(
         "joining {} tiles into a {w}x{h} image of {} channels",
         headers.len(),
