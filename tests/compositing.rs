@@ -141,6 +141,36 @@ fn passes_choose_the_channels() {
     );
 }
 
+/// Names beyond Latin-1 (a scene file `雪 ünï.toml`, a group and its object named `雪 cube`)
+/// go into the header as UTF-8, as OpenEXR stores strings: the exr crate's own conversion
+/// panicked on them.
+#[test]
+fn unicode_names_reach_the_header() {
+    let d = Dir::new("exr-unicode");
+    let text = GOOD
+        .replace("name = \"cube\"", "name = \"雪 cube\"")
+        .replace("group = \"cube\"", "group = \"雪 cube\"");
+    assert_ne!(text, GOOD);
+    let scene = d.file("雪 ünï.toml", &text);
+    let out = d.0.join("雪.exr");
+    let (code, err) = status(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let info = oiiotool(&["--info", "-v", out.to_str().unwrap()]);
+    for needle in [
+        "雪 ünï.toml",
+        "groupVelocities: \"雪 cube: beta",
+        "manifest: \"{\"雪 cube",
+    ] {
+        assert!(info.contains(needle), "`{needle}` in:\n{info}");
+    }
+}
+
 /// A transparent EXR (the default) "over" a constant plate in OpenImageIO equals a render
 /// with that plate as the background (opaque: alpha 1), to 1e-6.
 #[test]

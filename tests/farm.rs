@@ -6,7 +6,7 @@
 
 mod common;
 use common::cli::*;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn render(args: &[&str]) {
@@ -627,12 +627,118 @@ fn hostile_tiles_are_refused() {
     }
 }
 
-use std::path::PathBuf;
-
 /// `from` written again with its blocks stored bottom to top (a valid EXR, not one render writes).
 fn decreasing_copy(from: &Path, to: &Path) {
     use exr::prelude::*;
     let mut image = read_all_flat_layers_from_file(from).unwrap();
     image.layer_data[0].encoding.line_order = LineOrder::Decreasing;
     image.write().to_file(to).unwrap();
+}
+
+/// Pieces of names that mean something to a shell, to SLURM's `#SBATCH --output` patterns or to
+/// a terminal.
+const ODD: [&str; 27] = [
+    "$(touch${IFS}PWNED)",
+    "`touch${IFS}PWNED`",
+    ";touch${IFS}PWNED;",
+    "'",
+    "\"",
+    "\\",
+    "%j",
+    "%%",
+    "%A_%a",
+    "*",
+    "?",
+    "[a]",
+    "{a,b}",
+    "!",
+    "#",
+    "~",
+    "&",
+    "|",
+    "<>",
+    "é",
+    "雪",
+    "=",
+    "-",
+    "--x",
+    "$HOME",
+    "${IFS}",
+    "\t",
+];
+
+/// Scene files and outputs with random odd names, through `farm slurm --tiles` and its job
+/// scripts run as SLURM would run them: each is refused with exit status 1, or makes the whole
+/// image under its own name; no name runs a command. A fixed seed, so a failure reproduces.
+#[test]
+fn random_odd_names_run_no_commands() {
+    let d = Dir::new("farm-odd-names");
+    let mut rng = rest_embree::rng::Rng(0x0dd_5eed);
+    let mut pick = || ODD[(rng.next_u64() % ODD.len() as u64) as usize];
+    let (mut made, mut refused) = (0, 0);
+    for n in 0..24 {
+        let case = d.0.join(format!("case{n}"));
+        std::fs::create_dir_all(&case).unwrap();
+        let scene_name = format!("{}{}scene.toml", pick(), pick());
+        let out_name = format!("{}{}{}.exr", pick(), pick(), pick());
+        let scene = case.join(&scene_name);
+        std::fs::write(&scene, GOOD).unwrap();
+        let out = case.join("out").join(&out_name);
+        let sets = ["--set", "image.width=8", "--set", "image.height=4"];
+        let mut args = vec!["farm", "slurm", s(&scene), "-o", s(&out), "--tiles", "2x1"];
+        args.extend(sets);
+        let (ok, err) = farm(&case, &args);
+        if !ok {
+            // Refused with a clear message (farm() checked that it did not panic).
+            assert!(
+                err.starts_with("error: "),
+                "{scene_name} -> {out_name}: {err}"
+            );
+            refused += 1;
+            continue;
+        }
+        let logs = out.parent().unwrap().join("rest-embree-farm");
+        let scripts: Vec<PathBuf> = std::fs::read_dir(&logs)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "sbatch"))
+            .collect();
+        let named = |end: &str| {
+            scripts
+                .iter()
+                .find(|p| p.to_string_lossy().ends_with(end))
+                .unwrap_or_else(|| panic!("{out_name}: no {end} in {scripts:?}"))
+                .clone()
+        };
+        let (tiles, assemble) = (named("-tiles.sbatch"), named("-assemble.sbatch"));
+        for task in 0..2 {
+            let st = Command::new("bash")
+                .arg(&tiles)
+                .current_dir(&case)
+                .env("SLURM_ARRAY_TASK_ID", task.to_string())
+                .status()
+                .unwrap();
+            assert!(st.success(), "{scene_name} -> {out_name}: task {task}");
+        }
+        let st = Command::new("bash")
+            .arg(&assemble)
+            .current_dir(&case)
+            .status()
+            .unwrap();
+        assert!(st.success(), "{scene_name} -> {out_name}: assemble");
+        assert!(
+            out.is_file(),
+            "{scene_name} -> {out_name}: the image under its own name"
+        );
+        made += 1;
+    }
+    // No command ran, wherever a script or the shell might have run it.
+    let found = Command::new("find")
+        .args([s(&d.0), "/tmp", "-maxdepth", "4", "-name", "PWNED*"])
+        .output()
+        .unwrap();
+    let found = String::from_utf8_lossy(&found.stdout);
+    assert!(found.trim().is_empty(), "a name ran a command: {found}");
+    eprintln!("24 odd names: {made} made the image, {refused} refused");
+    assert!(made >= 8, "made {made}, refused {refused}");
 }

@@ -71,6 +71,37 @@ impl TileHeader {
                 ))
             }
         };
+        // What the reader lets pass but a writer refuses (a standard attribute of the wrong
+        // type, kept as a custom one), since the first tile's header is written again.
+        if let Err(e) = exr::meta::MetaData::validate(&meta.headers, true) {
+            return Err(bad(path, format!("its header is not valid: {e}")));
+        }
+        // Names and type names are NUL-terminated in the file: one the reader took with a NUL
+        // inside would be written as another header.
+        let printable =
+            |t: &Text| !t.bytes().is_empty() && t.bytes().iter().all(|b| (0x20..0x7f).contains(b));
+        for h in &meta.headers {
+            for (name, value) in h
+                .own_attributes
+                .other
+                .iter()
+                .chain(&h.shared_attributes.other)
+            {
+                let kind_ok = match value {
+                    AttributeValue::Custom { kind, .. } => printable(kind),
+                    _ => true,
+                };
+                if !printable(name) || !kind_ok {
+                    return Err(bad(
+                        path,
+                        format!(
+                            "its header has a malformed attribute ({:?})",
+                            name.to_string()
+                        ),
+                    ));
+                }
+            }
+        }
         let n = meta.headers.len();
         let Some(header) = meta.headers.into_iter().next().filter(|_| n == 1) else {
             return Err(bad(

@@ -88,6 +88,12 @@ pub(super) fn channels(
     (AnyChannels::sort(list), extra)
 }
 
+/// A header string as OpenEXR stores it: its UTF-8 bytes (the exr crate's `Text::from`
+/// panics on characters beyond Latin-1: a scene named `雪.toml`, an object named `雪`).
+fn text(s: &str) -> Text {
+    Text::from_slice_unchecked(s.as_bytes())
+}
+
 /// The file's header, for an image of `size` whose channels are those of `template` (its
 /// samples unused) and whose extra attributes are `extra`.
 fn headers(
@@ -117,16 +123,16 @@ fn headers(
             _ => {}
         }
         let value = match value {
-            Attribute::Text(t) => AttributeValue::Text(Text::from(t.as_str())),
+            Attribute::Text(t) => AttributeValue::Text(text(t)),
             Attribute::Texts(ts) => {
-                AttributeValue::TextVector(ts.iter().map(|t| Text::from(t.as_str())).collect())
+                AttributeValue::TextVector(ts.iter().map(|t| text(t)).collect())
             }
             Attribute::Number(x) => AttributeValue::F64(*x),
             Attribute::Int(i) => AttributeValue::I32(*i),
             Attribute::Vector(v) => AttributeValue::FloatVec3((v[0], v[1], v[2])),
             Attribute::Matrix(m) => AttributeValue::Matrix4x4(*m),
         };
-        attrs.other.insert(Text::from(name.as_str()), value);
+        attrs.other.insert(text(name), value);
     }
     // Scanlines, which compositors stream, in increasing order.
     let encoding = Encoding {

@@ -1,5 +1,5 @@
-//! OpenEXR's own validator on files the tests write: `tests/exrcheck/exrcheck.cpp` built once
-//! per test binary with g++ against libopenexr-dev (scripts/setup.sh installs both).
+//! OpenEXR's own validator on files the tests write: `tests/exrcheck/exrcheck.cpp` built with g++
+//! (once, again when the source changes) against libopenexr-dev (scripts/setup.sh installs both).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -8,9 +8,15 @@ use std::sync::OnceLock;
 fn tool() -> &'static Path {
     static TOOL: OnceLock<PathBuf> = OnceLock::new();
     TOOL.get_or_init(|| {
-        let exe =
-            Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("exrcheck-{}", std::process::id()));
+        let exe = Path::new(env!("CARGO_TARGET_TMPDIR")).join("exrcheck");
         let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/exrcheck/exrcheck.cpp");
+        let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+        if modified(&exe).is_some() && modified(&exe) >= modified(&source) {
+            return exe;
+        }
+        // Built beside it, then renamed: a test binary running at the same time sees the old
+        // tool or the new one, never half of one.
+        let building = exe.with_extension(format!("{}", std::process::id()));
         let flags = Command::new("pkg-config")
             .args(["--cflags", "--libs", "OpenEXR"])
             .output()
@@ -23,7 +29,7 @@ fn tool() -> &'static Path {
         let built = Command::new("g++")
             .arg("-O1")
             .arg("-o")
-            .arg(&exe)
+            .arg(&building)
             .arg(&source)
             .args(flags.split_whitespace())
             .output()
@@ -33,6 +39,7 @@ fn tool() -> &'static Path {
             "building exrcheck: {}",
             String::from_utf8_lossy(&built.stderr)
         );
+        std::fs::rename(&building, &exe).expect("exrcheck put in place");
         exe
     })
 }
