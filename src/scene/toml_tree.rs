@@ -11,7 +11,6 @@
 //! `toml_edit` on hostile input.
 
 use super::doc::{Form, Lines, Node, Origin, Val};
-use std::collections::HashMap;
 use toml_parser::decoder::{Encoding, ScalarKind};
 use toml_parser::lexer::{Token, TokenKind};
 use toml_parser::parser::{EventReceiver, RecursionGuard, ValidateWhitespace};
@@ -223,7 +222,7 @@ struct Builder<'i, 'l> {
     value: Option<Node>,
     /// Where each key of `current` is among its entries: a table of a million keys is read in
     /// linear time, not by a search of its entries per key.
-    current_keys: HashMap<String, usize>,
+    current_keys: KeyIndex,
 }
 
 fn table(origin: Origin, form: Form) -> Node {
@@ -252,7 +251,7 @@ impl<'i, 'l> Builder<'i, 'l> {
             in_header: None,
             open: Vec::new(),
             value: None,
-            current_keys: HashMap::new(),
+            current_keys: KeyIndex::default(),
         }
     }
 
@@ -351,8 +350,8 @@ impl<'i, 'l> Builder<'i, 'l> {
         self.header = Some(header);
         self.current_keys.clear();
         if let Val::Table(entries) = &fresh.val {
-            for (i, (k, _)) in entries.iter().enumerate() {
-                self.current_keys.insert(k.clone(), i);
+            for i in 0..entries.len() {
+                self.current_keys.insert(entries, i);
             }
         }
         self.current = fresh;
@@ -385,7 +384,7 @@ fn descend<'t>(
 /// for the first step.
 fn descend_indexed<'t>(
     mut node: &'t mut Node,
-    mut index: Option<&mut HashMap<String, usize>>,
+    mut index: Option<&mut KeyIndex>,
     path: &[Key],
     dotted: bool,
     place: Place,
@@ -395,14 +394,9 @@ fn descend_indexed<'t>(
         let Val::Table(entries) = &mut node.val else {
             return Err(err("cannot extend a value with a dotted key", key.at));
         };
-        let found = match index.take() {
-            Some(index) => {
-                let found = index.get(&key.name).copied();
-                if found.is_none() {
-                    index.insert(key.name.clone(), entries.len());
-                }
-                found
-            }
+        let index = index.take();
+        let found = match &index {
+            Some(index) => index.find(entries, &key.name),
             None => entries.iter().position(|(k, _)| *k == key.name),
         };
         let i = match found {
@@ -416,6 +410,9 @@ fn descend_indexed<'t>(
                     form = form.with(Form::INLINE);
                 }
                 entries.push((key.name.clone(), table(place.at(key.at), form)));
+                if let Some(index) = index {
+                    index.insert(entries, entries.len() - 1);
+                }
                 entries.len() - 1
             }
         };
@@ -453,6 +450,49 @@ fn descend_indexed<'t>(
     Ok(node)
 }
 
+/// Where each key of a table is among its entries, found by the key's hash and checked against
+/// the entry's own name (no copy of the name is kept). Seeded per process, so that a file
+/// cannot be written to collide.
+#[derive(Default)]
+struct KeyIndex {
+    /// Each entry's hash (kept, so growing the table reads no names) and index.
+    table: hashbrown::HashTable<(u64, usize)>,
+    hasher: hashbrown::DefaultHashBuilder,
+}
+
+impl KeyIndex {
+    fn clear(&mut self) {
+        self.table.clear();
+    }
+
+    fn hash(&self, name: &str) -> u64 {
+        use std::hash::BuildHasher;
+        self.hasher.hash_one(name)
+    }
+
+    /// Which of `entries` is named `name`.
+    fn find(&self, entries: &[(String, Node)], name: &str) -> Option<usize> {
+        self.find_hashed(entries, name, self.hash(name))
+    }
+
+    /// Which of `entries` is named `name`, whose hash is `hash`.
+    fn find_hashed(&self, entries: &[(String, Node)], name: &str, hash: u64) -> Option<usize> {
+        self.table
+            .find(hash, |&(h, i)| h == hash && entries[i].0 == name)
+            .map(|&(_, i)| i)
+    }
+
+    /// Index `entries[i]`, whose name is not indexed yet.
+    fn insert(&mut self, entries: &[(String, Node)], i: usize) {
+        self.insert_hashed(self.hash(&entries[i].0), i);
+    }
+
+    /// Index entry `i`, whose name's hash is `hash` and is not indexed yet.
+    fn insert_hashed(&mut self, hash: u64, i: usize) {
+        self.table.insert_unique(hash, (hash, i), |&(h, _)| h);
+    }
+}
+
 /// Put `value` at the dotted key `key` of `table`.
 fn insert(table: &mut Node, key: Vec<Key>, value: Node, place: Place, error: &mut dyn ErrorSink) {
     insert_indexed(table, None, key, value, place, error)
@@ -461,15 +501,17 @@ fn insert(table: &mut Node, key: Vec<Key>, value: Node, place: Place, error: &mu
 /// `insert`, with `index` (where each key of `table` is among its entries, kept up to date).
 fn insert_indexed(
     table: &mut Node,
-    mut index: Option<&mut HashMap<String, usize>>,
-    key: Vec<Key>,
+    mut index: Option<&mut KeyIndex>,
+    mut key: Vec<Key>,
     mut value: Node,
     place: Place,
     error: &mut dyn ErrorSink,
 ) {
-    let Some((last, path)) = key.split_last() else {
+    // The last key's name moves into the table.
+    let Some(last) = key.pop() else {
         return;
     };
+    let path = &key[..];
     // The index is the table's own: it serves the first step of a dotted key, or the key.
     let (step, own) = match path.is_empty() {
         true => (None, index.take()),
@@ -486,18 +528,19 @@ fn insert_indexed(
     let Val::Table(entries) = &mut parent.val else {
         return;
     };
-    let taken = match &own {
-        Some(index) => index.contains_key(&last.name),
-        None => entries.iter().any(|(k, _)| *k == last.name),
+    let hash = own.as_ref().map(|index| index.hash(&last.name));
+    let taken = match (&own, hash) {
+        (Some(index), Some(hash)) => index.find_hashed(entries, &last.name, hash).is_some(),
+        _ => entries.iter().any(|(k, _)| *k == last.name),
     };
     if taken {
         return error.report_error(err("duplicate key", last.at));
     }
-    if let Some(index) = own {
-        index.insert(last.name.clone(), entries.len());
-    }
     value.origin = place.at(last.at);
-    entries.push((last.name.clone(), value));
+    entries.push((last.name, value));
+    if let (Some(index), Some(hash)) = (own, hash) {
+        index.insert_hashed(hash, entries.len() - 1);
+    }
 }
 
 impl EventReceiver for Builder<'_, '_> {
