@@ -52,11 +52,36 @@ fn channels_types_compression_and_header_as_openimageio_reads_them() {
         assert!(info.contains(needle), "`{needle}` in:\n{info}");
     }
     assert!(!info.contains("tile"), "scanlines, not tiles:\n{info}");
+    // OpenEXR's own validator accepts what every compression and precision writes.
+    for (name, extra) in [
+        ("zips", &["--compression", "zips"][..]),
+        ("rle", &["--compression", "rle", "--half"]),
+        ("none", &["--compression", "none", "--passes", "none"]),
+        ("crop", &["--tiles", "2x2", "--tile", "3"]),
+    ] {
+        let out = d.0.join(format!("{name}.exr"));
+        let mut args = vec!["render", s, "-o", out.to_str().unwrap(), "-q"];
+        args.extend_from_slice(extra);
+        let (code, err) = status(&args);
+        assert_eq!(code, Some(0), "{name}: {err}");
+        assert!(
+            common::exrcheck::valid(&out),
+            "exrcheck rejects the {name} EXR"
+        );
+    }
+    assert!(
+        common::exrcheck::valid(&plain),
+        "exrcheck rejects the default EXR"
+    );
     let half = d.0.join("half.exr");
     let h = half.to_str().unwrap();
     let (code, err) = status(&["render", s, "-o", h, "-q", "--half", "--compression", "piz"]);
     assert_eq!(code, Some(0), "{err}");
     let info = oiiotool(&["--info", "-v", h]);
+    assert!(
+        common::exrcheck::valid(&half),
+        "exrcheck rejects the half, PIZ EXR"
+    );
     for needle in [
         "R (half)",
         "A (half)",
