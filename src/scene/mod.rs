@@ -6,12 +6,14 @@ pub(crate) mod doc;
 mod envelope;
 mod error;
 mod load;
+mod mesh_file;
 mod model;
 mod objects;
 mod pass_set;
 mod procedural;
 mod reader;
 pub(crate) mod toml_tree;
+mod transform;
 
 pub use error::SceneError;
 pub use load::{load_file, load_file_as, load_str, FrameSize};

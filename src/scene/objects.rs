@@ -3,6 +3,7 @@
 
 use super::procedural::{BarArray, Lattice};
 use super::reader::{SceneResult, Table};
+use super::transform::{Transform, KEYS};
 use crate::geometry::{Blocks, Implicit};
 use crate::geometry::{Geometry, Primitive};
 use glam::DVec3;
@@ -33,6 +34,10 @@ pub(super) const OBJECT_KEYS: &[&str] = &[
     "bar_size",
     "length",
     "axis",
+    "file",
+    "translate",
+    "rotate",
+    "scale",
 ];
 
 fn material_ref(
@@ -109,6 +114,65 @@ fn at_value(t: &Table, key: &str, why: impl Into<String>) -> super::SceneError {
     }
 }
 
+/// The twelve triangles of the box from `min` to `max`, two per face, counter-clockwise seen
+/// from outside.
+fn box_triangles(min: DVec3, max: DVec3) -> [[DVec3; 3]; 12] {
+    let c = |i: usize| {
+        DVec3::new(
+            if i & 1 == 0 { min.x } else { max.x },
+            if i & 2 == 0 { min.y } else { max.y },
+            if i & 4 == 0 { min.z } else { max.z },
+        )
+    };
+    // Each face's corners in order around it, seen from outside.
+    let faces = [
+        [0, 2, 3, 1], // z = min
+        [4, 5, 7, 6], // z = max
+        [0, 1, 5, 4], // y = min
+        [2, 6, 7, 3], // y = max
+        [0, 4, 6, 2], // x = min
+        [1, 3, 7, 5], // x = max
+    ];
+    let mut out = [[DVec3::ZERO; 3]; 12];
+    for (f, q) in faces.iter().enumerate() {
+        out[2 * f] = [c(q[0]), c(q[1]), c(q[2])];
+        out[2 * f + 1] = [c(q[0]), c(q[2]), c(q[3])];
+    }
+    out
+}
+
+/// The mesh `file` names, relative to the scene file's folder; errors name the scene's line
+/// and key, and the mesh file with its own line.
+fn read_mesh_file(t: &Table) -> SceneResult<super::mesh_file::MeshData> {
+    let name = t.req_string("file")?;
+    let node = t.get("file").expect("read above");
+    let base = std::path::Path::new(t.file())
+        .parent()
+        .unwrap_or(std::path::Path::new(""));
+    let path = base.join(name);
+    if let Ok(m) = std::fs::metadata(&path) {
+        let need = m
+            .len()
+            .saturating_mul(super::mesh_file::BYTES_PER_FILE_BYTE);
+        let what = format!(
+            "reading the mesh file {} ({})",
+            path.display(),
+            crate::memory::human(m.len())
+        );
+        if let Some(why) = crate::memory::too_much(need, &what) {
+            return Err(t.error_at(node, "file", why));
+        }
+    }
+    super::mesh_file::read(&path).map_err(|e| {
+        let at = e.line.map_or(String::new(), |l| format!(":{l}"));
+        t.error_at(
+            node,
+            "file",
+            format!("{}{at}: {}", path.display(), e.message),
+        )
+    })
+}
+
 pub(super) fn add_object(
     t: &Table,
     id: u32,
@@ -118,26 +182,111 @@ pub(super) fn add_object(
 ) -> SceneResult<String> {
     let kind = t.req_string("type")?;
     let mat = material_ref(t, "material", mats, 0)?;
+    let transform = Transform::read(t)?;
+    // A sphere or rod stays one under a uniform scale only.
+    let uniform = |what: &str| match &transform {
+        Some(x) if !x.is_uniform() => Err(at_value(
+            t,
+            "scale",
+            format!(
+                "a {what} scaled unevenly is no longer a {what}: give one factor, or use a mesh"
+            ),
+        )),
+        _ => Ok(transform.map_or(1.0, |x| x.scale.x)),
+    };
     match kind {
         "box" => {
             let (min, max) = (t.req_vec3("min")?, t.req_vec3("max")?);
             if min.cmpge(max).any() {
                 return Err(t.error("max", "every coordinate of max must exceed min"));
             }
-            budget(t, "type", total, 1)?;
-            geo.push_part(id, mat, [Primitive::Cuboid { min, max }]);
+            match transform {
+                None => {
+                    budget(t, "type", total, 1)?;
+                    geo.push_part(id, mat, [Primitive::Cuboid { min, max }]);
+                }
+                // Turned by quarter turns: still a box, its corners moved.
+                Some(x) if x.axis_permutation().is_some() => {
+                    let exact = Transform {
+                        rotation: x.axis_permutation().expect("checked"),
+                        ..x
+                    };
+                    let (a, b) = (exact.point(min), exact.point(max));
+                    budget(t, "type", total, 1)?;
+                    geo.push_part(
+                        id,
+                        mat,
+                        [Primitive::Cuboid {
+                            min: a.min(b),
+                            max: a.max(b),
+                        }],
+                    );
+                }
+                // Turned otherwise: its twelve triangles.
+                Some(x) => {
+                    budget(t, "type", total, 12)?;
+                    geo.push_part(
+                        id,
+                        mat,
+                        box_triangles(min, max).map(|v| Primitive::Triangle {
+                            v: v.map(|p| x.point(p)),
+                        }),
+                    );
+                }
+            }
         }
         "sphere" => {
             let center = t.req_vec3("center")?;
             let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
+            let s = uniform("sphere")?;
+            let center = transform.map_or(center, |x| x.point(center));
             budget(t, "type", total, 1)?;
-            geo.push_part(id, mat, [Primitive::Sphere { center, radius }]);
+            geo.push_part(
+                id,
+                mat,
+                [Primitive::Sphere {
+                    center,
+                    radius: radius * s,
+                }],
+            );
         }
         "rod" => {
             let (a, b) = (t.req_vec3("from")?, t.req_vec3("to")?);
             let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
+            let s = uniform("rod")?;
+            let (a, b) = transform.map_or((a, b), |x| (x.point(a), x.point(b)));
             budget(t, "type", total, 1)?;
-            geo.push_part(id, mat, [Primitive::Capsule { a, b, radius }]);
+            geo.push_part(
+                id,
+                mat,
+                [Primitive::Capsule {
+                    a,
+                    b,
+                    radius: radius * s,
+                }],
+            );
+        }
+        "mesh" if t.has("file") => {
+            if let Some(k) = ["vertices", "indices"].into_iter().find(|k| t.has(k)) {
+                return Err(at_value(
+                    t,
+                    k,
+                    "a mesh is given by `file` or by `vertices` and `indices`, not both",
+                ));
+            }
+            let mesh = read_mesh_file(t)?;
+            budget(t, "file", total, mesh.triangles.len() as u64)?;
+            let at = |i: u32| {
+                let p = mesh.positions[i as usize];
+                transform.map_or(p, |x| x.point(p))
+            };
+            geo.push_part(
+                id,
+                mat,
+                mesh.triangles
+                    .iter()
+                    .map(|tri| Primitive::Triangle { v: tri.map(at) }),
+            );
         }
         "mesh" => {
             let vn = t
@@ -176,7 +325,7 @@ pub(super) fn add_object(
                             idx[k] = *x as usize;
                         }
                         Ok(Primitive::Triangle {
-                            v: idx.map(|i| verts[i]),
+                            v: idx.map(|i| transform.map_or(verts[i], |x| x.point(verts[i]))),
                         })
                     })
                     .collect::<SceneResult<Vec<_>>>()?,
@@ -187,6 +336,19 @@ pub(super) fn add_object(
             }
             budget(t, "type", total, tris.len() as u64)?;
             geo.push_part(id, mat, tris);
+        }
+        "lattice" | "bar_array" if transform.is_some() => {
+            let key = KEYS
+                .into_iter()
+                .find(|k| t.has(k))
+                .expect("a transform has a key");
+            return Err(at_value(
+                t,
+                key,
+                format!(
+                    "transforms apply to boxes, spheres, rods and meshes; a {kind} is placed by its own keys (origin, center, spacing, axis)"
+                ),
+            ));
         }
         "lattice" => {
             let counts = t

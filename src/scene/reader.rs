@@ -33,6 +33,11 @@ impl<'a> Table<'a> {
         })
     }
 
+    /// The scene file's name, as errors give it (a path: meshes are found beside it).
+    pub fn file(&self) -> &'a str {
+        &self.doc.file
+    }
+
     pub fn root(doc: &'a Doc) -> SceneResult<Table<'a>> {
         Table::new(doc, &doc.root, String::new())
     }
