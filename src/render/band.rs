@@ -170,8 +170,7 @@ pub fn needs_spectra(scene: &Scene) -> bool {
     }
     let mut colours = vec![&scene.image.background, &scene.render.ambient];
     for m in &scene.materials {
-        colours.extend([&m.color, &m.specular]);
-        colours.extend(m.emission.as_ref());
+        colours.extend(m.colours());
     }
     colours.extend(scene.lights.iter().map(|l| &l.radiance));
     if colours.iter().any(|c| !c.from_rgb) {
@@ -210,9 +209,7 @@ pub fn extrapolation_warning(scene: &Scene) -> Option<String> {
     let coloured = |c: &crate::spectrum::Colour| {
         c.from_rgb && !c.is_black() && !(c.rgb.x == c.rgb.y && c.rgb.y == c.rgb.z)
     };
-    let materials = scene.materials.iter().any(|m| {
-        coloured(&m.color) || coloured(&m.specular) || m.emission.as_ref().is_some_and(coloured)
-    });
+    let materials = scene.materials.iter().any(|m| m.colours().any(coloured));
     let cam = &scene.camera.velocity;
     // The rapidity between two velocities: cosh φ = γ_u γ_v (1 − u·v).
     let between = |v: &Velocity| {

@@ -188,6 +188,8 @@ impl<'a, B: Band> Shader<'a, B> {
         let event = ray.at(hit.lambda);
         let lit = Lit {
             mat,
+            point: hit.point,
+            outward: n,
             group: hit.group,
             event,
             v,
@@ -256,9 +258,17 @@ impl<'a, B: Band> Shader<'a, B> {
     ) -> (B, u64) {
         let (mat, at) = (lit.mat, B::at(lit.shift));
         if let Some(e) = &mat.emission {
+            let e = mat
+                .emission_texture
+                .as_ref()
+                .map_or(e, |t| t.colour_at(lit.point, lit.outward));
             return (B::of(e, at), 0);
         }
-        let diffuse = B::of(&mat.color, at);
+        let colour = mat
+            .color_texture
+            .as_ref()
+            .map_or(&mat.color, |t| t.colour_at(lit.point, lit.outward));
+        let diffuse = B::of(colour, at);
         let mut color = B::of(&self.scene.render.ambient, at);
         color.mul_by(&diffuse);
         let specular = (!mat.specular.is_black()).then(|| B::of(&mat.specular, at));
@@ -343,6 +353,10 @@ struct LightTerm {
 /// A hit prepared for shading: see [`Shader::prepare`].
 pub struct Lit<'a> {
     mat: &'a crate::scene::Material,
+    /// The hit in its group's rest frame (where textures are laid out), and the surface's
+    /// outward normal there.
+    point: DVec3,
+    outward: DVec3,
     group: usize,
     event: Event,
     v: DVec3,

@@ -5,7 +5,7 @@ use super::doc::Val;
 use super::reader::{SceneResult, Table};
 use crate::spectrum::{camera, Colour, Role, Spectrum};
 
-const FORMS: &str = "[r, g, b] (linear, e.g. [0.8, 0.8, 0.8]), a grey number (0.8), { blackbody = T }, { line = NM, fwhm = NM } or { wavelengths = [...], values = [...] }";
+pub(super) const FORMS: &str = "[r, g, b] (linear, e.g. [0.8, 0.8, 0.8]), a grey number (0.8), { blackbody = T }, { line = NM, fwhm = NM } or { wavelengths = [...], values = [...] }";
 
 impl Table<'_> {
     /// A colour for `role`. Reflectances take RGB and tables only.

@@ -4,7 +4,7 @@ use super::doc::Doc;
 use super::model::*;
 use super::objects::{add_object, OBJECT_KEYS};
 use super::reader::{SceneResult, Table};
-use super::{PassSet, SceneError};
+use super::{PassSet, SceneError, Texture};
 use crate::geometry::Geometry;
 use crate::spacetime::Velocity;
 use crate::spectrum::{Colour, Role};
@@ -173,10 +173,11 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         Some(t) => render_settings(&t)?,
         None => RenderSettings::default(),
     };
+    let textures = textures(&root)?;
     let mut materials = vec![Material::default_white()];
     let mut material_ids: HashMap<String, u32> = HashMap::new();
     for t in root.tables("material")? {
-        let m = material(&t)?;
+        let m = material(&t, &textures)?;
         if material_ids.contains_key(&m.name) {
             return Err(t.error(
                 "name",
@@ -255,7 +256,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     }
     let film = root.table("film")?.map(|t| film(&t, &camera)).transpose()?;
     root.finish(&[
-        "camera", "image", "render", "material", "light", "group", "film",
+        "camera", "image", "render", "material", "texture", "light", "group", "film",
     ])?;
     Ok(Scene {
         camera,
@@ -556,12 +557,127 @@ fn render_settings(t: &Table) -> SceneResult<RenderSettings> {
     Ok(s)
 }
 
-fn material(t: &Table) -> SceneResult<Material> {
+/// A texture read for each role a material may give it (its colours uplifted as reflectances
+/// for `color`, as emitters for `emission`).
+struct ReadTexture {
+    name: String,
+    reflectance: Arc<Texture>,
+    emitter: Arc<Texture>,
+}
+
+/// The `[[texture]]` tables.
+fn textures(root: &Table) -> SceneResult<Vec<ReadTexture>> {
+    let mut out: Vec<ReadTexture> = Vec::new();
+    for t in root.tables("texture")? {
+        let name = t.req_string("name")?.to_string();
+        if out.iter().any(|x| x.name == name) {
+            return Err(t.error("name", format!("a texture named `{name}` is defined twice")));
+        }
+        let Some(c) = t.table("checker")? else {
+            return Err(t.error(
+                "checker",
+                "missing: a texture is a `checker = { size, color1, color2 }`",
+            ));
+        };
+        let size = match c.get("size") {
+            None => return Err(c.error("size", "missing: the checker's square size (a number, or [sx, sy, sz] with 0 for no change along an axis)")),
+            Some(n) => {
+                let s = match n.val {
+                    super::doc::Val::Array(_) => {
+                        let v = c.numbers_of(n, "size", Some(3))?;
+                        DVec3::new(v[0], v[1], v[2])
+                    }
+                    _ => DVec3::splat(c.f64_or("size", 1.0)?),
+                };
+                if s.cmplt(DVec3::ZERO).any() || s == DVec3::ZERO {
+                    return Err(c.error_at(n, "size", "sizes must be 0 or more, and one greater than 0"));
+                }
+                s
+            }
+        };
+        let both = |role| -> SceneResult<[crate::spectrum::Colour; 2]> {
+            let get = |k: &str| {
+                c.colour(k, role)?.ok_or_else(|| {
+                    c.error(
+                        k,
+                        "missing: give the checker's two colours, color1 and color2",
+                    )
+                })
+            };
+            Ok([get("color1")?, get("color2")?])
+        };
+        let reflectance = Arc::new(Texture::Checker {
+            size,
+            colors: both(Role::Reflectance)?,
+        });
+        let emitter = Arc::new(Texture::Checker {
+            size,
+            colors: both(Role::Emitter)?,
+        });
+        c.finish(&["size", "color1", "color2"])?;
+        t.finish(&["name", "checker"])?;
+        out.push(ReadTexture {
+            name,
+            reflectance,
+            emitter,
+        });
+    }
+    Ok(out)
+}
+
+/// A material's colour key: a colour, or the name of a texture (with the colour to hold in
+/// its place: the texture's first).
+fn colour_or_texture(
+    t: &Table,
+    key: &str,
+    role: Role,
+    textures: &[ReadTexture],
+) -> SceneResult<(Option<crate::spectrum::Colour>, Option<Arc<Texture>>)> {
+    let Some(name) = t.get(key).and_then(|n| match &n.val {
+        super::doc::Val::Str(s) => Some(s.as_str()),
+        _ => None,
+    }) else {
+        return Ok((t.colour(key, role)?, None));
+    };
+    let _ = t.string(key)?;
+    let Some(found) = textures.iter().find(|x| x.name == name) else {
+        let known: Vec<&str> = textures.iter().map(|x| x.name.as_str()).collect();
+        let n = t.get(key).expect("read above");
+        return Err(t.error_at(
+            n,
+            key,
+            format!(
+                "expected a colour, found a string: no texture is named `{name}` (textures: {}), \
+                 and colours have no names (red is [0.8, 0.1, 0.1]); a colour is {}",
+                if known.is_empty() {
+                    "none defined".to_string()
+                } else {
+                    known.join(", ")
+                },
+                super::colour::FORMS
+            ),
+        ));
+    };
+    let texture = match role {
+        Role::Emitter => found.emitter.clone(),
+        _ => found.reflectance.clone(),
+    };
+    let first = texture
+        .colours()
+        .next()
+        .expect("a texture has colours")
+        .clone();
+    Ok((Some(first), Some(texture)))
+}
+
+fn material(t: &Table, textures: &[ReadTexture]) -> SceneResult<Material> {
     let d = Material::default_white();
     let unit = |v: f64| (0.0..=1.0).contains(&v);
+    let (color, color_texture) = colour_or_texture(t, "color", Role::Reflectance, textures)?;
+    let (emission, emission_texture) = colour_or_texture(t, "emission", Role::Emitter, textures)?;
     let m = Material {
         name: t.req_string("name")?.to_string(),
-        color: t.colour("color", Role::Reflectance)?.unwrap_or(d.color),
+        color: color.unwrap_or(d.color),
         specular: t
             .colour("specular", Role::Reflectance)?
             .unwrap_or(d.specular),
@@ -569,7 +685,9 @@ fn material(t: &Table) -> SceneResult<Material> {
         reflect: t.f64_where("reflect", Some(0.0), unit, "between 0 and 1")?,
         transmit: t.f64_where("transmit", Some(0.0), unit, "between 0 and 1")?,
         ior: t.f64_where("ior", Some(d.ior), |v| v >= 1.0, "1 or more")?,
-        emission: t.colour("emission", Role::Emitter)?,
+        emission,
+        color_texture,
+        emission_texture,
     };
     t.finish(&[
         "name",

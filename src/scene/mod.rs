@@ -12,6 +12,7 @@ mod objects;
 mod pass_set;
 mod procedural;
 mod reader;
+mod texture;
 pub(crate) mod toml_tree;
 mod transform;
 
@@ -22,3 +23,4 @@ pub use model::{
     RenderSettings, Scene, MAX_FRAMES, MAX_FRAME_PIXELS, MAX_RAYS,
 };
 pub use pass_set::{Pass, PassSet};
+pub use texture::Texture;

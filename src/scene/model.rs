@@ -206,9 +206,23 @@ pub struct Material {
     pub ior: f64,
     /// Radiance emitted in the surface's rest frame (the surface then reflects nothing).
     pub emission: Option<Colour>,
+    /// A texture giving the diffuse reflectance in place of `color`.
+    pub color_texture: Option<std::sync::Arc<super::Texture>>,
+    /// A texture giving the emitted radiance in place of `emission` (which then holds its first
+    /// colour, so that the surface is known to emit).
+    pub emission_texture: Option<std::sync::Arc<super::Texture>>,
 }
 
 impl Material {
+    /// Every colour the material may show: its own and its textures'.
+    pub fn colours(&self) -> impl Iterator<Item = &Colour> {
+        [&self.color, &self.specular]
+            .into_iter()
+            .chain(self.emission.as_ref())
+            .chain(self.color_texture.iter().flat_map(|t| t.colours()))
+            .chain(self.emission_texture.iter().flat_map(|t| t.colours()))
+    }
+
     /// The material of objects that name none: grey 0.8 diffuse.
     pub fn default_white() -> Material {
         Material {
@@ -220,6 +234,8 @@ impl Material {
             transmit: 0.0,
             ior: 1.5,
             emission: None,
+            color_texture: None,
+            emission_texture: None,
         }
     }
 }

@@ -1,0 +1,183 @@
+//! Textures (docs/scene-format.md, "Textures"): a checker laid out in the rest frame of its
+//! object's group moves and deforms with the object exactly as geometry does: a plate with a
+//! checker renders as the same plate built from small boxes of alternating materials, at rest
+//! and at 0.6c and 0.9c, on both backends, Doppler shift and searchlight included. Bad texture
+//! references are clear errors.
+
+mod common;
+use common::cli::{status, Dir};
+use common::*;
+use rest_embree::render::{Frame, PixelValue};
+
+const HEAD: &str = r#"[camera]
+position = [0.3, -3.0, 2.2]
+look_at = [0, 0, 0]
+fov_y = 50
+time = 0
+
+[image]
+width = 120
+height = 90
+
+[[material]]
+name = "light"
+color = [0.9, 0.85, 0.7]
+
+[[material]]
+name = "dark"
+color = [0.1, 0.2, 0.5]
+
+[[light]]
+position = [1, -2, 4]
+intensity = 30
+"#;
+
+/// The plate, a checker of 0.5 squares over x and y in [-1, 1], top face at z = 0.
+fn checker_plate(velocity: &str) -> String {
+    format!(
+        "{HEAD}\n[[texture]]\nname = \"squares\"\nchecker = {{ size = [0.5, 0.5, 0], color1 = [0.9, 0.85, 0.7], color2 = [0.1, 0.2, 0.5] }}\n\n\
+         [[material]]\nname = \"checked\"\ncolor = \"squares\"\n\n\
+         [[group]]\nname = \"plate\"\nvelocity = {velocity}\n\
+         [[group.object]]\ntype = \"box\"\nmin = [-1, -1, -0.1]\nmax = [1, 1, 0]\nmaterial = \"checked\"\n"
+    )
+}
+
+/// The same plate as sixteen boxes, each of the colour the checker gives its square.
+fn boxes_plate(velocity: &str) -> String {
+    let mut s = format!("{HEAD}\n[[group]]\nname = \"plate\"\nvelocity = {velocity}\n");
+    for i in -2i32..2 {
+        for j in -2..2 {
+            let (x, y) = (f64::from(i) * 0.5, f64::from(j) * 0.5);
+            let m = if (i + j).rem_euclid(2) == 0 {
+                "light"
+            } else {
+                "dark"
+            };
+            s.push_str(&format!(
+                "[[group.object]]\ntype = \"box\"\nmin = [{x:?}, {y:?}, -0.1]\nmax = [{:?}, {:?}, 0]\nmaterial = \"{m}\"\n",
+                x + 0.5,
+                y + 0.5
+            ));
+        }
+    }
+    s
+}
+
+fn at(f: &Frame, x: i64, y: i64) -> &PixelValue {
+    &f.pixels[(y * i64::from(f.width) + x) as usize]
+}
+
+#[test]
+fn a_checker_moves_and_deforms_as_boxes_do() {
+    let d = Dir::new("texture-checker");
+    for velocity in ["[0, 0, 0]", "[0.6, 0, 0]", "[-0.5, 0.7, 0]"] {
+        let load = |name: &str, text: &str| {
+            let p = d.file(name, text);
+            rest_embree::scene::load_file(&p, &[]).unwrap_or_else(|e| panic!("{e}"))
+        };
+        let (checker, boxes) = (
+            load("checker.toml", &checker_plate(velocity)),
+            load("boxes.toml", &boxes_plate(velocity)),
+        );
+        for b in backends() {
+            let (c, x) = (render_with(&checker, b), render_with(&boxes, b));
+            let (w, h) = (i64::from(c.width), i64::from(c.height));
+            let (mut light, mut dark, mut inside) = (0, 0, 0);
+            for yy in 0..h {
+                for xx in 0..w {
+                    let (p, q) = (at(&c, xx, yy), at(&x, xx, yy));
+                    match q.material_id {
+                        2 => light += 1,
+                        3 => dark += 1,
+                        _ => {}
+                    }
+                    if p.color == q.color && p.alpha == q.alpha {
+                        continue;
+                    }
+                    // Only where the boxes meet: a neighbour of another box or none.
+                    let edge = (-1..=1).any(|dy| {
+                        (-1..=1).any(|dx| {
+                            let (u, v) = (xx + dx, yy + dy);
+                            (0..w).contains(&u)
+                                && (0..h).contains(&v)
+                                && at(&x, u, v).object_id != q.object_id
+                        })
+                    });
+                    if !edge {
+                        inside += 1;
+                    }
+                }
+            }
+            assert!(
+                light > 150 && dark > 150,
+                "{velocity} on {b}: both colours in view ({light}, {dark})"
+            );
+            assert_eq!(
+                inside, 0,
+                "{velocity} on {b}: pixels off the squares' edges differ"
+            );
+        }
+    }
+}
+
+/// An emitting checker glows in its two colours; unknown and malformed textures are refused
+/// at their key with what is accepted.
+#[test]
+fn emission_textures_and_bad_textures() {
+    let d = Dir::new("texture-bad");
+    let glow = checker_plate("[0, 0, 0]").replace("color = \"squares\"", "emission = \"squares\"");
+    let p = d.file("glow.toml", &glow);
+    let scene = rest_embree::scene::load_file(&p, &[]).unwrap();
+    let f = render_with(&scene, "bvh");
+    let hit: Vec<[f32; 3]> = f
+        .pixels
+        .iter()
+        .filter(|p| p.object_id == 1)
+        .map(|p| p.color)
+        .collect();
+    assert!(
+        hit.iter().any(|c| (c[0] - 0.9).abs() < 0.02)
+            && hit.iter().any(|c| (c[2] - 0.5).abs() < 0.02),
+        "both emitted colours seen"
+    );
+    let base = checker_plate("[0, 0, 0]");
+    for (from, to, needles) in [
+        (
+            "color = \"squares\"",
+            "color = \"squarez\"",
+            &[
+                "key `material.checked.color`",
+                "no texture named `squarez`",
+                "textures: squares",
+            ][..],
+        ),
+        ("size = [0.5, 0.5, 0], ", "", &["size", "missing"][..]),
+        (
+            "size = [0.5, 0.5, 0]",
+            "size = [0, 0, 0]",
+            &["size", "greater than 0"][..],
+        ),
+        (
+            "color2 = [0.1, 0.2, 0.5]",
+            "color2 = \"blue\"",
+            &["color2", "a colour is"][..],
+        ),
+        (
+            "checker = {",
+            "checkers = {",
+            &["key `texture.squares.checker`", "missing"][..],
+        ),
+    ] {
+        let text = base.replace(from, to);
+        assert_ne!(text, base, "{from}");
+        let s = d.file("bad.toml", &text);
+        let out = d.0.join("bad.png");
+        let (code, err) = status(&["render", s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        assert_eq!(code, Some(1), "{to}: {err}");
+        assert!(err.contains("bad.toml:"), "{to}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{to}: `{n}` in {err}");
+        }
+        assert!(!out.exists());
+    }
+}
