@@ -147,7 +147,7 @@ fn emission_textures_and_bad_textures() {
             "color = \"squarez\"",
             &[
                 "key `material.checked.color`",
-                "no texture named `squarez`",
+                "no texture is named `squarez`",
                 "textures: squares",
             ][..],
         ),
