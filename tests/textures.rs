@@ -181,3 +181,98 @@ fn emission_textures_and_bad_textures() {
         assert!(!out.exists());
     }
 }
+
+/// Write a `w` x `h` 8-bit RGB PNG whose texel (x, y) is `f(x, y)` (sRGB-encoded bytes).
+fn png(path: &std::path::Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
+    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let mut enc = png::Encoder::new(file, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc.write_header().unwrap();
+    let mut data = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            data.extend(f(x, y));
+        }
+    }
+    writer.write_image_data(&data).unwrap();
+}
+
+/// An image on a sphere: longitude and latitude as docs/scene-format.md maps them. The camera
+/// on -y sees longitudes from -180° (its left) to 0° (its right), u from 0 to 0.5: the image's
+/// first quarter (green) left of the centre, its second (red) right of it, its back half
+/// (blue) nowhere; the top half at full brightness, the bottom half at half (sRGB 188).
+#[test]
+fn an_image_wraps_a_sphere_by_longitude_and_latitude() {
+    let d = Dir::new("texture-image");
+    png(&d.0.join("map.png"), 64, 32, |x, y| {
+        let v = if y < 16 { 255 } else { 188 };
+        match x {
+            0..16 => [0, v, 0],
+            16..32 => [v, 0, 0],
+            _ => [0, 0, v],
+        }
+    });
+    let text = "[camera]\nposition = [0, -5, 0]\nlook_at = [0, 0, 0]\nfov_y = 30\n\n[image]\nwidth = 64\nheight = 64\n\n\
+                [[texture]]\nname = \"map\"\nimage = \"map.png\"\n\n[[material]]\nname = \"planet\"\nemission = \"map\"\n\n\
+                [[group]]\nname = \"planet\"\n[[group.object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"planet\"\n";
+    let p = d.file("planet.toml", text);
+    let scene = rest_embree::scene::load_file(&p, &[]).unwrap();
+    for b in backends() {
+        let f = render_with(&scene, b);
+        let px = |x: i64, y: i64| at(&f, x, y).color;
+        // Left of centre, above: green; right, above: red; right, below: red at half.
+        let (left, right, below) = (px(24, 26), px(40, 26), px(40, 38));
+        assert!(
+            left[1] > 0.95 && left[0] < 0.02 && left[2] < 0.02,
+            "{b}: {left:?}"
+        );
+        assert!(
+            right[0] > 0.95 && right[1] < 0.02 && right[2] < 0.02,
+            "{b}: {right:?}"
+        );
+        assert!(
+            (below[0] - 0.503).abs() < 0.01 && below[2] < 0.02,
+            "{b}: {below:?}"
+        );
+        assert!(
+            f.pixels.iter().all(|p| p.color[2] < 0.02),
+            "{b}: the back half is not seen"
+        );
+    }
+    // A mesh cannot take an image yet; an image that is not one is refused.
+    d.file("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n");
+    d.file("junk.png", "not a png");
+    for (from, to, needles) in [
+        (
+            "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
+            "type = \"mesh\"\nfile = \"tri.obj\"",
+            &["material", "UVs are not read yet"][..],
+        ),
+        (
+            "image = \"map.png\"",
+            "image = \"junk.png\"",
+            &["junk.png", "not a readable PNG"][..],
+        ),
+        (
+            "image = \"map.png\"",
+            "image = \"gone.exr\"",
+            &["gone.exr", "cannot read it"][..],
+        ),
+        (
+            "image = \"map.png\"",
+            "image = \"map.jpg\"",
+            &["map.jpg", "cannot read it"][..],
+        ),
+    ] {
+        let bad = text.replace(from, to);
+        assert_ne!(bad, text);
+        let s = d.file("bad.toml", &bad);
+        let out = d.0.join("bad.png");
+        let (code, err) = status(&["render", s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        assert_eq!(code, Some(1), "{to}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{to}: `{n}` in {err}");
+        }
+    }
+}

@@ -15,6 +15,8 @@ use std::ops::Mul;
 pub(crate) trait Band: Copy + Mul<f64, Output = Self> {
     /// A frame's shift as this band reads colours with it (prepared once per frame).
     type At: Copy;
+    /// Whether the band holds spectra (else RGB, where colours are their RGB exactly).
+    const SPECTRAL: bool;
     /// The frame whose wavelengths are `shift` times the camera's.
     fn at(shift: f64) -> Self::At;
     /// The colour `c` in that frame.
@@ -39,6 +41,7 @@ pub(crate) trait Band: Copy + Mul<f64, Output = Self> {
 }
 
 impl Band for DVec3 {
+    const SPECTRAL: bool = false;
     type At = ();
     fn at(_shift: f64) {}
     fn of(c: &Colour, _: ()) -> Self {
@@ -72,6 +75,7 @@ impl Band for DVec3 {
 }
 
 impl Band for Sampled {
+    const SPECTRAL: bool = true;
     type At = Shift;
     fn at(shift: f64) -> Shift {
         Shift::new(shift)

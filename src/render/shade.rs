@@ -190,6 +190,7 @@ impl<'a, B: Band> Shader<'a, B> {
             mat,
             point: hit.point,
             outward: n,
+            prim,
             group: hit.group,
             event,
             v,
@@ -258,17 +259,12 @@ impl<'a, B: Band> Shader<'a, B> {
     ) -> (B, u64) {
         let (mat, at) = (lit.mat, B::at(lit.shift));
         if let Some(e) = &mat.emission {
-            let e = mat
-                .emission_texture
-                .as_ref()
-                .map_or(e, |t| t.colour_at(lit.point, lit.outward));
-            return (B::of(e, at), 0);
+            return (
+                surface_colour(e, mat.emission_texture.as_deref(), lit, at),
+                0,
+            );
         }
-        let colour = mat
-            .color_texture
-            .as_ref()
-            .map_or(&mat.color, |t| t.colour_at(lit.point, lit.outward));
-        let diffuse = B::of(colour, at);
+        let diffuse = surface_colour(&mat.color, mat.color_texture.as_deref(), lit, at);
         let mut color = B::of(&self.scene.render.ambient, at);
         color.mul_by(&diffuse);
         let specular = (!mat.specular.is_black()).then(|| B::of(&mat.specular, at));
@@ -331,6 +327,28 @@ impl<'a, B: Band> Shader<'a, B> {
     }
 }
 
+/// A material's colour at a hit, or its texture's there, in the band. An image's RGB becomes a
+/// spectrum on its basis (`ImageTexture`): in RGB the texel itself.
+fn surface_colour<B: Band>(
+    colour: &crate::spectrum::Colour,
+    texture: Option<&crate::scene::Texture>,
+    lit: &Lit,
+    at: B::At,
+) -> B {
+    use crate::scene::TextureSample as S;
+    match texture.map(|t| t.at(&lit.prim, lit.point, lit.outward)) {
+        None => B::of(colour, at),
+        Some(S::Colour(c)) => B::of(c, at),
+        Some(S::Rgb(rgb, img)) => {
+            let c = if B::SPECTRAL { img.to_basis * rgb } else { rgb };
+            let mut out = B::of(&img.basis[0], at) * c.x;
+            out.add(&(B::of(&img.basis[1], at) * c.y));
+            out.add(&(B::of(&img.basis[2], at) * c.z));
+            out
+        }
+    }
+}
+
 /// A shadow ray to one light, and what decides the light it brings if nothing is in the way.
 pub struct ShadowQuery {
     pub ray: NullRay,
@@ -357,6 +375,8 @@ pub struct Lit<'a> {
     /// outward normal there.
     point: DVec3,
     outward: DVec3,
+    /// The primitive hit (where an image is mapped from).
+    prim: crate::geometry::Primitive,
     group: usize,
     event: Event,
     v: DVec3,

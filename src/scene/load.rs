@@ -203,6 +203,24 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
             let id = objects.len() as u32;
             let (first, implicit) = (geometry.prims.len(), geometry.implicit.len());
             let kind = add_object(&o, id, &material_ids, &mut geometry, &mut total)?;
+            // An image needs a mapping: spheres, boxes and rods have one; a mesh's UVs are not
+            // read yet.
+            let imaged = |m: u32| {
+                let m = &materials[m as usize];
+                [&m.color_texture, &m.emission_texture]
+                    .into_iter()
+                    .flatten()
+                    .any(|t| matches!(**t, Texture::Image(_)))
+            };
+            let meshed = geometry.prims[first..]
+                .iter()
+                .any(|p| matches!(p, crate::geometry::Primitive::Triangle { .. }));
+            if meshed && geometry.parts.last().is_some_and(|p| imaged(p.material)) {
+                return Err(o.error(
+                    "material",
+                    "its material's texture is an image, which maps onto spheres, boxes and rods; a mesh's UVs are not read yet",
+                ));
+            }
             let held = geometry.prims[first..].iter().map(|p| p.bounds());
             let implicit = geometry.implicit[implicit..]
                 .iter()
@@ -573,49 +591,40 @@ fn textures(root: &Table) -> SceneResult<Vec<ReadTexture>> {
         if out.iter().any(|x| x.name == name) {
             return Err(t.error("name", format!("a texture named `{name}` is defined twice")));
         }
-        let Some(c) = t.table("checker")? else {
-            return Err(t.error(
-                "checker",
-                "missing: a texture is a `checker = { size, color1, color2 }`",
-            ));
-        };
-        let size = match c.get("size") {
-            None => return Err(c.error("size", "missing: the checker's square size (a number, or [sx, sy, sz] with 0 for no change along an axis)")),
-            Some(n) => {
-                let s = match n.val {
-                    super::doc::Val::Array(_) => {
-                        let v = c.numbers_of(n, "size", Some(3))?;
-                        DVec3::new(v[0], v[1], v[2])
-                    }
-                    _ => DVec3::splat(c.f64_or("size", 1.0)?),
+        let (reflectance, emitter) = match (t.table("checker")?, t.string("image")?) {
+            (Some(_), Some(_)) => {
+                return Err(t.error("image", "a texture is a checker or an image, not both"))
+            }
+            (Some(c), None) => checker(&c)?,
+            (None, Some(file)) => {
+                let node = t.get("image").expect("read above");
+                let base = std::path::Path::new(t.file())
+                    .parent()
+                    .unwrap_or(std::path::Path::new(""));
+                let path = base.join(file);
+                let (w, h, texels) = super::texture::read_image(&path).map_err(|why| {
+                    t.error_at(node, "image", format!("{}: {why}", path.display()))
+                })?;
+                let shown = path.display().to_string();
+                let image = |role| {
+                    Arc::new(Texture::Image(super::ImageTexture::new(
+                        shown.clone(),
+                        w,
+                        h,
+                        texels.clone(),
+                        role,
+                    )))
                 };
-                if s.cmplt(DVec3::ZERO).any() || s == DVec3::ZERO {
-                    return Err(c.error_at(n, "size", "sizes must be 0 or more, and one greater than 0"));
-                }
-                s
+                (image(Role::Reflectance), image(Role::Emitter))
+            }
+            (None, None) => {
+                return Err(t.error(
+                    "checker",
+                    "missing: a texture is a `checker = { size, color1, color2 }` or an `image = \"file.png\"` (or .exr)",
+                ))
             }
         };
-        let both = |role| -> SceneResult<[crate::spectrum::Colour; 2]> {
-            let get = |k: &str| {
-                c.colour(k, role)?.ok_or_else(|| {
-                    c.error(
-                        k,
-                        "missing: give the checker's two colours, color1 and color2",
-                    )
-                })
-            };
-            Ok([get("color1")?, get("color2")?])
-        };
-        let reflectance = Arc::new(Texture::Checker {
-            size,
-            colors: both(Role::Reflectance)?,
-        });
-        let emitter = Arc::new(Texture::Checker {
-            size,
-            colors: both(Role::Emitter)?,
-        });
-        c.finish(&["size", "color1", "color2"])?;
-        t.finish(&["name", "checker"])?;
+        t.finish(&["name", "checker", "image"])?;
         out.push(ReadTexture {
             name,
             reflectance,
@@ -623,6 +632,47 @@ fn textures(root: &Table) -> SceneResult<Vec<ReadTexture>> {
         });
     }
     Ok(out)
+}
+
+/// A checker texture's table, read for both roles.
+fn checker(c: &Table) -> SceneResult<(Arc<Texture>, Arc<Texture>)> {
+    let size = match c.get("size") {
+        None => return Err(c.error("size", "missing: the checker's square size (a number, or [sx, sy, sz] with 0 for no change along an axis)")),
+        Some(n) => {
+            let s = match n.val {
+                super::doc::Val::Array(_) => {
+                    let v = c.numbers_of(n, "size", Some(3))?;
+                    DVec3::new(v[0], v[1], v[2])
+                }
+                _ => DVec3::splat(c.f64_or("size", 1.0)?),
+            };
+            if s.cmplt(DVec3::ZERO).any() || s == DVec3::ZERO {
+                return Err(c.error_at(n, "size", "sizes must be 0 or more, and one greater than 0"));
+            }
+            s
+        }
+    };
+    let both = |role| -> SceneResult<[crate::spectrum::Colour; 2]> {
+        let get = |k: &str| {
+            c.colour(k, role)?.ok_or_else(|| {
+                c.error(
+                    k,
+                    "missing: give the checker's two colours, color1 and color2",
+                )
+            })
+        };
+        Ok([get("color1")?, get("color2")?])
+    };
+    let reflectance = Arc::new(Texture::Checker {
+        size,
+        colors: both(Role::Reflectance)?,
+    });
+    let emitter = Arc::new(Texture::Checker {
+        size,
+        colors: both(Role::Emitter)?,
+    });
+    c.finish(&["size", "color1", "color2"])?;
+    Ok((reflectance, emitter))
 }
 
 /// A material's colour key: a colour, or the name of a texture (with the colour to hold in

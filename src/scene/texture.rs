@@ -2,8 +2,10 @@
 //! (`[[texture]]`). A checker alternates two colours in cubes laid out in the rest frame of the
 //! object's group, so the pattern moves and deforms with the object exactly as its geometry does.
 
-use crate::spectrum::Colour;
-use glam::DVec3;
+use crate::geometry::Primitive;
+use crate::spectrum::{camera, Colour, Role, Shift};
+use glam::{DMat3, DVec3};
+use std::f64::consts::PI;
 
 /// A colour that varies over a surface.
 #[derive(Clone, Debug, PartialEq)]
@@ -16,31 +18,185 @@ pub enum Texture {
         /// The colour of the box at the origin, and the other.
         colors: [Colour; 2],
     },
+    /// An image (PNG, sRGB-decoded to linear, or EXR, linear), mapped onto spheres, boxes and
+    /// rods by [`uv`].
+    Image(ImageTexture),
+}
+
+/// What a texture gives at a point: one of its colours, or an image's linear RGB with the
+/// image (whose basis turns it into a spectrum).
+pub enum Sample<'a> {
+    /// A colour of the texture's own.
+    Colour(&'a Colour),
+    /// Linear RGB from an image.
+    Rgb(DVec3, &'a ImageTexture),
+}
+
+/// An image's texels, and how one becomes a spectrum: `rgb` is written `c = to_basis · rgb` on
+/// the three basis colours (the uplifts of pure red, green and blue), so that at rest, under
+/// white light, the texel's colour is its RGB exactly, and shifted, each texel shifts as a
+/// spectrum, the same three spectra for every texel (uplifted once, not per texel).
+#[derive(Clone, PartialEq)]
+pub struct ImageTexture {
+    /// Where it came from (errors and the render id name it).
+    pub path: String,
+    /// Size in texels.
+    pub width: usize,
+    /// Size in texels.
+    pub height: usize,
+    /// Linear RGB, row by row from the top.
+    pub texels: Vec<[f32; 3]>,
+    /// Pure red, green and blue, uplifted in the texture's role.
+    pub basis: [Colour; 3],
+    /// From RGB to the coefficients on `basis`.
+    pub to_basis: DMat3,
+}
+
+/// Its path, size and a hash of its texels: the render id hashes this, not millions of floats.
+impl std::fmt::Debug for ImageTexture {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::hash::DefaultHasher::new();
+        for t in &self.texels {
+            t.map(f32::to_bits).hash(&mut h);
+        }
+        write!(
+            f,
+            "ImageTexture({}, {}x{}, {:016x})",
+            self.path,
+            self.width,
+            self.height,
+            h.finish()
+        )
+    }
+}
+
+impl ImageTexture {
+    /// An image texture of `texels` for colours of `role`.
+    pub fn new(
+        path: String,
+        width: usize,
+        height: usize,
+        texels: Vec<[f32; 3]>,
+        role: Role,
+    ) -> ImageTexture {
+        let basis = [DVec3::X, DVec3::Y, DVec3::Z].map(|e| Colour::rgb(e, role));
+        // The basis's colours as the camera records them: an emitter's own, a reflectance's
+        // under white light (each of the nine numbers a camera response, so the matrix holds
+        // the uplift's small departures from pure primaries).
+        let seen = |c: &Colour| match role {
+            Role::Emitter => camera::rgb(&c.sampled(Shift::new(1.0))),
+            _ => {
+                let white = Colour::rgb(DVec3::ONE, Role::Emitter).sampled(Shift::new(1.0));
+                let mut s = c.sampled(Shift::new(1.0));
+                for (a, b) in s.0.iter_mut().zip(white.0) {
+                    *a *= b;
+                }
+                camera::rgb(&s)
+            }
+        };
+        let m = DMat3::from_cols(seen(&basis[0]), seen(&basis[1]), seen(&basis[2]));
+        ImageTexture {
+            path,
+            width,
+            height,
+            texels,
+            basis,
+            to_basis: m.inverse(),
+        }
+    }
+
+    /// Bilinear: `u` wraps around, `v` (0 at the top row) is held at the edges.
+    pub fn bilinear(&self, u: f64, v: f64) -> DVec3 {
+        let (w, h) = (self.width as f64, self.height as f64);
+        let x = u.rem_euclid(1.0) * w - 0.5;
+        let y = (v.clamp(0.0, 1.0) * h - 0.5).clamp(0.0, h - 1.0);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let col = |i: f64| (i as i64).rem_euclid(self.width as i64) as usize;
+        let row = |j: f64| (j as i64).clamp(0, self.height as i64 - 1) as usize;
+        let t = |i: f64, j: f64| {
+            let [r, g, b] = self.texels[row(j) * self.width + col(i)];
+            DVec3::new(r.into(), g.into(), b.into())
+        };
+        let top = t(x0, y0) * (1.0 - fx) + t(x0 + 1.0, y0) * fx;
+        let bottom = t(x0, y0 + 1.0) * (1.0 - fx) + t(x0 + 1.0, y0 + 1.0) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+}
+
+/// Where a point of a primitive lies on an image, `(u, v)` in [0, 1] with v = 0 at the top:
+/// - a sphere: longitude and latitude about its centre, z up (the poles at v = 0 and 1), u = 0.5
+///   toward +x, increasing toward +y (east, seen from outside with north up);
+/// - a rod: around its axis (u, from the direction most nearly +z, or +x for a rod along z) and
+///   along it (v = 0 at `from`);
+/// - a box: each face holds the whole image, seen from outside: on the ±x faces u runs along y,
+///   on the ±y faces along x, on the ±z faces along x, and v downward along z (along y on ±z);
+/// - a triangle: none (mesh UVs are not read yet): None.
+pub fn uv(prim: &Primitive, p: DVec3, outward: DVec3) -> Option<(f64, f64)> {
+    match *prim {
+        Primitive::Sphere { center, .. } => {
+            let d = (p - center).normalize_or(DVec3::Z);
+            Some((
+                0.5 + d.y.atan2(d.x) / (2.0 * PI),
+                d.z.clamp(-1.0, 1.0).acos() / PI,
+            ))
+        }
+        Primitive::Capsule { a, b, .. } => {
+            let axis = b - a;
+            let len2 = axis.length_squared().max(f64::MIN_POSITIVE);
+            let t = ((p - a).dot(axis) / len2).clamp(0.0, 1.0);
+            let k = axis / len2.sqrt();
+            let reference = if k.z.abs() > 0.9 { DVec3::X } else { DVec3::Z };
+            let e1 = (reference - k * reference.dot(k)).normalize();
+            let e2 = k.cross(e1);
+            let r = p - a - k * (p - a).dot(k);
+            Some((0.5 + r.dot(e2).atan2(r.dot(e1)) / (2.0 * PI), t))
+        }
+        Primitive::Cuboid { min, max } => {
+            let size = max - min;
+            let f = (p - min) / size;
+            let n = outward.abs();
+            Some(if n.x >= n.y && n.x >= n.z {
+                (f.y, 1.0 - f.z)
+            } else if n.y >= n.z {
+                (f.x, 1.0 - f.z)
+            } else {
+                (f.x, 1.0 - f.y)
+            })
+        }
+        Primitive::Triangle { .. } => None,
+    }
 }
 
 impl Texture {
-    /// The colour at rest-frame point `p` of a surface whose outward normal there is
+    /// What the texture gives at rest-frame point `p` of `prim`, whose outward normal there is
     /// `outward`. A checker is read just inside the surface (by a billionth of its smallest
     /// square): a face lying on a boundary between squares, as a box's faces do on a grid of
     /// its own size, takes the colour of the square behind it, not the one rounding picks.
     #[inline]
-    pub fn colour_at(&self, p: DVec3, outward: DVec3) -> &Colour {
+    pub fn at(&self, prim: &Primitive, p: DVec3, outward: DVec3) -> Sample<'_> {
         match self {
+            Texture::Image(img) => {
+                let (u, v) = uv(prim, p, outward).unwrap_or((0.5, 0.5));
+                Sample::Rgb(img.bilinear(u, v), img)
+            }
             Texture::Checker { size, colors } => {
                 let smallest = [size.x, size.y, size.z]
                     .into_iter()
                     .filter(|&s| s > 0.0)
                     .fold(f64::INFINITY, f64::min);
                 let inside = p - outward * (1e-9 * smallest);
-                &colors[checker_cell(*size, inside)]
+                Sample::Colour(&colors[checker_cell(*size, inside)])
             }
         }
     }
 
-    /// Every colour the texture may give.
+    /// Every colour the texture may give (an image: its basis).
     pub fn colours(&self) -> impl Iterator<Item = &Colour> {
         match self {
             Texture::Checker { colors, .. } => colors.iter(),
+            Texture::Image(img) => img.basis.iter(),
         }
     }
 }
@@ -56,6 +212,97 @@ fn checker_cell(size: DVec3, p: DVec3) -> usize {
         }
     }
     sum.rem_euclid(2) as usize
+}
+
+
+/// The most texels an image texture may have (a 16384 x 16384 image).
+pub const MAX_TEXELS: u64 = 1 << 28;
+
+/// An image file's linear RGB texels, row by row from the top: a PNG (8 or 16 bits, grey,
+/// RGB, with or without alpha, palette; sRGB-decoded; alpha ignored) or an EXR (its R, G, B
+/// channels, or Y as grey). Why not, in words.
+pub fn read_image(path: &std::path::Path) -> Result<(usize, usize, Vec<[f32; 3]>), String> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let meta = std::fs::metadata(path).map_err(|e| format!("cannot read it: {e}"))?;
+    if !meta.is_file() {
+        return Err("it is not a regular file".into());
+    }
+    let fits = |w: usize, h: usize| -> Result<(), String> {
+        let n = w as u64 * h as u64;
+        if n == 0 || n > MAX_TEXELS {
+            return Err(format!("it is {w}x{h}; a texture has 1 to 2^28 texels"));
+        }
+        let what = format!("a {w}x{h} texture");
+        match crate::memory::too_much(n * 16, &what) {
+            Some(why) => Err(why),
+            None => Ok(()),
+        }
+    };
+    match ext.as_deref() {
+        Some("png") => {
+            let file = std::fs::File::open(path).map_err(|e| format!("cannot read it: {e}"))?;
+            let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+            decoder.set_transformations(png::Transformations::EXPAND);
+            let mut reader = decoder
+                .read_info()
+                .map_err(|e| format!("not a readable PNG: {e}"))?;
+            let (w, h) = (reader.info().width as usize, reader.info().height as usize);
+            fits(w, h)?;
+            let mut buf = vec![0; reader.output_buffer_size()];
+            let frame = reader
+                .next_frame(&mut buf)
+                .map_err(|e| format!("not a readable PNG: {e}"))?;
+            let channels = frame.color_type.samples();
+            let wide = frame.bit_depth == png::BitDepth::Sixteen;
+            let value = |i: usize| -> f32 {
+                let v = if wide {
+                    f32::from(u16::from_be_bytes([buf[2 * i], buf[2 * i + 1]])) / 65535.0
+                } else {
+                    f32::from(buf[i]) / 255.0
+                };
+                srgb_to_linear(v)
+            };
+            let texels = (0..w * h)
+                .map(|p| {
+                    let at = p * channels;
+                    match channels {
+                        1 | 2 => [value(at); 3],
+                        _ => [value(at), value(at + 1), value(at + 2)],
+                    }
+                })
+                .collect();
+            Ok((w, h, texels))
+        }
+        Some("exr") => {
+            let (w, h, ch) = crate::output::read_exr_channels(path).map_err(|e| e.to_string())?;
+            fits(w, h)?;
+            let pick =
+                |names: [&str; 3]| names.iter().map(|n| ch.get(*n)).collect::<Option<Vec<_>>>();
+            let planes = pick(["R", "G", "B"])
+                .or_else(|| pick(["Y", "Y", "Y"]))
+                .ok_or("it has neither R, G, B nor Y channels")?;
+            Ok((
+                w,
+                h,
+                (0..w * h)
+                    .map(|p| [planes[0][p], planes[1][p], planes[2][p]])
+                    .collect(),
+            ))
+        }
+        _ => Err("cannot tell its format: the name must end in .png or .exr".into()),
+    }
+}
+
+/// sRGB's decoding to linear.
+fn srgb_to_linear(v: f32) -> f32 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 #[cfg(test)]
