@@ -18,4 +18,7 @@ wide=(--width 576 --height 192 --samples 4 --quiet)
 $r render scenes/passing_spheres.toml -o "$o/spheres-rgb.png" "${wide[@]}" --set render.doppler=false --set render.searchlight=false
 $r render scenes/passing_spheres.toml -o "$o/spheres-doppler.png" "${wide[@]}" --set render.searchlight=false
 $r render scenes/passing_spheres.toml -o "$o/spheres-doppler-searchlight.png" "${wide[@]}"
+# The fast-moving planet: at rest, and at 0.9c as it approaches (scenes/planet.toml).
+$r render scenes/planet.toml -o "$o/planet-0.png" "${size[@]}" --set 'group.planet.velocity=[0, 0, 0]' --set 'camera.direction=[0, 1, 0]'
+$r render scenes/planet.toml -o "$o/planet-0.9.png" "${size[@]}"
 echo "wrote $(ls "$o" | wc -l) images to $o"

@@ -276,3 +276,20 @@ fn an_image_wraps_a_sphere_by_longitude_and_latitude() {
         }
     }
 }
+
+/// The planet demo loads and renders (a small image): its map is where the scene says.
+#[test]
+fn the_planet_demo_renders() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sets = [
+        ("--width 48".to_string(), "image.width=48".to_string()),
+        ("--height 32".to_string(), "image.height=32".to_string()),
+    ];
+    let scene = rest_embree::scene::load_file(&root.join("scenes/planet.toml"), &sets).unwrap();
+    let f = render_with(&scene, "bvh");
+    assert_all_finite(&f, "bvh");
+    assert!(
+        f.pixels.iter().filter(|p| p.object_id == 1).count() > 20,
+        "the planet is in view"
+    );
+}

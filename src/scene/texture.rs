@@ -214,7 +214,6 @@ fn checker_cell(size: DVec3, p: DVec3) -> usize {
     sum.rem_euclid(2) as usize
 }
 
-
 /// The most texels an image texture may have (a 16384 x 16384 image).
 pub const MAX_TEXELS: u64 = 1 << 28;
 
