@@ -151,7 +151,9 @@ fn ten_thousand_mutated_scenes_neither_panic_nor_give_nan() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut bases: Vec<String> = std::fs::read_dir(root.join("scenes"))
         .unwrap()
-        .map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .map(|p| std::fs::read_to_string(p).unwrap())
         .collect();
     bases.sort();
     bases.push(common::cli::GOOD.to_string());

@@ -192,11 +192,12 @@ pub fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> String {
         groups,
         objects,
         film,
+        sky,
         image: _,
     } = scene;
     let _ = write!(
         feed,
-        "{camera:?}|{image:?}|{render:?}|{materials:?}|{lights:?}|{groups:?}|{objects:?}|{film:?}|{backend}|{overrides:?}"
+        "{camera:?}|{image:?}|{render:?}|{materials:?}|{lights:?}|{groups:?}|{objects:?}|{film:?}|{sky:?}|{backend}|{overrides:?}"
     );
     format!("{:016x}", feed.0.finish())
 }

@@ -173,6 +173,7 @@ pub fn needs_spectra(scene: &Scene) -> bool {
         return false;
     }
     let mut colours = vec![&scene.image.background, &scene.render.ambient];
+    colours.extend(scene.sky.iter().flat_map(|s| s.map.basis.iter()));
     for m in &scene.materials {
         colours.extend(m.colours());
     }
@@ -189,7 +190,7 @@ pub fn needs_spectra(scene: &Scene) -> bool {
             .filter(|g| !g.geometry.is_empty())
             .map(|g| g.velocity.identity_key()),
     );
-    if !scene.image.background.is_black() {
+    if !scene.image.background.is_black() || scene.sky.is_some() {
         frames.push(crate::spacetime::Velocity::ZERO.identity_key());
     }
     frames.iter().any(|f| *f != frames[0])

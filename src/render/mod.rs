@@ -230,7 +230,8 @@ impl<'a> Rows<'a> {
         progress: Option<&'a Progress>,
     ) -> Self {
         let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
-        let cull = ScreenCull::new(world, &cam);
+        // A sky is seen through every pixel: nothing to cull.
+        let cull = ScreenCull::new(world, &cam).filter(|_| scene.sky.is_none());
         let spectral = needs_spectra(scene);
         Self {
             scene,

@@ -90,15 +90,28 @@ impl<'a, B: Band> Shader<'a, B> {
                 let (light, spent) = self.shade(ray, &h, shift, budget);
                 (light * k, spent)
             }
-            None => (self.background(receiver_s, shift), 0),
+            None => (self.background_along(ray.dir, receiver_s, shift), 0),
         }
     }
 
-    /// The background (a sky at rest in the world frame, lookback factor 1) as a receiver
-    /// with lookback factor `receiver_s` and wavelengths `shift` times the camera's sees it.
+    /// The background (at rest in the world frame, lookback factor 1) as a receiver with
+    /// lookback factor `receiver_s` and wavelengths `shift` times the camera's sees it: the
+    /// image's background colour (the same in every direction; see
+    /// [`Shader::background_along`] for a sky).
     pub fn background(&self, receiver_s: f64, shift: f64) -> B {
         let (shift, k) = self.arriving(receiver_s, 1.0, shift);
         B::of(&self.scene.image.background, B::at(shift)) * k
+    }
+
+    /// The background along world-frame direction `dir` (toward where the light comes from):
+    /// the sky's there where the scene has one, its texel a spectrum on the map's basis as an
+    /// image texture's is, else the background colour.
+    pub fn background_along(&self, dir: DVec3, receiver_s: f64, shift: f64) -> B {
+        let Some(sky) = &self.scene.sky else {
+            return self.background(receiver_s, shift);
+        };
+        let (shift, k) = self.arriving(receiver_s, 1.0, shift);
+        texel::<B>(&sky.map, sky.rgb(dir), B::at(shift)) * k
     }
 
     /// Radiance from a sender with lookback factor `sender_s` reaching a receiver with
@@ -154,7 +167,8 @@ impl<'a, B: Band> Shader<'a, B> {
     /// Whether primary rays that meet nothing add nothing: a transparent image, or a black
     /// background.
     pub fn primary_misses_add_nothing(&self) -> bool {
-        self.scene.image.background.is_black() || self.scene.image.is_transparent()
+        let black = self.scene.sky.is_none() && self.scene.image.background.is_black();
+        black || self.scene.image.is_transparent()
     }
 
     /// What the ray tree below a primary hit may spend.
@@ -339,14 +353,17 @@ fn surface_colour<B: Band>(
     match texture.map(|t| t.at(&lit.prim, lit.point, lit.outward)) {
         None => B::of(colour, at),
         Some(S::Colour(c)) => B::of(c, at),
-        Some(S::Rgb(rgb, img)) => {
-            let c = if B::SPECTRAL { img.to_basis * rgb } else { rgb };
-            let mut out = B::of(&img.basis[0], at) * c.x;
-            out.add(&(B::of(&img.basis[1], at) * c.y));
-            out.add(&(B::of(&img.basis[2], at) * c.z));
-            out
-        }
+        Some(S::Rgb(rgb, img)) => texel(img, rgb, at),
     }
+}
+
+/// An image's linear RGB as light in the band: on its basis (`ImageTexture`), in RGB itself.
+fn texel<B: Band>(img: &crate::scene::ImageTexture, rgb: DVec3, at: B::At) -> B {
+    let c = if B::SPECTRAL { img.to_basis * rgb } else { rgb };
+    let mut out = B::of(&img.basis[0], at) * c.x;
+    out.add(&(B::of(&img.basis[1], at) * c.y));
+    out.add(&(B::of(&img.basis[2], at) * c.z));
+    out
 }
 
 /// A shadow ray to one light, and what decides the light it brings if nothing is in the way.

@@ -222,7 +222,7 @@ fn shade_hits<B: Band>(
                 }
                 None => {
                     shadows.extend((0..lights).map(|_| None));
-                    Err(camera_s)
+                    Err((camera_s, ray.dir))
                 }
             }
         })
@@ -263,7 +263,7 @@ fn shade_hits<B: Band>(
                 seen.to_rgb() * *factor
             }
             Err(_) if black_sky => DVec3::ZERO,
-            Err(camera_s) => shader.background(*camera_s, 1.0).to_rgb(),
+            Err((camera_s, dir)) => shader.background_along(*dir, *camera_s, 1.0).to_rgb(),
         })
         .collect()
 }

@@ -262,10 +262,11 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
             geometry: Arc::new(geometry),
         });
     }
-    if groups.iter().all(|g| g.geometry.is_empty()) {
+    // Without objects only a sky is worth rendering.
+    if groups.iter().all(|g| g.geometry.is_empty()) && !root.has("sky") {
         return Err(root.error(
             "group",
-            "the scene is empty: add a [[group]] with at least one [[group.object]] (box, sphere, rod, mesh, lattice or bar_array)",
+            "the scene is empty: add a [[group]] with at least one [[group.object]] (box, sphere, rod, mesh, lattice or bar_array), or a [sky]",
         ));
     }
     let mut lights = Vec::new();
@@ -273,8 +274,14 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         lights.push(light(&t, &groups)?);
     }
     let film = root.table("film")?.map(|t| film(&t, &camera)).transpose()?;
+    let sky = root.table("sky")?.map(|t| sky(&t)).transpose()?;
+    // A sky is meant to be seen: the image shows it unless the scene asks for transparency.
+    let mut image = image;
+    if sky.is_some() && image.transparent.is_none() {
+        image.transparent = Some(false);
+    }
     root.finish(&[
-        "camera", "image", "render", "material", "texture", "light", "group", "film",
+        "camera", "image", "render", "material", "texture", "light", "group", "film", "sky",
     ])?;
     Ok(Scene {
         camera,
@@ -285,6 +292,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         groups,
         objects,
         film,
+        sky,
     })
 }
 
@@ -632,6 +640,30 @@ fn textures(root: &Table) -> SceneResult<Vec<ReadTexture>> {
         });
     }
     Ok(out)
+}
+
+/// The `[sky]` table: `map` (an equirectangular image), `rotate`, `intensity`.
+fn sky(t: &Table) -> SceneResult<super::Sky> {
+    let file = t.req_string("map")?;
+    let node = t.get("map").expect("read above");
+    let base = std::path::Path::new(t.file())
+        .parent()
+        .unwrap_or(std::path::Path::new(""));
+    let path = base.join(file);
+    let (w, h, texels) = super::texture::read_image(&path)
+        .map_err(|why| t.error_at(node, "map", format!("{}: {why}", path.display())))?;
+    let map = super::ImageTexture::new(path.display().to_string(), w, h, texels, Role::Emitter);
+    let rotation = match super::transform::Transform::read_rotation(t)? {
+        Some(r) => r,
+        None => glam::DMat3::IDENTITY,
+    };
+    let intensity = t.f64_where("intensity", Some(1.0), |v| v >= 0.0, "0 or more")?;
+    t.finish(&["map", "rotate", "intensity"])?;
+    Ok(super::Sky {
+        map: Arc::new(map),
+        rotation,
+        intensity,
+    })
 }
 
 /// A checker texture's table, read for both roles.

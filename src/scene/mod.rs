@@ -23,4 +23,4 @@ pub use model::{
     RenderSettings, Scene, MAX_FRAMES, MAX_FRAME_PIXELS, MAX_RAYS,
 };
 pub use pass_set::{Pass, PassSet};
-pub use texture::{ImageTexture, Sample as TextureSample, Texture};
+pub use texture::{ImageTexture, Sample as TextureSample, Sky, Texture};

@@ -295,6 +295,8 @@ pub struct Scene {
     pub objects: Vec<ObjectInfo>,
     /// The film, if the scene is one.
     pub film: Option<Film>,
+    /// The sky every ray that meets nothing sees, in place of the image's background.
+    pub sky: Option<super::Sky>,
 }
 
 impl Scene {

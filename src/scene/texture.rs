@@ -304,6 +304,33 @@ fn srgb_to_linear(v: f32) -> f32 {
     }
 }
 
+/// A sky at rest in the world frame, seen by every ray that meets nothing (`[sky]`): an
+/// equirectangular map in the convention of the `equirectangular` camera (a camera at rest with
+/// that projection looking along +x with up +z renders the map back pixel for pixel), turned
+/// by `rotation` and scaled by `intensity`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sky {
+    /// The map, its texels radiances (emitter role).
+    pub map: std::sync::Arc<ImageTexture>,
+    /// Turns the sky: the map's +x goes to `rotation * x`.
+    pub rotation: DMat3,
+    /// Multiplies its radiance.
+    pub intensity: f64,
+}
+
+impl Sky {
+    /// The linear RGB the sky shows along world-frame direction `d` (toward where the light
+    /// comes from).
+    pub fn rgb(&self, d: DVec3) -> DVec3 {
+        let d = (self.rotation.transpose() * d).normalize_or(DVec3::X);
+        // The camera's: longitude from +x toward its right (-y), latitude up toward +z.
+        let lon = (-d.y).atan2(d.x);
+        let lat = d.z.clamp(-1.0, 1.0).asin();
+        let (u, v) = (lon / (2.0 * PI) + 0.5, 0.5 - lat / PI);
+        self.map.bilinear(u, v) * self.intensity
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -44,31 +44,37 @@ impl Transform {
                 s
             }
         };
-        let mut rotation = DMat3::IDENTITY;
-        if let Some(n) = t.get("rotate") {
-            let turns = match &n.val {
-                super::doc::Val::Array(_) => t.tables("rotate")?,
-                _ => vec![t.table("rotate")?.expect("present")],
-            };
-            for r in turns {
-                let axis = r.req_vec3("axis")?;
-                if axis.length_squared() == 0.0 {
-                    return Err(r.error("axis", "the axis must not be zero"));
-                }
-                let degrees = r
-                    .f64("degrees")?
-                    .ok_or_else(|| r.error("degrees", "missing: give the angle in degrees"))?;
-                r.finish(&["axis", "degrees"])?;
-                rotation =
-                    DMat3::from_axis_angle(axis.normalize(), degrees.to_radians()) * rotation;
-            }
-        }
+        let rotation = Transform::read_rotation(t)?.unwrap_or(DMat3::IDENTITY);
         let translate = t.vec3("translate")?.unwrap_or(DVec3::ZERO);
         Ok(Some(Transform {
             scale,
             rotation,
             translate,
         }))
+    }
+
+    /// The `rotate` key of `t`: a turn `{ axis, degrees }` or a list of them, in order.
+    pub fn read_rotation(t: &Table) -> SceneResult<Option<DMat3>> {
+        let Some(n) = t.get("rotate") else {
+            return Ok(None);
+        };
+        let turns = match &n.val {
+            super::doc::Val::Array(_) => t.tables("rotate")?,
+            _ => vec![t.table("rotate")?.expect("present")],
+        };
+        let mut rotation = DMat3::IDENTITY;
+        for r in turns {
+            let axis = r.req_vec3("axis")?;
+            if axis.length_squared() == 0.0 {
+                return Err(r.error("axis", "the axis must not be zero"));
+            }
+            let degrees = r
+                .f64("degrees")?
+                .ok_or_else(|| r.error("degrees", "missing: give the angle in degrees"))?;
+            r.finish(&["axis", "degrees"])?;
+            rotation = DMat3::from_axis_angle(axis.normalize(), degrees.to_radians()) * rotation;
+        }
+        Ok(Some(rotation))
     }
 
     /// Where the transform takes point `p`.

@@ -120,7 +120,9 @@ fn scenes() -> Vec<String> {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes");
     let mut out: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
-        .map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .map(|p| std::fs::read_to_string(p).unwrap())
         .collect();
     out.sort();
     assert!(out.len() >= 4, "the scenes directory");
