@@ -308,3 +308,103 @@ fn bad_meshes_and_transforms_are_clear_errors() {
         assert!(!out.exists());
     }
 }
+
+/// A sphere written as a mesh of 16 x 32 quads: with its vertex normals it shades smoothly,
+/// within a few percent of the exact sphere (a mesh's silhouette is a polygon, so only pixels
+/// both renders see the sphere in are compared); without them, faceted, several times farther.
+#[test]
+fn vertex_normals_shade_a_mesh_smoothly() {
+    let d = Dir::new("mesh-smooth");
+    let (rings, segments) = (16, 32);
+    let mut obj = String::new();
+    let centre = DVec3::new(0.0, 10.0, 0.0);
+    for i in 0..=rings {
+        for j in 0..segments {
+            let (th, ph) = (
+                std::f64::consts::PI * i as f64 / rings as f64,
+                2.0 * std::f64::consts::PI * j as f64 / segments as f64,
+            );
+            let n = DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+            let p = centre + n;
+            obj.push_str(&format!(
+                "v {:?} {:?} {:?}\nvn {:?} {:?} {:?}\n",
+                p.x, p.y, p.z, n.x, n.y, n.z
+            ));
+        }
+    }
+    let flat_obj = obj
+        .lines()
+        .filter(|l| !l.starts_with("vn"))
+        .map(|l| format!("{l}\n"))
+        .collect::<String>();
+    let (mut faces, mut flat_faces) = (String::new(), String::new());
+    for i in 0..rings {
+        for j in 0..segments {
+            let k = |i: usize, j: usize| 1 + i * segments + j % segments;
+            let q = [k(i, j), k(i + 1, j), k(i + 1, j + 1), k(i, j + 1)];
+            faces.push_str(&format!(
+                "f {0}//{0} {1}//{1} {2}//{2} {3}//{3}\n",
+                q[0], q[1], q[2], q[3]
+            ));
+            flat_faces.push_str(&format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]));
+        }
+    }
+    d.file("smooth.obj", &(obj + &faces));
+    d.file("flat.obj", &(flat_obj + &flat_faces));
+    let sets = [
+        "image.width=96",
+        "image.height=64",
+        "group.cube.velocity=[0, 0, 0]",
+    ];
+    let sphere = load(
+        &d,
+        "sphere.toml",
+        &with_object("type = \"sphere\"\ncenter = [0, 10, 0]\nradius = 1"),
+        &sets,
+    );
+    let smooth = load(
+        &d,
+        "smooth.toml",
+        &with_object("type = \"mesh\"\nfile = \"smooth.obj\""),
+        &sets,
+    );
+    let flat = load(
+        &d,
+        "flat.toml",
+        &with_object("type = \"mesh\"\nfile = \"flat.obj\""),
+        &sets,
+    );
+    for b in backends() {
+        let (s, m, f) = (
+            render_with(&sphere, b),
+            render_with(&smooth, b),
+            render_with(&flat, b),
+        );
+        let error = |o: &Frame| {
+            let (mut sum, mut n) = (0.0, 0);
+            for (p, q) in s.pixels.iter().zip(&o.pixels) {
+                if p.object_id == 1 && q.object_id == 1 {
+                    sum += (0..3)
+                        .map(|k| f64::from((p.color[k] - q.color[k]).abs()))
+                        .sum::<f64>();
+                    n += 1;
+                }
+            }
+            assert!(n > 300, "{b}: {n} pixels compared");
+            sum / n as f64
+        };
+        let (es, ef) = (error(&m), error(&f));
+        let level = s
+            .pixels
+            .iter()
+            .filter(|p| p.object_id == 1)
+            .map(|p| f64::from(p.color[0] + p.color[1] + p.color[2]))
+            .sum::<f64>()
+            / s.pixels.iter().filter(|p| p.object_id == 1).count() as f64;
+        assert!(
+            es < 0.03 * level,
+            "{b}: smooth mesh off the sphere by {es} (level {level})"
+        );
+        assert!(ef > 3.0 * es, "{b}: flat {ef} against smooth {es}");
+    }
+}

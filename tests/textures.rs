@@ -247,7 +247,7 @@ fn an_image_wraps_a_sphere_by_longitude_and_latitude() {
         (
             "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
             "type = \"mesh\"\nfile = \"tri.obj\"",
-            &["material", "UVs are not read yet"][..],
+            &["material", "no texture coordinates"][..],
         ),
         (
             "image = \"map.png\"",
@@ -292,4 +292,54 @@ fn the_planet_demo_renders() {
         f.pixels.iter().filter(|p| p.object_id == 1).count() > 20,
         "the planet is in view"
     );
+}
+
+/// A mesh's texture coordinates from its file map an image onto it: a square of two triangles
+/// whose corners take the image's corners shows each quarter of a 2 x 2 image in its place
+/// (vt's v up from the bottom, as OBJ has it).
+#[test]
+fn a_mesh_maps_an_image_by_its_texture_coordinates() {
+    let d = Dir::new("texture-uv");
+    png(&d.0.join("quads.png"), 2, 2, |x, y| match (x, y) {
+        (0, 0) => [255, 0, 0],
+        (1, 0) => [0, 255, 0],
+        (0, 1) => [0, 0, 255],
+        _ => [255, 255, 255],
+    });
+    // A square in the plane y = 0, facing -y, x and z from -1 to 1.
+    d.file(
+        "square.obj",
+        "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    );
+    let text = "[camera]\nposition = [0, -5, 0]\nlook_at = [0, 0, 0]\nfov_y = 30\n\n[image]\nwidth = 64\nheight = 64\n\n\
+                [[texture]]\nname = \"quads\"\nimage = \"quads.png\"\n\n[[material]]\nname = \"lit\"\nemission = \"quads\"\n\n\
+                [[group]]\nname = \"square\"\n[[group.object]]\ntype = \"mesh\"\nfile = \"square.obj\"\nmaterial = \"lit\"\n";
+    let scene = rest_embree::scene::load_file(&d.file("uv.toml", text), &[]).unwrap();
+    for b in backends() {
+        let f = render_with(&scene, b);
+        // Top left of the square (x < 0, z > 0): the image's top left texel, red.
+        let c = |x: i64, y: i64| at(&f, x, y).color;
+        let near =
+            |got: [f32; 3], want: [f32; 3]| got.iter().zip(want).all(|(g, w)| (g - w).abs() < 0.05);
+        assert!(
+            near(c(20, 20), [1.0, 0.0, 0.0]),
+            "{b}: top left {:?}",
+            c(20, 20)
+        );
+        assert!(
+            near(c(43, 20), [0.0, 1.0, 0.0]),
+            "{b}: top right {:?}",
+            c(43, 20)
+        );
+        assert!(
+            near(c(20, 43), [0.0, 0.0, 1.0]),
+            "{b}: bottom left {:?}",
+            c(20, 43)
+        );
+        assert!(
+            near(c(43, 43), [1.0, 1.0, 1.0]),
+            "{b}: bottom right {:?}",
+            c(43, 43)
+        );
+    }
 }

@@ -15,6 +15,19 @@ pub struct Part {
     pub object: u32,
     /// The material (index into [`Scene::materials`](crate::scene::Scene::materials)).
     pub material: u32,
+    /// A mesh's data at its triangles' corners (from its file), if it has any.
+    pub corners: Option<std::sync::Arc<Corners>>,
+}
+
+/// Data at a mesh's triangles' corners, by triangle in the part's order: vertex normals (for
+/// smooth shading) and texture coordinates.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Corners {
+    /// Each corner's normal (unit, outward as the file gives it).
+    pub normals: Option<Vec<[DVec3; 3]>>,
+    /// Each corner's texture coordinates (u, v with v = 0 at the image's bottom, as OBJ and PLY
+    /// have it).
+    pub uvs: Option<Vec<[[f64; 2]; 3]>>,
 }
 
 /// The static geometry of one velocity group, in its rest frame.
@@ -50,6 +63,17 @@ impl Geometry {
         material: u32,
         prims: impl IntoIterator<Item = Primitive>,
     ) {
+        self.push_part_with(object, material, prims, None)
+    }
+
+    /// Append primitives as one part, with data at their corners (a mesh's triangles).
+    pub fn push_part_with(
+        &mut self,
+        object: u32,
+        material: u32,
+        prims: impl IntoIterator<Item = Primitive>,
+        corners: Option<std::sync::Arc<Corners>>,
+    ) {
         let start = self.prims.len() as u32;
         self.prims.extend(prims);
         let end = self.prims.len() as u32;
@@ -71,6 +95,7 @@ impl Geometry {
                     end,
                     object,
                     material,
+                    corners,
                 },
             );
         }
@@ -101,6 +126,7 @@ impl Geometry {
                 end,
                 object,
                 material,
+                corners: None,
             });
             start = end;
         }
@@ -221,6 +247,38 @@ impl Geometry {
     pub fn part_of(&self, prim: u32) -> &Part {
         let i = self.parts.partition_point(|p| p.end <= prim);
         &self.parts[i]
+    }
+
+    /// At rest-frame point `p` of held triangle `prim`: its interpolated vertex normal and
+    /// texture coordinates, where its mesh has them (None for other primitives).
+    pub fn corners_at(&self, prim: u32, p: DVec3) -> (Option<DVec3>, Option<[f64; 2]>) {
+        let part = self.part_of(prim);
+        let (Some(c), Some(Primitive::Triangle { v })) =
+            (&part.corners, self.prims.get(prim as usize))
+        else {
+            return (None, None);
+        };
+        let i = (prim - part.start) as usize;
+        // Barycentric coordinates of p (on the triangle, up to rounding).
+        let (e1, e2, q) = (v[1] - v[0], v[2] - v[0], p - v[0]);
+        let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let (q1, q2) = (q.dot(e1), q.dot(e2));
+        let det = d11 * d22 - d12 * d12;
+        if det == 0.0 || !det.is_finite() {
+            return (None, None);
+        }
+        let b1 = (d22 * q1 - d12 * q2) / det;
+        let b2 = (d11 * q2 - d12 * q1) / det;
+        let w = [1.0 - b1 - b2, b1, b2];
+        let normal = c.normals.as_ref().and_then(|n| {
+            let n = n[i];
+            (n[0] * w[0] + n[1] * w[1] + n[2] * w[2]).try_normalize()
+        });
+        let uv = c.uvs.as_ref().map(|t| {
+            let t = t[i];
+            [0, 1].map(|k| t[0][k] * w[0] + t[1][k] * w[1] + t[2][k] * w[2])
+        });
+        (normal, uv)
     }
 
     /// The index of primitive `prim` among its object's primitives (an object's parts are

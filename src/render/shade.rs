@@ -198,12 +198,16 @@ impl<'a, B: Band> Shader<'a, B> {
         let v = hit.dir / hit.s;
         let n = prim.normal(hit.point);
         let inside = n.dot(v) > 0.0;
-        let nf = if inside { -n } else { n };
+        let faced = if inside { -n } else { n };
+        // A mesh's vertex normals shade it smoothly, turned to the side the ray sees.
+        let (smooth, corner_uv) = g.geometry.corners_at(hit.prim, hit.point);
+        let nf = smooth.map_or(faced, |s| if s.dot(faced) < 0.0 { -s } else { s });
         let event = ray.at(hit.lambda);
         let lit = Lit {
             mat,
             point: hit.point,
             outward: n,
+            corner_uv,
             prim,
             group: hit.group,
             event,
@@ -350,7 +354,7 @@ fn surface_colour<B: Band>(
     at: B::At,
 ) -> B {
     use crate::scene::TextureSample as S;
-    match texture.map(|t| t.at(&lit.prim, lit.point, lit.outward)) {
+    match texture.map(|t| t.at(&lit.prim, lit.point, lit.outward, lit.corner_uv)) {
         None => B::of(colour, at),
         Some(S::Colour(c)) => B::of(c, at),
         Some(S::Rgb(rgb, img)) => texel(img, rgb, at),
@@ -392,8 +396,10 @@ pub struct Lit<'a> {
     /// outward normal there.
     point: DVec3,
     outward: DVec3,
-    /// The primitive hit (where an image is mapped from).
+    /// The primitive hit (where an image is mapped from), and a mesh's texture coordinates
+    /// there.
     prim: crate::geometry::Primitive,
+    corner_uv: Option<[f64; 2]>,
     group: usize,
     event: Event,
     v: DVec3,

@@ -203,8 +203,8 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
             let id = objects.len() as u32;
             let (first, implicit) = (geometry.prims.len(), geometry.implicit.len());
             let kind = add_object(&o, id, &material_ids, &mut geometry, &mut total)?;
-            // An image needs a mapping: spheres, boxes and rods have one; a mesh's UVs are not
-            // read yet.
+            // An image needs a mapping: spheres, boxes and rods have one, a mesh its file's
+            // texture coordinates.
             let imaged = |m: u32| {
                 let m = &materials[m as usize];
                 [&m.color_texture, &m.emission_texture]
@@ -212,13 +212,16 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
                     .flatten()
                     .any(|t| matches!(**t, Texture::Image(_)))
             };
-            let meshed = geometry.prims[first..]
-                .iter()
-                .any(|p| matches!(p, crate::geometry::Primitive::Triangle { .. }));
-            if meshed && geometry.parts.last().is_some_and(|p| imaged(p.material)) {
+            let unmapped = geometry.prims.get(first).is_some_and(|p| {
+                let part = geometry.part_of(first as u32);
+                matches!(p, crate::geometry::Primitive::Triangle { .. })
+                    && imaged(part.material)
+                    && part.corners.as_ref().is_none_or(|c| c.uvs.is_none())
+            });
+            if unmapped {
                 return Err(o.error(
                     "material",
-                    "its material's texture is an image, which maps onto spheres, boxes and rods; a mesh's UVs are not read yet",
+                    "its material's texture is an image, and the mesh has no texture coordinates (vt in OBJ, u and v in PLY) to map it; spheres, boxes and rods have their own",
                 ));
             }
             let held = geometry.prims[first..].iter().map(|p| p.bounds());

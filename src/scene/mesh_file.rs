@@ -12,6 +12,10 @@ pub struct MeshData {
     pub positions: Vec<DVec3>,
     /// Triangles, counter-clockwise seen from the front as the file gives them.
     pub triangles: Vec<[u32; 3]>,
+    /// Each triangle's corner normals, where the file gives normals for every corner.
+    pub normals: Option<Vec<[DVec3; 3]>>,
+    /// Each triangle's corner texture coordinates, where the file gives them for every corner.
+    pub uvs: Option<Vec<[[f64; 2]; 3]>>,
 }
 
 /// Why a mesh file could not be read: the message, and the 1-based line it concerns, if any.
@@ -96,6 +100,38 @@ fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
         Err(e) => return Err(obj_error(path, &e)),
     };
     let mut mesh = MeshData::default();
+    let every = |f: &dyn Fn(&tobj::Mesh) -> bool| models.iter().all(|m| f(&m.mesh));
+    let with_normals =
+        every(&|m| !m.normals.is_empty() && m.normal_indices.len() == m.indices.len());
+    let with_uvs =
+        every(&|m| !m.texcoords.is_empty() && m.texcoord_indices.len() == m.indices.len());
+    let (mut normals, mut uvs) = (Vec::new(), Vec::new());
+    for m in &models {
+        let corner = |list: &[f64], at: u32, n: usize| -> Option<Vec<f64>> {
+            list.get(at as usize * n..at as usize * n + n)
+                .map(<[f64]>::to_vec)
+        };
+        if with_normals {
+            for t in m.mesh.normal_indices.chunks_exact(3) {
+                let c = [t[0], t[1], t[2]]
+                    .map(|i| corner(&m.mesh.normals, i, 3).map(|v| DVec3::new(v[0], v[1], v[2])));
+                let [Some(a), Some(b), Some(c)] = c else {
+                    return Err(MeshError::new("a normal index is out of range"));
+                };
+                normals.push([a, b, c].map(|n| n.normalize_or_zero()));
+            }
+        }
+        if with_uvs {
+            for t in m.mesh.texcoord_indices.chunks_exact(3) {
+                let c = [t[0], t[1], t[2]]
+                    .map(|i| corner(&m.mesh.texcoords, i, 2).map(|v| [v[0], v[1]]));
+                let [Some(a), Some(b), Some(c)] = c else {
+                    return Err(MeshError::new("a texture coordinate index is out of range"));
+                };
+                uvs.push([a, b, c]);
+            }
+        }
+    }
     for m in models {
         let base = mesh.positions.len() as u32;
         mesh.positions.extend(
@@ -111,6 +147,8 @@ fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
                 .map(|t| [base + t[0], base + t[1], base + t[2]]),
         );
     }
+    mesh.normals = with_normals.then_some(normals);
+    mesh.uvs = with_uvs.then_some(uvs);
     Ok(mesh)
 }
 
@@ -201,6 +239,8 @@ fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
         .get("vertex")
         .ok_or_else(|| MeshError::new("it has no `vertex` element"))?;
     let mut mesh = MeshData::default();
+    let (mut vertex_normals, mut vertex_uvs) = (Vec::new(), Vec::new());
+    let uv_names = [["u", "v"], ["s", "t"], ["texture_u", "texture_v"]];
     for (i, v) in vertices.iter().enumerate() {
         let coordinate = |k: &str| {
             v.get(k)
@@ -212,7 +252,16 @@ fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
             coordinate("y")?,
             coordinate("z")?,
         ));
+        let get = |k: &str| v.get(k).and_then(number);
+        if let (Some(x), Some(y), Some(z)) = (get("nx"), get("ny"), get("nz")) {
+            vertex_normals.push(DVec3::new(x, y, z).normalize_or_zero());
+        }
+        if let Some(uv) = uv_names.iter().find_map(|[a, b]| Some([get(a)?, get(b)?])) {
+            vertex_uvs.push(uv);
+        }
     }
+    let n_all = vertex_normals.len() == mesh.positions.len();
+    let uv_all = vertex_uvs.len() == mesh.positions.len();
     let faces = ply
         .payload
         .get("face")
@@ -244,5 +293,47 @@ fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
                 .push([list[0] as u32, list[k] as u32, list[k + 1] as u32]);
         }
     }
+    let corners = |t: &[u32; 3]| t.map(|i| i as usize);
+    if n_all {
+        mesh.normals = Some(
+            mesh.triangles
+                .iter()
+                .map(|t| corners(t).map(|i| vertex_normals[i]))
+                .collect(),
+        );
+    }
+    if uv_all {
+        mesh.uvs = Some(
+            mesh.triangles
+                .iter()
+                .map(|t| corners(t).map(|i| vertex_uvs[i]))
+                .collect(),
+        );
+    }
     Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn obj_normals_and_uvs_reach_the_corners() {
+        let dir = std::env::temp_dir().join(format!("rest-embree-objn-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("t.obj");
+        std::fs::write(&p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 2\nvn 1 0 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1/1 2/2/2 3/3/3\n").unwrap();
+        let m = read(&p).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert_eq!(m.normals, Some(vec![[DVec3::Z, DVec3::Z, DVec3::X]]));
+        assert_eq!(m.uvs, Some(vec![[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]]));
+        // Normals without texture coordinates, on a quad.
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(&p, "v 0 0 0\nvn 0 0 1\nv 1 0 0\nvn 0 0 1\nv 1 1 0\nvn 0 0 1\nv 0 1 0\nvn 1 0 0\nf 1//1 2//2 3//3 4//4\n").unwrap();
+        let m = read(&p).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert_eq!(m.triangles.len(), 2);
+        assert_eq!(m.uvs, None);
+        assert_eq!(m.normals.map(|n| n.len()), Some(2));
+    }
 }

@@ -280,12 +280,26 @@ pub(super) fn add_object(
                 let p = mesh.positions[i as usize];
                 transform.map_or(p, |x| x.point(p))
             };
-            geo.push_part(
+            // Normals turn with the mesh and take the inverse of its scale.
+            let normal = |n: DVec3| {
+                transform.map_or(n, |x| (x.rotation * (n / x.scale)).normalize_or_zero())
+            };
+            let corners = (mesh.normals.is_some() || mesh.uvs.is_some()).then(|| {
+                std::sync::Arc::new(crate::geometry::Corners {
+                    normals: mesh
+                        .normals
+                        .as_ref()
+                        .map(|n| n.iter().map(|c| c.map(normal)).collect()),
+                    uvs: mesh.uvs.clone(),
+                })
+            });
+            geo.push_part_with(
                 id,
                 mat,
                 mesh.triangles
                     .iter()
                     .map(|tri| Primitive::Triangle { v: tri.map(at) }),
+                corners,
             );
         }
         "mesh" => {

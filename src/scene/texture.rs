@@ -132,7 +132,7 @@ impl ImageTexture {
 ///   along it (v = 0 at `from`);
 /// - a box: each face holds the whole image, seen from outside: on the ±x faces u runs along y,
 ///   on the ±y faces along x, on the ±z faces along x, and v downward along z (along y on ±z);
-/// - a triangle: none (mesh UVs are not read yet): None.
+/// - a triangle: none of its own (a mesh's texture coordinates come from its file): None.
 pub fn uv(prim: &Primitive, p: DVec3, outward: DVec3) -> Option<(f64, f64)> {
     match *prim {
         Primitive::Sphere { center, .. } => {
@@ -174,11 +174,22 @@ impl Texture {
     /// `outward`. A checker is read just inside the surface (by a billionth of its smallest
     /// square): a face lying on a boundary between squares, as a box's faces do on a grid of
     /// its own size, takes the colour of the square behind it, not the one rounding picks.
+    /// A mesh's texture coordinates there, `corner_uv` (v up from the bottom, as mesh files
+    /// have it), take the place of the primitive's own mapping.
     #[inline]
-    pub fn at(&self, prim: &Primitive, p: DVec3, outward: DVec3) -> Sample<'_> {
+    pub fn at(
+        &self,
+        prim: &Primitive,
+        p: DVec3,
+        outward: DVec3,
+        corner_uv: Option<[f64; 2]>,
+    ) -> Sample<'_> {
         match self {
             Texture::Image(img) => {
-                let (u, v) = uv(prim, p, outward).unwrap_or((0.5, 0.5));
+                let (u, v) = match corner_uv {
+                    Some([u, v]) => (u, 1.0 - v),
+                    None => uv(prim, p, outward).unwrap_or((0.5, 0.5)),
+                };
                 Sample::Rgb(img.bilinear(u, v), img)
             }
             Texture::Checker { size, colors } => {
