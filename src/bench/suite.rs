@@ -28,6 +28,29 @@ pub(crate) fn paper(name: &str, sets: &[String]) -> Result<crate::scene::Scene, 
     load_str(&format!("scenes/{name}.toml"), text, &sets)
 }
 
+/// The fast-moving planet (scenes/planet.toml) with overrides: its map written beside a copy
+/// of the scene in the temporary folder, so the bench runs from any directory.
+pub(crate) fn planet(sets: &[String]) -> Result<crate::scene::Scene, SceneError> {
+    let dir = std::env::temp_dir().join(format!("rest-embree-bench-planet-{}", std::process::id()));
+    let fail = |e: std::io::Error| {
+        SceneError::new("bench", "", format!("cannot write the planet's map: {e}"))
+    };
+    std::fs::create_dir_all(&dir).map_err(fail)?;
+    std::fs::write(
+        dir.join("planet-map.png"),
+        include_bytes!("../../scenes/planet-map.png"),
+    )
+    .map_err(fail)?;
+    let sets: Vec<(String, String)> = sets
+        .iter()
+        .map(|s| (format!("--set {s}"), s.clone()))
+        .collect();
+    let name = dir.join("planet.toml").display().to_string();
+    let scene = load_str(&name, include_str!("../../scenes/planet.toml"), &sets);
+    let _ = std::fs::remove_dir_all(&dir);
+    scene
+}
+
 fn sets(list: &[&str]) -> Vec<String> {
     list.iter().map(|s| s.to_string()).collect()
 }
@@ -160,6 +183,38 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
             paper("lattice", &s)?,
             &["embree", "bvh"],
         ))
+    }));
+    // What an image texture costs (three colour lookups per hit on the map's basis), against
+    // the same planet in one colour; and what a sky map costs, against a black background.
+    out.push(LazyCase::new("planet 0.9c, image texture", move || {
+        let size = vec![
+            format!("image.width={px}"),
+            format!("image.height={px}"),
+            "image.samples=1".into(),
+        ];
+        let mut plain = size.clone();
+        plain.push("material.surface.color=0.6".into());
+        Ok(Case::new(
+            "planet 0.9c, image texture",
+            planet(&size)?,
+            &["embree", "bvh"],
+        )
+        .without_hi_reference()
+        .beside("the same planet in one colour", planet(&plain)?))
+    }));
+    out.push(LazyCase::new("planet 0.9c, sky map", move || {
+        let size = vec![
+            format!("image.width={px}"),
+            format!("image.height={px}"),
+            "image.samples=1".into(),
+        ];
+        let mut sky = size.clone();
+        sky.push("sky.map=\"planet-map.png\"".into());
+        Ok(
+            Case::new("planet 0.9c, sky map", planet(&sky)?, &["embree", "bvh"])
+                .without_hi_reference()
+                .beside("the same planet against a black background", planet(&size)?),
+        )
     }));
     // Light as a camera records it (Doppler shift and searchlight on every leg of a path)
     // against the RGB render of the same scene, measured side by side.
