@@ -1,7 +1,7 @@
 //! The sky (docs/scene-format.md, "The sky"): an equirectangular map in the convention of the
 //! `equirectangular` camera, so that camera at rest, looking along +x with up +z, at the map's
 //! size, renders the map back texel for texel; a camera moving through it sees the same sky
-//! remapped by aberration (PHYSICS.md §4.3: cos θ' = (cos θ + β)/(1 + β cos θ)), with the
+//! remapped by aberration (docs/physics.md §1: cos θ' = (cos θ + β)/(1 + β cos θ)), with the
 //! Doppler shift and the searchlight off.
 
 mod common;
