@@ -44,6 +44,23 @@ fn obj(corners: &[DVec3]) -> String {
     s
 }
 
+/// The box as an ASCII STL: two facets per face (STL has no polygons).
+fn stl(corners: &[DVec3]) -> String {
+    let mut s = String::from("solid box\n");
+    for f in BOX_FACES {
+        for t in [[f[0], f[1], f[2]], [f[0], f[2], f[3]]] {
+            s.push_str("  facet normal 0 0 0\n    outer loop\n");
+            for i in t {
+                let c = corners[i as usize - 1];
+                s.push_str(&format!("      vertex {:?} {:?} {:?}\n", c.x, c.y, c.z));
+            }
+            s.push_str("    endloop\n  endfacet\n");
+        }
+    }
+    s.push_str("endsolid box\n");
+    s
+}
+
 fn ply_ascii(corners: &[DVec3]) -> String {
     let mut s = format!(
         "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n",
@@ -140,11 +157,12 @@ fn a_box_as_obj_and_ply_renders_as_the_box() {
     d.file("box.obj", &obj(&box_corners()));
     d.file("box.ply", &ply_ascii(&box_corners()));
     std::fs::write(d.0.join("box-binary.ply"), ply_binary(&box_corners())).unwrap();
+    d.file("box.stl", &stl(&box_corners()));
     for velocity in ["[0, 0, 0]", "[0.5, 0, 0]", "[-0.3, 0.6, 0.2]"] {
         let set = format!("group.cube.velocity={velocity}");
         let sets = ["image.width=96", "image.height=64", set.as_str()];
         let reference = load(&d, "box.toml", GOOD, &sets);
-        for file in ["box.obj", "box.ply", "box-binary.ply"] {
+        for file in ["box.obj", "box.ply", "box-binary.ply", "box.stl"] {
             let text = with_object(&format!("type = \"mesh\"\nfile = \"{file}\""));
             let mesh = load(&d, "mesh.toml", &text, &sets);
             for b in backends() {
@@ -258,17 +276,22 @@ fn bad_meshes_and_transforms_are_clear_errors() {
     d.file("empty.obj", "# nothing\nv 0 0 0\n");
     d.file("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 zz\n0 1 0\n3 0 1 2\n");
     d.file("range.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
-    d.file("model.stl", "solid x\nendsolid x\n");
+    d.file("model.3ds", "not a mesh\n");
+    d.file(
+        "bad.stl",
+        "solid x\n  facet normal 0 0 1\n    outer loop\n      vertex 0 0 zz\n",
+    );
     d.file("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
     std::fs::create_dir_all(d.0.join("folder.obj")).unwrap();
-    let cases: [(&str, &[&str]); 13] = [
+    let cases: [(&str, &[&str]); 14] = [
         ("type = \"mesh\"\nfile = \"missing.obj\"", &["missing.obj", "cannot read it"]),
         ("type = \"mesh\"\nfile = \"bad-v.obj\"", &["bad-v.obj:2", "position parse error"]),
         ("type = \"mesh\"\nfile = \"bad-f.obj\"", &["bad-f.obj:4", "out of bounds"]),
         ("type = \"mesh\"\nfile = \"empty.obj\"", &["empty.obj", "no triangles"]),
         ("type = \"mesh\"\nfile = \"bad.ply\"", &["bad.ply", "not a readable PLY"]),
         ("type = \"mesh\"\nfile = \"range.ply\"", &["range.ply", "vertex 7"]),
-        ("type = \"mesh\"\nfile = \"model.stl\"", &["model.stl", ".obj or .ply"]),
+        ("type = \"mesh\"\nfile = \"model.3ds\"", &["model.3ds", ".obj, .ply"]),
+        ("type = \"mesh\"\nfile = \"bad.stl\"", &["bad.stl", "not a readable STL"]),
         ("type = \"mesh\"\nfile = \"nan.obj\"", &["nan.obj", "not finite"]),
         ("type = \"mesh\"\nfile = \"folder.obj\"", &["folder.obj", "not a regular file"]),
         (

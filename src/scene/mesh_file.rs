@@ -1,5 +1,5 @@
-//! Triangle meshes read from files: Wavefront OBJ (through the `tobj` crate) and PLY, ASCII or
-//! binary (through `ply-rs-bw`). Polygons are split into fans of triangles. What goes wrong is
+//! Triangle meshes read from files: Wavefront OBJ (through the `tobj` crate), PLY, ASCII or
+//! binary (through `ply-rs-bw`), and STL, ASCII or binary (through `stl_io`). Polygons are split into fans of triangles. What goes wrong is
 //! said with the file and, where there is one, its line.
 
 use glam::DVec3;
@@ -42,7 +42,7 @@ impl MeshError {
 }
 
 /// The formats, by extension.
-pub const EXTENSIONS: [&str; 2] = ["obj", "ply"];
+pub const EXTENSIONS: [&str; 3] = ["obj", "ply", "stl"];
 
 /// Bytes of memory reading takes per byte of file, at most (text to positions, indices and the
 /// readers' own tables), for the check against the memory limit before reading.
@@ -62,10 +62,11 @@ pub fn read(path: &Path) -> Result<MeshData, MeshError> {
     let mesh = match ext.as_deref() {
         Some("obj") => read_obj(path)?,
         Some("ply") => read_ply(path)?,
+        Some("stl") => read_stl(path)?,
         _ => {
             return Err(MeshError::new(format!(
                 "cannot tell its format: the name must end in {}",
-                EXTENSIONS.map(|e| format!(".{e}")).join(" or ")
+                EXTENSIONS.map(|e| format!(".{e}")).join(", ")
             )))
         }
     };
@@ -197,6 +198,36 @@ fn obj_error(path: &Path, e: &tobj::LoadError) -> MeshError {
         }
     }
     MeshError::new(what)
+}
+
+/// An STL file (its facets' own normals are not used: STL's are per facet, which the
+/// triangle's winding already gives).
+fn read_stl(path: &Path) -> Result<MeshData, MeshError> {
+    let file =
+        std::fs::File::open(path).map_err(|e| MeshError::new(format!("cannot read it: {e}")))?;
+    let stl = stl_io::read_stl(&mut std::io::BufReader::new(file))
+        .map_err(|e| MeshError::new(format!("not a readable STL file: {e}")))?;
+    let n = stl.vertices.len();
+    let triangles = stl
+        .faces
+        .iter()
+        .map(|f| {
+            if f.vertices.iter().any(|&i| i >= n) {
+                return Err(MeshError::new("a facet names a vertex it does not have"));
+            }
+            Ok(f.vertices.map(|i| i as u32))
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(MeshData {
+        positions: stl
+            .vertices
+            .iter()
+            .map(|v| DVec3::new(v[0].into(), v[1].into(), v[2].into()))
+            .collect(),
+        triangles,
+        normals: None,
+        uvs: None,
+    })
 }
 
 fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
