@@ -7,20 +7,6 @@ mod common;
 use common::cli::*;
 use common::*;
 
-/// oiiotool's standard output for `args`; a missing tool is a set-up error, said so.
-fn oiiotool(args: &[&str]) -> String {
-    let out = std::process::Command::new("oiiotool")
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("oiiotool ({e}): run scripts/setup.sh (openimageio-tools)"));
-    assert!(
-        out.status.success(),
-        "oiiotool {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
 #[test]
 fn channels_types_compression_and_header_as_openimageio_reads_them() {
     let d = Dir::new("exr-header");

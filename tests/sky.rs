@@ -10,21 +10,6 @@ use common::*;
 use glam::DVec3;
 use std::f64::consts::PI;
 
-fn png(path: &std::path::Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
-    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
-    let mut enc = png::Encoder::new(file, w, h);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    let mut writer = enc.write_header().unwrap();
-    let mut data = Vec::new();
-    for y in 0..h {
-        for x in 0..w {
-            data.extend(f(x, y));
-        }
-    }
-    writer.write_image_data(&data).unwrap();
-}
-
 fn linear(v: u8) -> f64 {
     let v = f64::from(v) / 255.0;
     if v <= 0.04045 {
@@ -58,7 +43,7 @@ fn the_equirectangular_camera_renders_the_sky_map_back() {
     let (w, h) = (96, 48);
     // Distinct texels: every pixel must land on its own.
     let texel = |x: u32, y: u32| [(x * 2) as u8, (y * 5) as u8, ((x * 7 + y * 3) % 256) as u8];
-    png(&d.0.join("sky.png"), w, h, texel);
+    write_png(&d.0.join("sky.png"), w, h, texel);
     let p = d.file("sky.toml", &scene(w, h, ""));
     let s = rest_embree::scene::load_file(&p, &[]).unwrap();
     for b in backends() {
@@ -85,7 +70,7 @@ fn the_equirectangular_camera_renders_the_sky_map_back() {
 fn a_moving_camera_sees_the_sky_remapped_by_aberration() {
     let d = Dir::new("sky-aberration");
     let (w, h) = (128, 64);
-    png(&d.0.join("sky.png"), w, h, |x, y| smooth(x, y, w, h));
+    write_png(&d.0.join("sky.png"), w, h, |x, y| smooth(x, y, w, h));
     let beta = 0.6;
     let p = d.file(
         "sky.toml",

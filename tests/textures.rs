@@ -182,22 +182,6 @@ fn emission_textures_and_bad_textures() {
     }
 }
 
-/// Write a `w` x `h` 8-bit RGB PNG whose texel (x, y) is `f(x, y)` (sRGB-encoded bytes).
-fn png(path: &std::path::Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
-    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
-    let mut enc = png::Encoder::new(file, w, h);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    let mut writer = enc.write_header().unwrap();
-    let mut data = Vec::new();
-    for y in 0..h {
-        for x in 0..w {
-            data.extend(f(x, y));
-        }
-    }
-    writer.write_image_data(&data).unwrap();
-}
-
 /// An image on a sphere: longitude and latitude as docs/scene-format.md maps them. The camera
 /// on -y sees longitudes from -180° (its left) to 0° (its right), u from 0 to 0.5: the image's
 /// first quarter (green) left of the centre, its second (red) right of it, its back half
@@ -205,7 +189,7 @@ fn png(path: &std::path::Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) 
 #[test]
 fn an_image_wraps_a_sphere_by_longitude_and_latitude() {
     let d = Dir::new("texture-image");
-    png(&d.0.join("map.png"), 64, 32, |x, y| {
+    write_png(&d.0.join("map.png"), 64, 32, |x, y| {
         let v = if y < 16 { 255 } else { 188 };
         match x {
             0..16 => [0, v, 0],
@@ -300,7 +284,7 @@ fn the_planet_demo_renders() {
 #[test]
 fn a_mesh_maps_an_image_by_its_texture_coordinates() {
     let d = Dir::new("texture-uv");
-    png(&d.0.join("quads.png"), 2, 2, |x, y| match (x, y) {
+    write_png(&d.0.join("quads.png"), 2, 2, |x, y| match (x, y) {
         (0, 0) => [255, 0, 0],
         (1, 0) => [0, 255, 0],
         (0, 1) => [0, 0, 255],

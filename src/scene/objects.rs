@@ -146,10 +146,7 @@ fn box_triangles(min: DVec3, max: DVec3) -> [[DVec3; 3]; 12] {
 fn read_mesh_file(t: &Table) -> SceneResult<super::mesh_file::MeshData> {
     let name = t.req_string("file")?;
     let node = t.get("file").expect("read above");
-    let base = std::path::Path::new(t.file())
-        .parent()
-        .unwrap_or(std::path::Path::new(""));
-    let path = base.join(name);
+    let path = t.path_beside(name);
     if let Ok(m) = std::fs::metadata(&path) {
         let need = m
             .len()

@@ -38,6 +38,14 @@ impl<'a> Table<'a> {
         &self.doc.file
     }
 
+    /// A file the scene names: relative to the scene file's folder.
+    pub fn path_beside(&self, name: &str) -> std::path::PathBuf {
+        let base = std::path::Path::new(self.file())
+            .parent()
+            .unwrap_or(std::path::Path::new(""));
+        base.join(name)
+    }
+
     pub fn root(doc: &'a Doc) -> SceneResult<Table<'a>> {
         Table::new(doc, &doc.root, String::new())
     }

@@ -64,3 +64,19 @@ pub fn same_picture(a: &Frame, b: &Frame, what: &str, max_id_share: f64, max_col
     }
     assert!(worst <= max_color, "{what}: colour differs by {worst}");
 }
+
+/// Write a `w` x `h` 8-bit RGB PNG whose texel (x, y) is `f(x, y)` (sRGB-encoded bytes).
+pub fn write_png(path: &std::path::Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
+    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let mut enc = png::Encoder::new(file, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc.write_header().unwrap();
+    let mut data = Vec::with_capacity((3 * w * h) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            data.extend(f(x, y));
+        }
+    }
+    writer.write_image_data(&data).unwrap();
+}

@@ -123,3 +123,18 @@ pub fn status_with_env(args: &[&str], env: &[(&str, &str)]) -> (Option<i32>, Str
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     (out.status.code(), err, stdout)
 }
+
+/// oiiotool's standard output for `args` (OpenImageIO's tool, from Debian's openimageio-tools,
+/// which scripts/setup.sh installs); it failing, or missing, fails the test, saying which.
+pub fn oiiotool(args: &[&str]) -> String {
+    let out = Command::new("oiiotool")
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("oiiotool ({e}): run scripts/setup.sh (openimageio-tools)"));
+    assert!(
+        out.status.success(),
+        "oiiotool {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}

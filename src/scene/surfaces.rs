@@ -1,0 +1,205 @@
+//! The scene's surfaces: `[[material]]` tables, the `[[texture]]` tables they may name
+//! (checkers, images) and the `[sky]`.
+
+use super::model::Material;
+use super::reader::{SceneResult, Table};
+use super::Texture;
+use crate::spectrum::Role;
+use glam::DVec3;
+use std::sync::Arc;
+
+/// The image file `key` names (beside the scene file): its path and linear texels.
+fn image_beside(
+    t: &Table,
+    key: &str,
+) -> SceneResult<(std::path::PathBuf, usize, usize, Vec<[f32; 3]>)> {
+    let node = t.get(key).expect("the caller read it");
+    let path = t.path_beside(t.req_string(key)?);
+    let (w, h, texels) = super::texture::read_image(&path)
+        .map_err(|why| t.error_at(node, key, format!("{}: {why}", path.display())))?;
+    Ok((path, w, h, texels))
+}
+
+/// A texture read for each role a material may give it (its colours uplifted as reflectances
+/// for `color`, as emitters for `emission`).
+pub(super) struct ReadTexture {
+    name: String,
+    reflectance: Arc<Texture>,
+    emitter: Arc<Texture>,
+}
+
+/// The `[[texture]]` tables.
+pub(super) fn textures(root: &Table) -> SceneResult<Vec<ReadTexture>> {
+    let mut out: Vec<ReadTexture> = Vec::new();
+    for t in root.tables("texture")? {
+        let name = t.req_string("name")?.to_string();
+        if out.iter().any(|x| x.name == name) {
+            return Err(t.error("name", format!("a texture named `{name}` is defined twice")));
+        }
+        let (reflectance, emitter) = match (t.table("checker")?, t.string("image")?) {
+            (Some(_), Some(_)) => {
+                return Err(t.error("image", "a texture is a checker or an image, not both"))
+            }
+            (Some(c), None) => checker(&c)?,
+            (None, Some(_)) => {
+                let (path, w, h, texels) = image_beside(&t, "image")?;
+                let shown = path.display().to_string();
+                let image = |role| {
+                    Arc::new(Texture::Image(super::ImageTexture::new(
+                        shown.clone(),
+                        w,
+                        h,
+                        texels.clone(),
+                        role,
+                    )))
+                };
+                (image(Role::Reflectance), image(Role::Emitter))
+            }
+            (None, None) => {
+                return Err(t.error(
+                    "checker",
+                    "missing: a texture is a `checker = { size, color1, color2 }` or an `image = \"file.png\"` (or .exr)",
+                ))
+            }
+        };
+        t.finish(&["name", "checker", "image"])?;
+        out.push(ReadTexture {
+            name,
+            reflectance,
+            emitter,
+        });
+    }
+    Ok(out)
+}
+
+/// The `[sky]` table: `map` (an equirectangular image), `rotate`, `intensity`.
+pub(super) fn sky(t: &Table) -> SceneResult<super::Sky> {
+    let (path, w, h, texels) = image_beside(t, "map")?;
+    let map = super::ImageTexture::new(path.display().to_string(), w, h, texels, Role::Emitter);
+    let rotation = super::transform::Transform::read_rotation(t)?.unwrap_or(glam::DMat3::IDENTITY);
+    let intensity = t.f64_where("intensity", Some(1.0), |v| v >= 0.0, "0 or more")?;
+    t.finish(&["map", "rotate", "intensity"])?;
+    Ok(super::Sky {
+        map: Arc::new(map),
+        rotation,
+        intensity,
+    })
+}
+
+/// A checker texture's table, read for both roles.
+fn checker(c: &Table) -> SceneResult<(Arc<Texture>, Arc<Texture>)> {
+    let size = match c.get("size") {
+        None => return Err(c.error("size", "missing: the checker's square size (a number, or [sx, sy, sz] with 0 for no change along an axis)")),
+        Some(n) => {
+            let s = match n.val {
+                super::doc::Val::Array(_) => {
+                    let v = c.numbers_of(n, "size", Some(3))?;
+                    DVec3::new(v[0], v[1], v[2])
+                }
+                _ => DVec3::splat(c.f64_or("size", 1.0)?),
+            };
+            if s.cmplt(DVec3::ZERO).any() || s == DVec3::ZERO {
+                return Err(c.error_at(n, "size", "sizes must be 0 or more, and one greater than 0"));
+            }
+            s
+        }
+    };
+    let both = |role| -> SceneResult<[crate::spectrum::Colour; 2]> {
+        let get = |k: &str| {
+            c.colour(k, role)?.ok_or_else(|| {
+                c.error(
+                    k,
+                    "missing: give the checker's two colours, color1 and color2",
+                )
+            })
+        };
+        Ok([get("color1")?, get("color2")?])
+    };
+    let reflectance = Arc::new(Texture::Checker {
+        size,
+        colors: both(Role::Reflectance)?,
+    });
+    let emitter = Arc::new(Texture::Checker {
+        size,
+        colors: both(Role::Emitter)?,
+    });
+    c.finish(&["size", "color1", "color2"])?;
+    Ok((reflectance, emitter))
+}
+
+/// A material's colour key: a colour, or the name of a texture (with the colour to hold in
+/// its place: the texture's first).
+fn colour_or_texture(
+    t: &Table,
+    key: &str,
+    role: Role,
+    textures: &[ReadTexture],
+) -> SceneResult<(Option<crate::spectrum::Colour>, Option<Arc<Texture>>)> {
+    let Some(name) = t.get(key).and_then(|n| match &n.val {
+        super::doc::Val::Str(s) => Some(s.as_str()),
+        _ => None,
+    }) else {
+        return Ok((t.colour(key, role)?, None));
+    };
+    let _ = t.string(key)?;
+    let Some(found) = textures.iter().find(|x| x.name == name) else {
+        let known: Vec<&str> = textures.iter().map(|x| x.name.as_str()).collect();
+        let n = t.get(key).expect("read above");
+        return Err(t.error_at(
+            n,
+            key,
+            format!(
+                "expected a colour, found a string: no texture is named `{name}` (textures: {}), \
+                 and colours have no names (red is [0.8, 0.1, 0.1]); a colour is {}",
+                if known.is_empty() {
+                    "none defined".to_string()
+                } else {
+                    known.join(", ")
+                },
+                super::colour::FORMS
+            ),
+        ));
+    };
+    let texture = match role {
+        Role::Emitter => found.emitter.clone(),
+        _ => found.reflectance.clone(),
+    };
+    let first = texture
+        .colours()
+        .next()
+        .expect("a texture has colours")
+        .clone();
+    Ok((Some(first), Some(texture)))
+}
+
+pub(super) fn material(t: &Table, textures: &[ReadTexture]) -> SceneResult<Material> {
+    let d = Material::default_white();
+    let unit = |v: f64| (0.0..=1.0).contains(&v);
+    let (color, color_texture) = colour_or_texture(t, "color", Role::Reflectance, textures)?;
+    let (emission, emission_texture) = colour_or_texture(t, "emission", Role::Emitter, textures)?;
+    let m = Material {
+        name: t.req_string("name")?.to_string(),
+        color: color.unwrap_or(d.color),
+        specular: t
+            .colour("specular", Role::Reflectance)?
+            .unwrap_or(d.specular),
+        shininess: t.f64_where("shininess", Some(d.shininess), |v| v >= 0.0, "0 or more")?,
+        reflect: t.f64_where("reflect", Some(0.0), unit, "between 0 and 1")?,
+        transmit: t.f64_where("transmit", Some(0.0), unit, "between 0 and 1")?,
+        ior: t.f64_where("ior", Some(d.ior), |v| v >= 1.0, "1 or more")?,
+        emission,
+        color_texture,
+        emission_texture,
+    };
+    t.finish(&[
+        "name",
+        "color",
+        "specular",
+        "shininess",
+        "reflect",
+        "transmit",
+        "ior",
+        "emission",
+    ])?;
+    Ok(m)
+}
