@@ -88,7 +88,9 @@ impl TileHeader {
                 .chain(&h.shared_attributes.other)
             {
                 let kind_ok = match value {
-                    AttributeValue::Custom { kind, .. } => printable(kind),
+                    AttributeValue::Custom { kind, bytes } => {
+                        printable(kind) && standard_size_holds(kind, bytes.len())
+                    }
                     _ => true,
                 };
                 if !printable(name) || !kind_ok {
@@ -211,6 +213,21 @@ impl TileHeader {
                 .zip(&other.list)
                 .all(|(a, b)| a.name == b.name && a.sample_type == b.sample_type)
     }
+}
+
+/// Whether an attribute the exr crate keeps as raw bytes has the size its type has, where the
+/// type is one of OpenEXR's own of fixed size (the crate reads the others itself): a tile whose
+/// `m44d` holds 64 bytes would be copied into a file OpenEXR rejects.
+fn standard_size_holds(kind: &Text, len: usize) -> bool {
+    let size = match kind.bytes() {
+        b"m33d" => 72,
+        b"m44d" => 128,
+        b"v2d" => 16,
+        b"v3d" => 24,
+        b"floatvector" => return len % 4 == 0,
+        _ => return true,
+    };
+    len == size
 }
 
 /// Check the tiles against the first: the same full image, channels and render.

@@ -260,6 +260,25 @@ fn hostile_tiles_are_refused() {
             "a directory",
         ),
         (
+            // A 4x4 float matrix renamed and retyped as a double one, its 64 bytes left: what
+            // the fuzz suite found joined into a file OpenEXR rejects.
+            made("m44d.exr", &|p: &Path| {
+                let mut b = bytes.clone();
+                let name = b
+                    .windows(13)
+                    .position(|w| w == b"worldToCamera")
+                    .expect("its name");
+                b[name + 10] = b'E';
+                let at = b
+                    .windows(4)
+                    .position(|w| w == b"m44f")
+                    .expect("worldToCamera");
+                b[at + 3] = b'd';
+                std::fs::write(p, b).unwrap()
+            }),
+            "malformed attribute",
+        ),
+        (
             made("decreasing.exr", &|p: &Path| decreasing_copy(&t0, p)),
             "not stored top to bottom",
         ),
