@@ -224,7 +224,7 @@ fn standard_size_holds(kind: &Text, len: usize) -> bool {
         b"m44d" => 128,
         b"v2d" => 16,
         b"v3d" => 24,
-        b"floatvector" => return len % 4 == 0,
+        b"floatvector" => return len.is_multiple_of(4),
         _ => return true,
     };
     len == size
