@@ -132,3 +132,276 @@ fn a_moving_camera_sees_the_sky_remapped_by_aberration() {
     }
     assert!(checked > 6000, "{checked} pixels checked");
 }
+
+// ---- The star field (docs/physics.md §5.5) ----
+
+/// A camera at the origin looking along +x with up +z, a sky of stars and nothing else.
+fn star_scene(projection: &str, w: u32, h: u32, camera_extra: &str, sky_extra: &str) -> String {
+    format!(
+        "[camera]\nposition = [0, 0, 0]\ndirection = [1, 0, 0]\nup = [0, 0, 1]\n{projection}\n{camera_extra}\n\
+         [image]\nwidth = {w}\nheight = {h}\n\n\
+         [sky]\nstars = {{ count = 400, seed = 11, magnitudes = [0, 4], temperatures = [2500, 40000] }}\n{sky_extra}\n"
+    )
+}
+
+/// Luminance (CIE Y) of linear sRGB.
+fn lum(c: [f32; 3]) -> f64 {
+    0.2126 * f64::from(c[0]) + 0.7152 * f64::from(c[1]) + 0.0722 * f64::from(c[2])
+}
+
+/// The solid angle of pixel (x, y) of a pinhole camera of focal length `f` pixels, by a
+/// midpoint rule over the pixel (cos³θ / f² per unit pixel area), not the closed form.
+fn pinhole_pixel_sr(x: u32, y: u32, w: u32, h: u32, f: f64) -> f64 {
+    let n = 8;
+    let mut sum = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let u = f64::from(x) + (f64::from(i) + 0.5) / f64::from(n) - 0.5 * f64::from(w);
+            let v = f64::from(y) + (f64::from(j) + 0.5) / f64::from(n) - 0.5 * f64::from(h);
+            sum += f / (f * f + u * u + v * v).powf(1.5);
+        }
+    }
+    sum / f64::from(n * n)
+}
+
+#[test]
+fn a_star_field_holds_the_same_light_on_every_image_size() {
+    let d = Dir::new("stars-flux");
+    let fov: f64 = 70.0;
+    let mut totals = Vec::new();
+    for size in [48u32, 160] {
+        let text = star_scene(&format!("fov_y = {fov}"), size, size, "", "");
+        let p = d.file(&format!("stars-{size}.toml"), &text);
+        let s = rest_embree::scene::load_file(&p, &[]).unwrap();
+        // What the stars in view send, at rest: the sum of their irradiances.
+        let half = (0.5 * fov.to_radians()).tan();
+        let stars = &s.sky.as_ref().unwrap().stars.as_ref().unwrap().stars;
+        let in_view: f64 = stars
+            .iter()
+            .filter(|st| {
+                st.dir.x > 0.0
+                    && (st.dir.y / st.dir.x).abs() < half
+                    && (st.dir.z / st.dir.x).abs() < half
+            })
+            .map(|st| st.irradiance)
+            .sum();
+        let f = 0.5 * f64::from(size) / half;
+        for b in backends() {
+            let frame = render_with(&s, b);
+            let mut total = 0.0;
+            let mut lit = 0;
+            for y in 0..size {
+                for x in 0..size {
+                    let c = frame.pixels[(y * size + x) as usize].color;
+                    if lum(c) > 0.0 {
+                        lit += 1;
+                        total += lum(c) * pinhole_pixel_sr(x, y, size, size, f);
+                    }
+                }
+            }
+            assert!(lit > 20, "{b} at {size}²: {lit} pixels hold stars");
+            assert!(
+                (total / in_view - 1.0).abs() < 1e-4,
+                "{b} at {size}²: the image holds {total}, the stars in view send {in_view}"
+            );
+            totals.push(total);
+        }
+    }
+    assert!((totals[0] / totals[totals.len() - 1] - 1.0).abs() < 1e-4);
+}
+
+/// The camera's pixel of a camera-frame direction, for the equirectangular camera looking
+/// along +x with up +z (longitude toward its right, -y).
+fn equirect_pixel(d: DVec3, w: u32, h: u32) -> (u32, u32) {
+    let lon = (-d.y).atan2(d.x);
+    let lat = d.z.clamp(-1.0, 1.0).asin();
+    (
+        ((lon / (2.0 * PI) + 0.5) * f64::from(w)) as u32,
+        ((0.5 - lat / PI) * f64::from(h)) as u32,
+    )
+}
+
+/// The law for a star seen from a frame where its light is shifted by D: a blackbody at D·T,
+/// its irradiance D⁻² times that blackbody's over the rest one's (for luminance E at rest).
+fn shifted_star(kelvin: f64, e: f64, d: f64) -> DVec3 {
+    use rest_embree::spectrum::{camera::rgb_of, planck};
+    let rest = rgb_of(|nm| planck(nm, kelvin));
+    let y = rest.dot(DVec3::new(0.2126, 0.7152, 0.0722));
+    rgb_of(|nm| planck(nm, d * kelvin)) * (e / y / (d * d))
+}
+
+#[test]
+fn a_moving_camera_sees_each_star_aberrated_and_shifted_as_a_blackbody_at_d_t() {
+    let d = Dir::new("stars-moving");
+    let (w, h) = (720, 360);
+    let beta: f64 = 0.9;
+    let gamma = 1.0 / (1.0 - beta * beta).sqrt();
+    let text = star_scene(
+        "projection = \"equirectangular\"",
+        w,
+        h,
+        &format!("velocity = [{beta}, 0, 0]"),
+        "",
+    );
+    let p = d.file("stars.toml", &text);
+    let s = rest_embree::scene::load_file(&p, &[]).unwrap();
+    let stars = s
+        .sky
+        .as_ref()
+        .unwrap()
+        .stars
+        .as_ref()
+        .unwrap()
+        .stars
+        .clone();
+    // Where each star should fall (aberration about +x, azimuth kept), and its light.
+    let mut want: std::collections::HashMap<(u32, u32), Vec<DVec3>> = Default::default();
+    for st in stars.iter() {
+        let cos_w = st.dir.x;
+        let cos_c = (cos_w + beta) / (1.0 + beta * cos_w);
+        let side = DVec3::new(0.0, st.dir.y, st.dir.z).normalize_or(DVec3::Z);
+        let dc = DVec3::X * cos_c + side * (1.0 - cos_c * cos_c).max(0.0).sqrt();
+        let (x, y) = equirect_pixel(dc, w, h);
+        // D = γ(1 + β cos θ_world) for a camera moving toward the star.
+        let doppler = gamma * (1.0 + beta * cos_w);
+        let lat = |py: f64| (0.5 - py / f64::from(h)) * PI;
+        let sr =
+            2.0 * PI / f64::from(w) * (lat(f64::from(y)).sin() - lat(f64::from(y) + 1.0).sin());
+        want.entry((x, y))
+            .or_default()
+            .push(shifted_star(st.kelvin, st.irradiance, doppler) / sr);
+    }
+    for b in backends() {
+        let f = render_with(&s, b);
+        let mut checked = 0;
+        for y in 0..h {
+            for x in 0..w {
+                let got = f.pixels[(y * w + x) as usize].color;
+                match want.get(&(x, y)) {
+                    None => assert_eq!(got, [0.0; 3], "{b}: pixel ({x}, {y}) holds no star"),
+                    Some(v) => {
+                        let sum: DVec3 = v.iter().copied().sum();
+                        for k in 0..3 {
+                            let rel = (f64::from(got[k]) - sum[k]).abs() / sum.max_element();
+                            assert!(
+                                rel < 1e-5,
+                                "{b}: pixel ({x}, {y}) channel {k}: {} against {}",
+                                got[k],
+                                sum[k]
+                            );
+                        }
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 350, "{b}: {checked} stars checked");
+    }
+    // Bunching: ahead of the camera a cap of half-angle 30° holds more stars than at rest.
+    let ahead = want.keys().filter(|&&(x, y)| {
+        let lon = ((f64::from(x) + 0.5) / f64::from(w) - 0.5) * 2.0 * PI;
+        let lat = (0.5 - (f64::from(y) + 0.5) / f64::from(h)) * PI;
+        lat.cos() * lon.cos() > 30f64.to_radians().cos()
+    });
+    assert!(
+        ahead.count()
+            > 4 * stars
+                .iter()
+                .filter(|s| s.dir.x > 30f64.to_radians().cos())
+                .count()
+    );
+}
+
+#[test]
+fn a_moving_sky_looks_as_a_camera_moving_the_other_way_sees_it() {
+    let d = Dir::new("stars-sky-moving");
+    let (w, h) = (240, 120);
+    let eq = "projection = \"equirectangular\"";
+    let a = d.file(
+        "a.toml",
+        &star_scene(eq, w, h, "velocity = [0.3, 0.5, 0.2]", ""),
+    );
+    let b = d.file(
+        "b.toml",
+        &star_scene(eq, w, h, "", "velocity = [-0.3, -0.5, -0.2]"),
+    );
+    let (a, b) = (
+        rest_embree::scene::load_file(&a, &[]).unwrap(),
+        rest_embree::scene::load_file(&b, &[]).unwrap(),
+    );
+    let (fa, fb) = (render_with(&a, "bvh"), render_with(&b, "bvh"));
+    let mut lit = 0;
+    for (pa, pb) in fa.pixels.iter().zip(&fb.pixels) {
+        lit += usize::from(pa.color != [0.0; 3]);
+        for k in 0..3 {
+            let scale = pa.color[k].abs().max(pb.color[k].abs()).max(1e-30);
+            assert!(
+                (pa.color[k] - pb.color[k]).abs() / scale < 1e-4,
+                "{:?} against {:?}",
+                pa.color,
+                pb.color
+            );
+        }
+    }
+    assert!(lit > 300, "{lit}");
+}
+
+#[test]
+fn bad_skies_are_clear_errors() {
+    use common::cli::fails;
+    let cam = "[camera]\nposition = [0, 0, 0]\ndirection = [1, 0, 0]\nup = [0, 0, 1]\n\n";
+    for (name, sky, needles) in [
+        (
+            "sky-empty",
+            "[sky]\nintensity = 2\n",
+            &["key `sky.map`", "stars"][..],
+        ),
+        (
+            "stars-count",
+            "[sky]\nstars = { count = 0 }\n",
+            &["sky.stars.count", "whole number"],
+        ),
+        (
+            "stars-no-count",
+            "[sky]\nstars = { seed = 3 }\n",
+            &["sky.stars.count"],
+        ),
+        (
+            "stars-huge",
+            "[sky]\nstars = { count = 1e12 }\n",
+            &["sky.stars.count", "10000000"],
+        ),
+        (
+            "stars-seed",
+            "[sky]\nstars = { count = 5, seed = -1 }\n",
+            &["sky.stars.seed"],
+        ),
+        (
+            "stars-magnitudes",
+            "[sky]\nstars = { count = 5, magnitudes = [6, 0] }\n",
+            &["sky.stars.magnitudes", "low <= high"],
+        ),
+        (
+            "stars-temperatures",
+            "[sky]\nstars = { count = 5, temperatures = [0, 5000] }\n",
+            &["sky.stars.temperatures"],
+        ),
+        (
+            "stars-irradiance",
+            "[sky]\nstars = { count = 5, irradiance = nan }\n",
+            &["sky.stars.irradiance"],
+        ),
+        (
+            "stars-unknown",
+            "[sky]\nstars = { count = 5, colour = 3 }\n",
+            &["sky.stars.colour"],
+        ),
+        (
+            "sky-fast",
+            "[sky]\nstars = { count = 5 }\nvelocity = [1, 0, 0]\n",
+            &["sky.velocity"],
+        ),
+    ] {
+        fails(name, &format!("{cam}{sky}"), &[], needles);
+    }
+}

@@ -173,7 +173,16 @@ pub fn needs_spectra(scene: &Scene) -> bool {
         return false;
     }
     let mut colours = vec![&scene.image.background, &scene.render.ambient];
-    colours.extend(scene.sky.iter().flat_map(|s| s.map.basis.iter()));
+    colours.extend(
+        scene
+            .sky
+            .iter()
+            .flat_map(|s| s.map.iter().flat_map(|m| m.basis.iter())),
+    );
+    // Stars are blackbodies.
+    if scene.sky.as_ref().is_some_and(|s| s.stars.is_some()) {
+        return true;
+    }
     for m in &scene.materials {
         colours.extend(m.colours());
     }
@@ -190,8 +199,11 @@ pub fn needs_spectra(scene: &Scene) -> bool {
             .filter(|g| !g.geometry.is_empty())
             .map(|g| g.velocity.identity_key()),
     );
-    if !scene.image.background.is_black() || scene.sky.is_some() {
+    if !scene.image.background.is_black() {
         frames.push(crate::spacetime::Velocity::ZERO.identity_key());
+    }
+    if let Some(sky) = &scene.sky {
+        frames.push(sky.velocity.identity_key());
     }
     frames.iter().any(|f| *f != frames[0])
 }

@@ -115,6 +115,61 @@ impl CameraRays {
         self.to_camera.view_dir(world_dir).0
     }
 
+    /// The image point (in pixels from the top-left corner) a camera-frame looking direction
+    /// `d` (unit) falls on, with the solid angle of the pixel holding it; None where it falls
+    /// outside the image, and always for an orthographic camera (all of whose rays look one
+    /// way, so it sees no point of the sky).
+    pub fn pixel_toward(&self, d: DVec3) -> Option<((u32, u32), f64)> {
+        let c = &self.camera;
+        let (f, r, u) = (d.dot(c.forward), d.dot(c.right), d.dot(c.up));
+        let (px, py) = match c.projection {
+            Projection::Pinhole { .. } => {
+                if f <= 0.0 {
+                    return None;
+                }
+                let k = self.focal / f;
+                (r * k + 0.5 * self.width, 0.5 * self.height - u * k)
+            }
+            Projection::Equirectangular => {
+                let lon = r.atan2(f);
+                let lat = u.clamp(-1.0, 1.0).asin();
+                (
+                    (lon / (2.0 * PI) + 0.5) * self.width,
+                    (0.5 - lat / PI) * self.height,
+                )
+            }
+            Projection::Orthographic { .. } => return None,
+        };
+        if !(px >= 0.0 && py >= 0.0 && px < self.width && py < self.height) {
+            return None;
+        }
+        let (x, y) = (px as u32, py as u32);
+        Some(((x, y), self.pixel_solid_angle(x, y)))
+    }
+
+    /// The solid angle (camera frame, sr) pixel (x, y) looks into, exactly: for a pinhole the
+    /// rectangle's solid angle seen from the focal distance (docs/physics.md §5.5), for the
+    /// equirectangular projection Δlon (sin lat₀ − sin lat₁). 0 for an orthographic camera.
+    pub fn pixel_solid_angle(&self, x: u32, y: u32) -> f64 {
+        let (x0, y0) = self.centred(f64::from(x), f64::from(y));
+        let (x1, y1) = (x0 + 1.0, y0 - 1.0);
+        match self.camera.projection {
+            Projection::Pinhole { .. } => {
+                let f = self.focal;
+                // The solid angle of [0, a] × [0, b] seen from distance f over the corner at
+                // the axis, signed (odd in a and in b), so sums of four give any rectangle.
+                let corner = |a: f64, b: f64| (a * b / (f * (f * f + a * a + b * b).sqrt())).atan();
+                (corner(x1, y0) - corner(x0, y0) - corner(x1, y1) + corner(x0, y1)).abs()
+            }
+            Projection::Equirectangular => {
+                let lat = |py: f64| (0.5 - py / self.height) * PI;
+                let (top, bottom) = (lat(f64::from(y)), lat(f64::from(y) + 1.0));
+                2.0 * PI / self.width * (top.sin() - bottom.sin())
+            }
+            Projection::Orthographic { .. } => 0.0,
+        }
+    }
+
     /// γ_c(1 + β_c·a): the camera's lookback factor for a world-frame looking direction `a`;
     /// the Doppler factor of a surface with factor s is this over s.
     pub fn lookback_factor(&self, dir_world: DVec3) -> f64 {

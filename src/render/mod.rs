@@ -13,6 +13,7 @@ mod ray_budget;
 mod sampler;
 mod screen_cull;
 mod shade;
+mod star_pixels;
 mod tile;
 mod world;
 
@@ -218,6 +219,7 @@ struct Rows<'a> {
     passes: Passes,
     cam: CameraRays,
     cull: Option<ScreenCull>,
+    stars: Option<star_pixels::StarPixels>,
     spectral: bool,
     progress: Option<&'a Progress>,
 }
@@ -233,12 +235,22 @@ impl<'a> Rows<'a> {
         // A sky is seen through every pixel: nothing to cull.
         let cull = ScreenCull::new(world, &cam).filter(|_| scene.sky.is_none());
         let spectral = needs_spectra(scene);
+        let seen = if spectral {
+            Seen::of(scene)
+        } else {
+            Seen::NONE
+        };
+        let stars = scene
+            .sky
+            .as_ref()
+            .and_then(|sky| star_pixels::StarPixels::new(sky, &cam, seen, spectral));
         Self {
             scene,
             world,
             passes,
             cam,
             cull,
+            stars,
             spectral,
             progress,
         }
@@ -282,14 +294,19 @@ impl<'a> Rows<'a> {
                 for x0 in (0..w).step_by(TILE as usize) {
                     let xy = (x0, y0);
                     let (cam, cull) = (&self.cam, self.cull.as_ref());
+                    let view = tile::View {
+                        cam,
+                        cull,
+                        stars: self.stars.as_ref(),
+                    };
                     let tile = if self.spectral {
                         let seen = Seen::of(scene);
                         let s = &mut scratch;
-                        tile::render_tile::<Sampled>(seen, scene, world, cam, cull, xy, passes, s)
+                        tile::render_tile::<Sampled>(seen, scene, world, &view, xy, passes, s)
                     } else {
                         let s = &mut scratch;
                         let seen = Seen::NONE;
-                        tile::render_tile::<DVec3>(seen, scene, world, cam, cull, xy, passes, s)
+                        tile::render_tile::<DVec3>(seen, scene, world, &view, xy, passes, s)
                     };
                     counts.0 += tile.primary_rays;
                     counts.1 += tile.nonfinite;

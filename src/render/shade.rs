@@ -22,10 +22,17 @@ struct LightRt<'a> {
     from_light: Boost,
 }
 
+/// The sky, with the boost into its rest frame where it moves.
+struct SkyRt<'a> {
+    sky: &'a crate::scene::Sky,
+    to_sky: Option<Boost>,
+}
+
 pub struct Shader<'a, B> {
     scene: &'a Scene,
     world: &'a World,
     lights: Vec<LightRt<'a>>,
+    sky: Option<SkyRt<'a>>,
     seen: Seen,
     band: PhantomData<B>,
 }
@@ -71,10 +78,15 @@ impl<'a, B: Band> Shader<'a, B> {
                 from_light: Boost::from_rest(&l.velocity),
             })
             .collect();
+        let sky = scene.sky.as_ref().map(|sky| SkyRt {
+            sky,
+            to_sky: (!sky.velocity.is_zero()).then(|| Boost::to_rest(&sky.velocity)),
+        });
         Self {
             scene,
             world,
             lights,
+            sky,
             seen,
             band: PhantomData,
         }
@@ -107,11 +119,19 @@ impl<'a, B: Band> Shader<'a, B> {
     /// the sky's there where the scene has one, its texel a spectrum on the map's basis as an
     /// image texture's is, else the background colour.
     pub fn background_along(&self, dir: DVec3, receiver_s: f64, shift: f64) -> B {
-        let Some(sky) = &self.scene.sky else {
+        let Some(sky) = &self.sky else {
             return self.background(receiver_s, shift);
         };
-        let (shift, k) = self.arriving(receiver_s, 1.0, shift);
-        texel::<B>(&sky.map, sky.rgb(dir), B::at(shift)) * k
+        let Some(map) = &sky.sky.map else {
+            return self.background(receiver_s, shift);
+        };
+        let (dir, sky_s) = match &sky.to_sky {
+            Some(b) => b.view_dir(dir),
+            None => (dir, 1.0),
+        };
+        let (shift, k) = self.arriving(receiver_s, sky_s, shift);
+        let rgb = sky.sky.rgb(dir).expect("it has a map");
+        texel::<B>(map, rgb, B::at(shift)) * k
     }
 
     /// Radiance from a sender with lookback factor `sender_s` reaching a receiver with

@@ -7,6 +7,7 @@ use super::frame::{Mattes, PixelValue, MATTE_RANKS};
 use super::sampler::sample_offset;
 use super::screen_cull::ScreenCull;
 use super::shade::Shader;
+use super::star_pixels::StarPixels;
 use super::world::{PrimaryHits, SurfaceHit, World};
 use super::{Passes, TILE};
 use crate::scene::Scene;
@@ -191,6 +192,10 @@ pub fn trace_tile(
     (n as u64 * t.total as u64, found)
 }
 
+/// The stars seen in a tile: the frame's, the tile's live pixels (as its primary rays are
+/// ordered) and the tile's offset in the full image.
+type TileStars<'a> = (&'a StarPixels, &'a [(u32, u32)], (u32, u32));
+
 /// The colours (linear sRGB) of primary hits (background where none), with the shadow rays of
 /// all of them traced together, light by light, so they go to the backends in packets.
 fn shade_hits<B: Band>(
@@ -198,6 +203,7 @@ fn shade_hits<B: Band>(
     world: &World,
     cam: &CameraRays,
     primary: &PrimaryHits,
+    stars: Option<TileStars>,
 ) -> Vec<DVec3> {
     // One entry per light and hit (None where there is no shadow ray), hit-major.
     let lights = shader.light_count();
@@ -263,9 +269,27 @@ fn shade_hits<B: Band>(
                 seen.to_rgb() * *factor
             }
             Err(_) if black_sky => DVec3::ZERO,
-            Err((camera_s, dir)) => shader.background_along(*dir, *camera_s, 1.0).to_rgb(),
+            Err((camera_s, dir)) => {
+                let sky = shader.background_along(*dir, *camera_s, 1.0).to_rgb();
+                // The stars of the pixel this ray belongs to (`image_points`).
+                match stars {
+                    Some((st, coords, (ox, oy))) => {
+                        let (x, y) = coords[k];
+                        sky + st.at(x + ox, y + oy)
+                    }
+                    None => sky,
+                }
+            }
         })
         .collect()
+}
+
+/// What one frame's camera sees, the same for every tile: its rays, the screen cull, and the
+/// stars in its pixels.
+pub struct View<'a> {
+    pub cam: &'a CameraRays,
+    pub cull: Option<&'a ScreenCull>,
+    pub stars: Option<&'a StarPixels>,
 }
 
 pub struct TilePixel {
@@ -289,12 +313,12 @@ pub fn render_tile<B: Band>(
     seen: Seen,
     scene: &Scene,
     world: &World,
-    cam: &CameraRays,
-    cull: Option<&ScreenCull>,
+    view: &View,
     (x0, y0): (u32, u32),
     passes: Passes,
     scratch: &mut TileScratch,
 ) -> TileResult {
+    let (cam, cull) = (view.cam, view.cull);
     let (t, px, primary) = scratch.tile(scene, cam, cull, (x0, y0));
     let (offset, live, live_coords) = (t.offset, &t.live, &t.live_coords);
     let (w, h) = scene.image.frame_size();
@@ -359,7 +383,8 @@ pub fn render_tile<B: Band>(
         let colors = if centre {
             Vec::new()
         } else {
-            shade_hits(&shader, world, cam, primary)
+            let stars = view.stars.map(|st| (st, &live_coords[..], offset));
+            shade_hits(&shader, world, cam, primary, stars)
         };
         for (j, &k) in live.iter().enumerate() {
             if !centre {

@@ -302,7 +302,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
 
 /// A velocity: `velocity = [bx, by, bz]`, or `<dir_key> = [...]` with one of `beta`,
 /// `rapidity`, `one_minus_beta`. None when none of these keys is present.
-fn velocity(t: &Table, dir_key: &str) -> SceneResult<Option<Velocity>> {
+pub(super) fn velocity(t: &Table, dir_key: &str) -> SceneResult<Option<Velocity>> {
     let forms: Vec<&str> = ["beta", "rapidity", "one_minus_beta"]
         .into_iter()
         .filter(|k| t.has(k))

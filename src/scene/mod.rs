@@ -12,6 +12,7 @@ mod objects;
 mod pass_set;
 mod procedural;
 mod reader;
+pub mod stars;
 mod surfaces;
 mod texture;
 pub(crate) mod toml_tree;

@@ -72,18 +72,109 @@ pub(super) fn textures(root: &Table) -> SceneResult<Vec<ReadTexture>> {
     Ok(out)
 }
 
-/// The `[sky]` table: `map` (an equirectangular image), `rotate`, `intensity`.
+/// The `[sky]` table: `map` (an equirectangular image), `rotate`, `intensity`, `stars`,
+/// `velocity` (or `beta` with `velocity_direction`, ...).
 pub(super) fn sky(t: &Table) -> SceneResult<super::Sky> {
-    let (path, w, h, texels) = image_beside(t, "map")?;
-    let map = super::ImageTexture::new(path.display().to_string(), w, h, texels, Role::Emitter);
+    let map = match t.has("map") {
+        true => {
+            let (path, w, h, texels) = image_beside(t, "map")?;
+            let shown = path.display().to_string();
+            Some(Arc::new(super::ImageTexture::new(
+                shown,
+                w,
+                h,
+                texels,
+                Role::Emitter,
+            )))
+        }
+        false => None,
+    };
+    let stars = t.table("stars")?.map(|s| stars(&s)).transpose()?;
+    if map.is_none() && stars.is_none() {
+        return Err(t.error(
+            "map",
+            "missing: a sky is a `map = \"sky.exr\"` (equirectangular), `stars = { count = ... }`, or both",
+        ));
+    }
     let rotation = super::transform::Transform::read_rotation(t)?.unwrap_or(glam::DMat3::IDENTITY);
     let intensity = t.f64_where("intensity", Some(1.0), |v| v >= 0.0, "0 or more")?;
-    t.finish(&["map", "rotate", "intensity"])?;
+    let velocity =
+        super::load::velocity(t, "velocity_direction")?.unwrap_or(crate::spacetime::Velocity::ZERO);
+    t.finish(&[
+        "map",
+        "rotate",
+        "intensity",
+        "stars",
+        "velocity",
+        "beta",
+        "rapidity",
+        "one_minus_beta",
+        "velocity_direction",
+    ])?;
     Ok(super::Sky {
-        map: Arc::new(map),
+        map,
         rotation,
         intensity,
+        stars,
+        velocity,
     })
+}
+
+/// `[sky] stars = { count, seed, magnitudes, irradiance, temperatures }`.
+fn stars(t: &Table) -> SceneResult<super::stars::StarField> {
+    use super::stars::{StarField, MAX_STARS};
+    let count = t.f64_where(
+        "count",
+        None,
+        |v| v.fract() == 0.0 && (1.0..=MAX_STARS as f64).contains(&v),
+        &format!("a whole number from 1 to {MAX_STARS}"),
+    )? as u64;
+    let seed = t.f64_where(
+        "seed",
+        Some(1.0),
+        |v| v.fract() == 0.0 && (0.0..=9.007_199_254_740_992e15).contains(&v),
+        "a whole number from 0 to 2^53",
+    )? as u64;
+    let pair = |key: &str, default: [f64; 2], ok: &dyn Fn(f64) -> bool, what: &str| {
+        let Some(n) = t.get(key) else {
+            return Ok(default);
+        };
+        let v = t.numbers_of(n, key, Some(2))?;
+        if !(ok(v[0]) && ok(v[1]) && v[0] <= v[1]) {
+            return Err(t.error_at(
+                n,
+                key,
+                format!("give [low, high], low <= high, each {what}"),
+            ));
+        }
+        Ok([v[0], v[1]])
+    };
+    let magnitudes = pair(
+        "magnitudes",
+        [0.0, 6.0],
+        &|v: f64| v.is_finite() && v.abs() <= 30.0,
+        "between -30 and 30",
+    )?;
+    let temperatures = pair(
+        "temperatures",
+        [3000.0, 30000.0],
+        &|v: f64| (100.0..=1e6).contains(&v),
+        "from 100 to 1000000 K",
+    )?;
+    let irradiance = t.f64_where(
+        "irradiance",
+        Some(2e-5),
+        |v| v > 0.0 && v.is_finite(),
+        "greater than 0",
+    )?;
+    t.finish(&["count", "seed", "magnitudes", "irradiance", "temperatures"])?;
+    Ok(StarField::new(
+        count,
+        seed,
+        magnitudes,
+        irradiance,
+        temperatures,
+    ))
 }
 
 /// A checker texture's table, read for both roles.

@@ -315,30 +315,36 @@ fn srgb_to_linear(v: f32) -> f32 {
     }
 }
 
-/// A sky at rest in the world frame, seen by every ray that meets nothing (`[sky]`): an
-/// equirectangular map in the convention of the `equirectangular` camera (a camera at rest with
-/// that projection looking along +x with up +z renders the map back pixel for pixel), turned
-/// by `rotation` and scaled by `intensity`.
+/// A sky, seen by every ray that meets nothing (`[sky]`), at rest in the world frame unless
+/// it is given a velocity: an equirectangular map in the convention of the `equirectangular`
+/// camera (a camera at rest with that projection looking along +x with up +z renders the map
+/// back pixel for pixel), turned by `rotation` and scaled by `intensity`, and a star field
+/// (where neither is given, the image's background).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sky {
     /// The map, its texels radiances (emitter role).
-    pub map: std::sync::Arc<ImageTexture>,
-    /// Turns the sky: the map's +x goes to `rotation * x`.
+    pub map: Option<std::sync::Arc<ImageTexture>>,
+    /// Turns the sky (map and stars): the map's +x goes to `rotation * x`.
     pub rotation: DMat3,
-    /// Multiplies its radiance.
+    /// Multiplies the map's radiance.
     pub intensity: f64,
+    /// The stars.
+    pub stars: Option<super::stars::StarField>,
+    /// The sky's velocity in the world frame.
+    pub velocity: crate::spacetime::Velocity,
 }
 
 impl Sky {
-    /// The linear RGB the sky shows along world-frame direction `d` (toward where the light
-    /// comes from).
-    pub fn rgb(&self, d: DVec3) -> DVec3 {
+    /// The linear RGB the map shows along sky-frame direction `d` (toward where the light
+    /// comes from); None without a map.
+    pub fn rgb(&self, d: DVec3) -> Option<DVec3> {
+        let map = self.map.as_ref()?;
         let d = (self.rotation.transpose() * d).normalize_or(DVec3::X);
         // The camera's: longitude from +x toward its right (-y), latitude up toward +z.
         let lon = (-d.y).atan2(d.x);
         let lat = d.z.clamp(-1.0, 1.0).asin();
         let (u, v) = (lon / (2.0 * PI) + 0.5, 0.5 - lat / PI);
-        self.map.bilinear(u, v) * self.intensity
+        Some(map.bilinear(u, v) * self.intensity)
     }
 }
 
