@@ -230,114 +230,216 @@ fn read_stl(path: &Path) -> Result<MeshData, MeshError> {
     })
 }
 
+/// A PLY vertex as read: x, y, z, nx, ny, nz, u, v (or s, t, or texture_u, texture_v), with
+/// a bit for each one the file gave. Typed, not a map of names per element: a scanned mesh
+/// has millions of vertices.
+#[derive(Clone, Copy, Default)]
+struct PlyVertex {
+    values: [f64; 8],
+    given: u8,
+}
+
+impl PlyVertex {
+    fn put(&mut self, name: &str, v: f64) -> ply_rs_bw::ply::PropertyAccessResult {
+        use ply_rs_bw::ply::PropertyAccessResult::{Ignored, Set};
+        let k = match name {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            "nx" => 3,
+            "ny" => 4,
+            "nz" => 5,
+            "u" | "s" | "texture_u" => 6,
+            "v" | "t" | "texture_v" => 7,
+            _ => return Ignored,
+        };
+        self.values[k] = v;
+        self.given |= 1 << k;
+        Set
+    }
+
+    fn has(&self, bits: u8) -> bool {
+        self.given & bits == bits
+    }
+}
+
+/// A PLY face as read: its vertex indices (`vertex_indices` or `vertex_index`), or the first
+/// that is out of u32's range.
+#[derive(Clone, Default)]
+struct PlyFace {
+    indices: smallvec::SmallVec<[u32; 4]>,
+    out_of_range: Option<i64>,
+    given: bool,
+}
+
+impl PlyFace {
+    fn put<T: Copy + Into<i64>>(
+        &mut self,
+        name: &str,
+        list: &[T],
+    ) -> ply_rs_bw::ply::PropertyAccessResult {
+        use ply_rs_bw::ply::PropertyAccessResult::{Ignored, Set};
+        if name != "vertex_indices" && name != "vertex_index" {
+            return Ignored;
+        }
+        self.given = true;
+        self.indices.clear();
+        for &i in list {
+            let i: i64 = i.into();
+            match u32::try_from(i) {
+                Ok(u) => self.indices.push(u),
+                Err(_) => {
+                    self.out_of_range.get_or_insert(i);
+                }
+            }
+        }
+        Set
+    }
+}
+
+/// An element the renderer does not use (edges, materials, ...), read past.
+struct PlySkip;
+
+macro_rules! scalar_setters {
+    ($($f:ident: $t:ty),*) => {
+        $(fn $f(&mut self, name: &str, v: $t) -> ply_rs_bw::ply::PropertyAccessResult {
+            self.put(name, f64::from(v))
+        })*
+    };
+}
+
+macro_rules! list_setters {
+    ($($f:ident: $t:ty),*) => {
+        $(fn $f(&mut self, name: &str, v: Vec<$t>) -> ply_rs_bw::ply::PropertyAccessResult {
+            self.put(name, &v)
+        })*
+    };
+}
+
+impl ply_rs_bw::ply::PropertyAccess for PlyVertex {
+    fn new() -> Self {
+        Self::default()
+    }
+    scalar_setters!(set_char: i8, set_uchar: u8, set_short: i16, set_ushort: u16, set_int: i32,
+        set_uint: u32, set_float: f32, set_double: f64);
+}
+
+impl ply_rs_bw::ply::PropertyAccess for PlyFace {
+    fn new() -> Self {
+        Self::default()
+    }
+    list_setters!(set_list_char: i8, set_list_uchar: u8, set_list_short: i16,
+        set_list_ushort: u16, set_list_int: i32, set_list_uint: u32);
+}
+
+impl ply_rs_bw::ply::PropertyAccess for PlySkip {
+    fn new() -> Self {
+        PlySkip
+    }
+}
+
 fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
-    use ply_rs_bw::parser::Parser;
-    use ply_rs_bw::ply::{DefaultElement, Property};
+    use ply_rs_bw::parser::{Parser, Reader};
     let file =
         std::fs::File::open(path).map_err(|e| MeshError::new(format!("cannot read it: {e}")))?;
-    let ply = Parser::<DefaultElement>::new()
-        .read_ply(&mut std::io::BufReader::new(file))
-        .map_err(|e| MeshError {
-            line: e.line(),
-            message: format!("not a readable PLY file: {e}"),
-        })?;
-    let number = |p: &Property| -> Option<f64> {
-        Some(match *p {
-            Property::Char(v) => v.into(),
-            Property::UChar(v) => v.into(),
-            Property::Short(v) => v.into(),
-            Property::UShort(v) => v.into(),
-            Property::Int(v) => v.into(),
-            Property::UInt(v) => v.into(),
-            Property::Float(v) => v.into(),
-            Property::Double(v) => v,
-            _ => return None,
-        })
+    let unreadable = |e: ply_rs_bw::parser::ParseError| MeshError {
+        line: e.line(),
+        message: format!("not a readable PLY file: {e}"),
     };
-    let indices = |p: &Property| -> Option<Vec<i64>> {
-        Some(match p {
-            Property::ListChar(v) => v.iter().map(|&i| i.into()).collect(),
-            Property::ListUChar(v) => v.iter().map(|&i| i.into()).collect(),
-            Property::ListShort(v) => v.iter().map(|&i| i.into()).collect(),
-            Property::ListUShort(v) => v.iter().map(|&i| i.into()).collect(),
-            Property::ListInt(v) => v.iter().map(|&i| i.into()).collect(),
-            Property::ListUInt(v) => v.iter().map(|&i| i.into()).collect(),
-            _ => return None,
-        })
-    };
-    let vertices = ply
-        .payload
-        .get("vertex")
-        .ok_or_else(|| MeshError::new("it has no `vertex` element"))?;
-    let mut mesh = MeshData::default();
-    let (mut vertex_normals, mut vertex_uvs) = (Vec::new(), Vec::new());
-    let uv_names = [["u", "v"], ["s", "t"], ["texture_u", "texture_v"]];
-    for (i, v) in vertices.iter().enumerate() {
-        let coordinate = |k: &str| {
-            v.get(k)
-                .and_then(number)
-                .ok_or_else(|| MeshError::new(format!("vertex {i} has no number `{k}`")))
-        };
-        mesh.positions.push(DVec3::new(
-            coordinate("x")?,
-            coordinate("y")?,
-            coordinate("z")?,
-        ));
-        let get = |k: &str| v.get(k).and_then(number);
-        if let (Some(x), Some(y), Some(z)) = (get("nx"), get("ny"), get("nz")) {
-            vertex_normals.push(DVec3::new(x, y, z).normalize_or_zero());
-        }
-        if let Some(uv) = uv_names.iter().find_map(|[a, b]| Some([get(a)?, get(b)?])) {
-            vertex_uvs.push(uv);
+    let mut reader = Reader::new(std::io::BufReader::with_capacity(1 << 20, file));
+    let header = Parser::<PlySkip>::new()
+        .read_header(&mut reader)
+        .map_err(unreadable)?;
+    let (mut vertices, mut faces) = (None, None);
+    // Elements are read in the header's order, each by the type that keeps what it needs.
+    for (name, def) in &header.elements {
+        match name.as_str() {
+            "vertex" => {
+                vertices = Some(
+                    Parser::<PlyVertex>::new()
+                        .read_payload_for_element(&mut reader, def, &header)
+                        .map_err(unreadable)?,
+                )
+            }
+            "face" => {
+                faces = Some(
+                    Parser::<PlyFace>::new()
+                        .read_payload_for_element(&mut reader, def, &header)
+                        .map_err(unreadable)?,
+                )
+            }
+            _ => {
+                Parser::<PlySkip>::new()
+                    .read_payload_for_element(&mut reader, def, &header)
+                    .map_err(unreadable)?;
+            }
         }
     }
-    let n_all = vertex_normals.len() == mesh.positions.len();
-    let uv_all = vertex_uvs.len() == mesh.positions.len();
-    let faces = ply
-        .payload
-        .get("face")
-        .ok_or_else(|| MeshError::new("it has no `face` element"))?;
+    let vertices = vertices.ok_or_else(|| MeshError::new("it has no `vertex` element"))?;
+    let mut mesh = MeshData {
+        positions: Vec::with_capacity(vertices.len()),
+        ..Default::default()
+    };
+    for (i, v) in vertices.iter().enumerate() {
+        if let Some(k) = (0..3).find(|&k| !v.has(1 << k)) {
+            return Err(MeshError::new(format!(
+                "vertex {i} has no number `{}`",
+                ["x", "y", "z"][k]
+            )));
+        }
+        mesh.positions
+            .push(DVec3::new(v.values[0], v.values[1], v.values[2]));
+    }
+    let n_all = vertices.iter().all(|v| v.has(0b111_000));
+    let uv_all = vertices.iter().all(|v| v.has(0b1100_0000));
+    let faces = faces.ok_or_else(|| MeshError::new("it has no `face` element"))?;
     let n = mesh.positions.len() as i64;
+    mesh.triangles.reserve(faces.len());
     for (f, face) in faces.iter().enumerate() {
-        let list = face
-            .get("vertex_indices")
-            .or_else(|| face.get("vertex_index"))
-            .and_then(indices)
-            .ok_or_else(|| {
-                MeshError::new(format!(
-                    "face {f} has no integer list `vertex_indices` (or `vertex_index`)"
-                ))
-            })?;
+        if !face.given {
+            return Err(MeshError::new(format!(
+                "face {f} has no integer list `vertex_indices` (or `vertex_index`)"
+            )));
+        }
+        let list = &face.indices;
+        if let Some(bad) = face.out_of_range.or_else(|| {
+            list.iter()
+                .find(|&&i| i64::from(i) >= n)
+                .map(|&i| i64::from(i))
+        }) {
+            return Err(MeshError::new(format!(
+                "face {f} names vertex {bad}; the file has {n} (counted from 0)"
+            )));
+        }
         if list.len() < 3 {
             return Err(MeshError::new(format!(
                 "face {f} has {} corners; a face needs 3 or more",
                 list.len()
             )));
         }
-        if let Some(bad) = list.iter().find(|&&i| i < 0 || i >= n) {
-            return Err(MeshError::new(format!(
-                "face {f} names vertex {bad}; the file has {n} (counted from 0)"
-            )));
-        }
         for k in 1..list.len() - 1 {
-            mesh.triangles
-                .push([list[0] as u32, list[k] as u32, list[k + 1] as u32]);
+            mesh.triangles.push([list[0], list[k], list[k + 1]]);
         }
     }
-    let corners = |t: &[u32; 3]| t.map(|i| i as usize);
-    if n_all {
+    drop(faces);
+    let corners = |t: &[u32; 3]| t.map(|i| &vertices[i as usize]);
+    if n_all && !vertices.is_empty() {
         mesh.normals = Some(
             mesh.triangles
                 .iter()
-                .map(|t| corners(t).map(|i| vertex_normals[i]))
+                .map(|t| {
+                    corners(t).map(|v| {
+                        DVec3::new(v.values[3], v.values[4], v.values[5]).normalize_or_zero()
+                    })
+                })
                 .collect(),
         );
     }
-    if uv_all {
+    if uv_all && !vertices.is_empty() {
         mesh.uvs = Some(
             mesh.triangles
                 .iter()
-                .map(|t| corners(t).map(|i| vertex_uvs[i]))
+                .map(|t| corners(t).map(|v| [v.values[6], v.values[7]]))
                 .collect(),
         );
     }
