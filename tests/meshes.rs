@@ -283,7 +283,11 @@ fn bad_meshes_and_transforms_are_clear_errors() {
     );
     d.file("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
     std::fs::create_dir_all(d.0.join("folder.obj")).unwrap();
-    let cases: [(&str, &[&str]); 14] = [
+    d.file(
+        "two.obj",
+        "v 0 10 0\nv 1 10 0\nv 0 11 0\nusemtl hull\nf 1 2 3\n",
+    );
+    let cases: [(&str, &[&str]); 17] = [
         ("type = \"mesh\"\nfile = \"missing.obj\"", &["missing.obj", "cannot read it"]),
         ("type = \"mesh\"\nfile = \"bad-v.obj\"", &["bad-v.obj:2", "position parse error"]),
         ("type = \"mesh\"\nfile = \"bad-f.obj\"", &["bad-f.obj:4", "out of bounds"]),
@@ -309,6 +313,18 @@ fn bad_meshes_and_transforms_are_clear_errors() {
         (
             "type = \"lattice\"\ncounts = [2, 2, 2]\ntranslate = [1, 0, 0]",
             &["translate", "transforms apply to"],
+        ),
+        (
+            "type = \"mesh\"\nfile = \"two.obj\"\nmaterials = { wing = \"white\" }",
+            &["materials.wing", "no material `wing`", "hull"],
+        ),
+        (
+            "type = \"mesh\"\nfile = \"two.obj\"\nmaterials = { hull = \"paint\" }",
+            &["materials.hull", "no material named `paint`"],
+        ),
+        (
+            "type = \"box\"\nmin = [-0.5, 10, -0.5]\nmax = [0.5, 11, 0.5]\nmaterials = { hull = \"white\" }",
+            &["materials", "not used with the other keys"],
         ),
     ];
     for (object, needles) in cases {
@@ -430,4 +446,31 @@ fn vertex_normals_shade_a_mesh_smoothly() {
         );
         assert!(ef > 3.0 * es, "{b}: flat {ef} against smooth {es}");
     }
+}
+
+/// An OBJ's `usemtl` names choose the scene's materials: by the same name, by the object's
+/// `materials` table, else the object's `material`; each run of triangles is a part of the
+/// object with its material, and the primitive ids still count the object's triangles.
+#[test]
+fn obj_materials_map_to_the_scenes_by_name() {
+    let d = Dir::new("mesh-materials");
+    d.file(
+        "ship.obj",
+        "v 0 10 0\nv 1 10 0\nv 0 11 0\nv 1 11 0\nv 0 10 1\n\
+         f 1 2 3\nusemtl red\nf 2 4 3\nf 1 2 5\nusemtl paint\nf 1 3 5\nusemtl other\nf 2 4 5\n",
+    );
+    let text = with_object(
+        "type = \"mesh\"\nfile = \"ship.obj\"\nmaterials = { paint = \"blue\" }",
+    ) + "\n[[material]]\nname = \"red\"\ncolor = [1, 0, 0]\n\n[[material]]\nname = \"blue\"\ncolor = [0, 0, 1]\n";
+    let s = load(&d, "scene.toml", &text, &[]);
+    let id = |n: &str| s.materials.iter().position(|m| m.name == n).unwrap() as u32;
+    let g = &s.groups[0].geometry;
+    let by_triangle: Vec<u32> = (0..5).map(|p| g.part_of(p).material).collect();
+    assert_eq!(
+        by_triangle,
+        [id("white"), id("red"), id("red"), id("blue"), id("white")]
+    );
+    assert_eq!(g.parts.len(), 4);
+    let ids: Vec<u32> = (0..5).map(|p| g.index_in_object(p)).collect();
+    assert_eq!(ids, [0, 1, 2, 3, 4]);
 }

@@ -199,7 +199,10 @@ mod tests {
         }
         // A PLY file written, read, built and rendered: the terrain is in view.
         let s = super::scene_file_here("mesh-file", 2000);
-        assert!(s.contains("2048 triangles") && s.contains("rendered at 256²"), "{s}");
+        assert!(
+            s.contains("2048 triangles") && s.contains("rendered at 256²"),
+            "{s}"
+        );
         let lit: u64 = s
             .split(" pixels not black")
             .next()

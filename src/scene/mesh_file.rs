@@ -16,7 +16,19 @@ pub struct MeshData {
     pub normals: Option<Vec<[DVec3; 3]>>,
     /// Each triangle's corner texture coordinates, where the file gives them for every corner.
     pub uvs: Option<Vec<[[f64; 2]; 3]>>,
+    /// The material names the file uses (OBJ's `usemtl`), in the order first used.
+    pub materials: Vec<String>,
+    /// Each triangle's material (an index into `materials`, or [`NO_MATERIAL`]); empty where
+    /// the file names none.
+    pub material_of: Vec<u32>,
 }
+
+/// A triangle's material where the file gives it none.
+pub const NO_MATERIAL: u32 = u32::MAX;
+
+/// The name under which the names of an OBJ's `usemtl` statements are handed to tobj as a
+/// material library of their own (see `read_obj`).
+const USEMTL_NAMES: &str = "rest-embree-usemtl-names.mtl";
 
 /// Why a mesh file could not be read: the message, and the 1-based line it concerns, if any.
 #[derive(Clone, Debug, PartialEq)]
@@ -84,17 +96,51 @@ pub fn read(path: &Path) -> Result<MeshData, MeshError> {
 }
 
 fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
-    let file =
-        std::fs::File::open(path).map_err(|e| MeshError::new(format!("cannot read it: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| MeshError::new(format!("cannot read it: {e}")))?;
+    // tobj keeps a triangle's `usemtl` only where a material library defines that name, and
+    // the scene maps names to its own materials without reading the file's library: the
+    // names used are collected first and given to tobj as a library of their own.
+    let mut names: Vec<String> = Vec::new();
+    for line in bytes.split(|&b| b == b'\n') {
+        let line = String::from_utf8_lossy(line);
+        if let Some(("usemtl", rest)) = line.trim().split_once(char::is_whitespace) {
+            let name = rest.trim().to_string();
+            if !name.is_empty() && !names.contains(&name) {
+                names.push(name);
+            }
+        }
+    }
+    use std::io::Read;
+    let mut source = std::io::Cursor::new(format!("mtllib {USEMTL_NAMES}\n").into_bytes())
+        .chain(std::io::Cursor::new(bytes));
+    let library = || {
+        let materials: Vec<tobj::Material> = names
+            .iter()
+            .map(|n| tobj::Material {
+                name: n.clone(),
+                ..Default::default()
+            })
+            .collect();
+        let map = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.clone(), i))
+            .collect();
+        Ok((materials, map))
+    };
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
     };
-    // Materials (`mtllib`) are not read: objects take the scene's materials.
-    let loaded = tobj::load_obj_buf(&mut std::io::BufReader::new(file), &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
+    // The file's own libraries (`mtllib`) are not read: objects take the scene's materials.
+    let loaded = tobj::load_obj_buf(&mut std::io::BufReader::new(&mut source), &options, |p| {
+        if p.file_name().and_then(|n| n.to_str()) == Some(USEMTL_NAMES) {
+            library()
+        } else {
+            Err(tobj::LoadError::OpenFileFailed)
+        }
     });
     let models = match loaded {
         Ok((models, _materials)) => models,
@@ -147,7 +193,12 @@ fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
                 .chunks_exact(3)
                 .map(|t| [base + t[0], base + t[1], base + t[2]]),
         );
+        if !names.is_empty() {
+            let id = m.mesh.material_id.map_or(NO_MATERIAL, |i| i as u32);
+            mesh.material_of.resize(mesh.triangles.len(), id);
+        }
     }
+    mesh.materials = names;
     mesh.normals = with_normals.then_some(normals);
     mesh.uvs = with_uvs.then_some(uvs);
     Ok(mesh)
@@ -227,6 +278,7 @@ fn read_stl(path: &Path) -> Result<MeshData, MeshError> {
         triangles,
         normals: None,
         uvs: None,
+        ..Default::default()
     })
 }
 

@@ -35,6 +35,7 @@ pub(super) const OBJECT_KEYS: &[&str] = &[
     "length",
     "axis",
     "file",
+    "materials",
     "translate",
     "rotate",
     "scale",
@@ -139,6 +140,40 @@ fn box_triangles(min: DVec3, max: DVec3) -> [[DVec3; 3]; 12] {
         out[2 * f + 1] = [c(q[0]), c(q[2]), c(q[3])];
     }
     out
+}
+
+/// The scene material of each material a mesh file names (OBJ's `usemtl`): the one
+/// `materials = { file_name = "scene_name" }` gives, else the scene's material of the same
+/// name, else the object's `material`.
+fn file_materials(
+    t: &Table,
+    in_file: &[String],
+    mats: &HashMap<String, u32>,
+    default: u32,
+) -> SceneResult<Vec<u32>> {
+    let mut chosen: Vec<u32> = in_file
+        .iter()
+        .map(|n| mats.get(n).copied().unwrap_or(default))
+        .collect();
+    if let Some(map) = t.table("materials")? {
+        let keys: Vec<&str> = map.keys().collect();
+        for k in keys {
+            let Some(i) = in_file.iter().position(|n| n == k) else {
+                let named = if in_file.is_empty() {
+                    "the file names no materials (usemtl)".to_string()
+                } else {
+                    format!("the file's materials: {}", in_file.join(", "))
+                };
+                return Err(map.error_at(
+                    map.get(k).expect("a key of the table"),
+                    k,
+                    format!("the mesh file has no material `{k}` ({named})"),
+                ));
+            };
+            chosen[i] = material_ref(&map, k, mats, default)?;
+        }
+    }
+    Ok(chosen)
 }
 
 /// The mesh `file` names, relative to the scene file's folder; errors name the scene's line
@@ -290,14 +325,37 @@ pub(super) fn add_object(
                     uvs: mesh.uvs.clone(),
                 })
             });
-            geo.push_part_with(
-                id,
-                mat,
-                mesh.triangles
-                    .iter()
-                    .map(|tri| Primitive::Triangle { v: tri.map(at) }),
-                corners,
-            );
+            // Runs of triangles of one material, each a part of the object.
+            let chosen = file_materials(t, &mesh.materials, mats, mat)?;
+            let material_of = |i: usize| match mesh.material_of.get(i) {
+                Some(&m) if m != super::mesh_file::NO_MATERIAL => chosen[m as usize],
+                _ => mat,
+            };
+            let n = mesh.triangles.len();
+            let mut start = 0;
+            while start < n {
+                let m = material_of(start);
+                let end = (start + 1..n).find(|&i| material_of(i) != m).unwrap_or(n);
+                let corners = corners.as_ref().map(|c| {
+                    if (start, end) == (0, n) {
+                        c.clone()
+                    } else {
+                        std::sync::Arc::new(crate::geometry::Corners {
+                            normals: c.normals.as_ref().map(|v| v[start..end].to_vec()),
+                            uvs: c.uvs.as_ref().map(|v| v[start..end].to_vec()),
+                        })
+                    }
+                });
+                geo.push_part_with(
+                    id,
+                    m,
+                    mesh.triangles[start..end]
+                        .iter()
+                        .map(|tri| Primitive::Triangle { v: tri.map(at) }),
+                    corners,
+                );
+                start = end;
+            }
         }
         "mesh" => {
             let vn = t

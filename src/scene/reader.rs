@@ -62,6 +62,11 @@ impl<'a> Table<'a> {
         }
     }
 
+    /// The table's keys, in the file's order.
+    pub fn keys(&self) -> impl Iterator<Item = &'a str> {
+        self.entries().iter().map(|(k, _)| k.as_str())
+    }
+
     pub fn has(&self, key: &str) -> bool {
         self.entries().iter().any(|(k, _)| k == key)
     }
