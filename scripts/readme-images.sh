@@ -21,4 +21,18 @@ $r render scenes/passing_spheres.toml -o "$o/spheres-doppler-searchlight.png" "$
 # The fast-moving planet: at rest, and at 0.9c as it approaches (scenes/planet.toml).
 $r render scenes/planet.toml -o "$o/planet-0.png" "${size[@]}" --set 'group.planet.velocity=[0, 0, 0]' --set 'camera.direction=[0, 1, 0]'
 $r render scenes/planet.toml -o "$o/planet-0.9.png" "${size[@]}"
+# A flight through the star field at 0.99c, beside the same sky from a camera at rest.
+sky=(--width 384 --height 216 --quiet)
+$r render scenes/star_flight.toml -o "$o/stars-0.png" "${sky[@]}" --set 'camera.velocity=[0, 0, 0]'
+$r render scenes/star_flight.toml -o "$o/stars-0.99.png" "${sky[@]}"
+# A textured OBJ model at rest and approaching at 0.9c, against the stars.
+$r render scenes/rocket.toml -o "$o/rocket-0.png" "${sky[@]}" --samples 4 --set 'group.rocket.velocity=[0, 0, 0]' --set 'camera.direction=[0, 1, 0]'
+$r render scenes/rocket.toml -o "$o/rocket-0.9.png" "${sky[@]}" --samples 4
+# Six frames of the planet film, as one picture.
+film=$(mktemp -d)
+$r render scenes/planet_film.toml -o "$film/planet-####.png" --width 320 --height 180 --quiet --frames 12..46
+frames=()
+for k in 12 18 24 30 36 46; do frames+=("$film/planet-$(printf %04d $k).png"); done
+oiiotool "${frames[@]}" --mosaic 3x2 -o "$o/planet-film.png"
+rm -rf "$film"
 echo "wrote $(ls "$o" | wc -l) images to $o"
