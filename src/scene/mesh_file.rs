@@ -101,13 +101,29 @@ fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
     // the scene maps names to its own materials without reading the file's library: the
     // names used are collected first and given to tobj as a library of their own.
     let mut names: Vec<String> = Vec::new();
+    // Which triangles' corners carry a normal and texture coordinates of their own: where a
+    // file has normals, tobj gives a face without them its neighbour's, which would shade it
+    // wrongly. A face of k corners is k - 2 triangles, in the file's order.
+    let mut given: Vec<(bool, bool)> = Vec::new();
     for line in bytes.split(|&b| b == b'\n') {
         let line = String::from_utf8_lossy(line);
-        if let Some(("usemtl", rest)) = line.trim().split_once(char::is_whitespace) {
-            let name = rest.trim().to_string();
-            if !name.is_empty() && !names.contains(&name) {
-                names.push(name);
+        match line.trim().split_once(char::is_whitespace) {
+            Some(("usemtl", rest)) => {
+                let name = rest.trim().to_string();
+                if !name.is_empty() && !names.contains(&name) {
+                    names.push(name);
+                }
             }
+            Some(("f", rest)) => {
+                let corners: Vec<&str> = rest.split_whitespace().collect();
+                let part = |c: &str, k: usize| c.split('/').nth(k).is_some_and(|x| !x.is_empty());
+                let flags = (
+                    corners.iter().all(|c| part(c, 2)),
+                    corners.iter().all(|c| part(c, 1)),
+                );
+                given.extend(std::iter::repeat_n(flags, corners.len().saturating_sub(2)));
+            }
+            _ => {}
         }
     }
     use std::io::Read;
@@ -147,18 +163,28 @@ fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
         Err(e) => return Err(obj_error(path, &e)),
     };
     let mut mesh = MeshData::default();
-    let every = |f: &dyn Fn(&tobj::Mesh) -> bool| models.iter().all(|m| f(&m.mesh));
-    let with_normals =
-        every(&|m| !m.normals.is_empty() && m.normal_indices.len() == m.indices.len());
-    let with_uvs =
-        every(&|m| !m.texcoords.is_empty() && m.texcoord_indices.len() == m.indices.len());
+    // Normals and texture coordinates where some model gives them for every corner; a model
+    // without them gets its flat face normals (the shading of a mesh without normals) and
+    // texture coordinates (0, 0).
+    let complete = |list: &[f64], idx: &[u32], m: &tobj::Mesh| {
+        !list.is_empty() && idx.len() == m.indices.len()
+    };
+    let with_normals = models
+        .iter()
+        .any(|m| complete(&m.mesh.normals, &m.mesh.normal_indices, &m.mesh));
+    let with_uvs = models
+        .iter()
+        .any(|m| complete(&m.mesh.texcoords, &m.mesh.texcoord_indices, &m.mesh));
     let (mut normals, mut uvs) = (Vec::new(), Vec::new());
     for m in &models {
         let corner = |list: &[f64], at: u32, n: usize| -> Option<Vec<f64>> {
             list.get(at as usize * n..at as usize * n + n)
                 .map(<[f64]>::to_vec)
         };
-        if with_normals {
+        let position = |i: u32| {
+            corner(&m.mesh.positions, i, 3).map_or(DVec3::ZERO, |v| DVec3::new(v[0], v[1], v[2]))
+        };
+        if with_normals && complete(&m.mesh.normals, &m.mesh.normal_indices, &m.mesh) {
             for t in m.mesh.normal_indices.chunks_exact(3) {
                 let c = [t[0], t[1], t[2]]
                     .map(|i| corner(&m.mesh.normals, i, 3).map(|v| DVec3::new(v[0], v[1], v[2])));
@@ -167,8 +193,13 @@ fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
                 };
                 normals.push([a, b, c].map(|n| n.normalize_or_zero()));
             }
+        } else if with_normals {
+            for t in m.mesh.indices.chunks_exact(3) {
+                let [a, b, c] = [t[0], t[1], t[2]].map(position);
+                normals.push([(b - a).cross(c - a).normalize_or_zero(); 3]);
+            }
         }
-        if with_uvs {
+        if with_uvs && complete(&m.mesh.texcoords, &m.mesh.texcoord_indices, &m.mesh) {
             for t in m.mesh.texcoord_indices.chunks_exact(3) {
                 let c = [t[0], t[1], t[2]]
                     .map(|i| corner(&m.mesh.texcoords, i, 2).map(|v| [v[0], v[1]]));
@@ -177,6 +208,8 @@ fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
                 };
                 uvs.push([a, b, c]);
             }
+        } else if with_uvs {
+            uvs.extend(m.mesh.indices.chunks_exact(3).map(|_| [[0.0; 2]; 3]));
         }
     }
     for m in models {
@@ -198,9 +231,20 @@ fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
             mesh.material_of.resize(mesh.triangles.len(), id);
         }
     }
-    mesh.materials = names;
+    if given.len() == mesh.triangles.len() {
+        for (k, &(has_normals, has_uvs)) in given.iter().enumerate() {
+            if with_normals && !has_normals {
+                let [a, b, c] = mesh.triangles[k].map(|i| mesh.positions[i as usize]);
+                normals[k] = [(b - a).cross(c - a).normalize_or_zero(); 3];
+            }
+            if with_uvs && !has_uvs {
+                uvs[k] = [[0.0; 2]; 3];
+            }
+        }
+    }
     mesh.normals = with_normals.then_some(normals);
     mesh.uvs = with_uvs.then_some(uvs);
+    mesh.materials = names;
     Ok(mesh)
 }
 
@@ -520,5 +564,19 @@ mod tests {
         assert_eq!(m.triangles.len(), 2);
         assert_eq!(m.uvs, None);
         assert_eq!(m.normals.map(|n| n.len()), Some(2));
+        // A part with normals and texture coordinates beside one without (another usemtl):
+        // the second gets its flat face normal and (0, 0), the first keeps its own.
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(&p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 1 0 0\nvt 0.5 0.5\nusemtl a\nf 1/1/1 2/1/1 3/1/1\nusemtl b\nf 1 4 2\n").unwrap();
+        let m = read(&p).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert_eq!(
+            m.normals,
+            Some(vec![[DVec3::X; 3], [DVec3::Y; 3]]),
+            "the flat normal of (0,0,0) (0,0,1) (1,0,0) is +y"
+        );
+        assert_eq!(m.uvs, Some(vec![[[0.5, 0.5]; 3], [[0.0, 0.0]; 3]]));
+        assert_eq!(m.materials, ["a", "b"]);
+        assert_eq!(m.material_of, [0, 1]);
     }
 }
