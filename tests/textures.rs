@@ -327,3 +327,77 @@ fn a_mesh_maps_an_image_by_its_texture_coordinates() {
         );
     }
 }
+
+/// Textures turn and move with their object: an object placed by `scale`, `rotate` and
+/// `translate`, seen by a camera placed the same way, is the picture of the object as given
+/// (a sphere with an image, and a box turned by 30°, so twelve triangles, with an image and
+/// with a checker), all but silhouette pixels equal.
+#[test]
+fn textures_turn_and_move_with_their_object() {
+    let d = Dir::new("texture-placed");
+    write_png(&d.0.join("map.png"), 64, 32, |x, y| {
+        [(x * 4) as u8, (y * 8) as u8, ((x * 7 + y * 3) % 256) as u8]
+    });
+    let scene = |object: &str, place: &str, camera: [f64; 3], look: [f64; 3]| {
+        format!(
+            "[camera]\nposition = {camera:?}\nlook_at = {look:?}\nup = [0, 0, 1]\nfov_y = 30\n\n\
+             [image]\nwidth = 64\nheight = 64\n\n\
+             [[texture]]\nname = \"map\"\nimage = \"map.png\"\n\n\
+             [[texture]]\nname = \"squares\"\nchecker = {{ size = 0.3, color1 = [1, 0.5, 0], color2 = [0, 0.2, 1] }}\n\n\
+             [[material]]\nname = \"map\"\nemission = \"map\"\n\n[[material]]\nname = \"squares\"\nemission = \"squares\"\n\n\
+             [[group]]\nname = \"g\"\n[[group.object]]\n{object}\n{place}\n"
+        )
+    };
+    // Scaled by 2, turned 30° about z, moved by (2, 1, 0.5): the camera at 5 units on -y
+    // becomes 10 units along the turned -y from the moved centre.
+    let a = 30f64.to_radians();
+    let (t, k) = ([2.0, 1.0, 0.5], 2.0);
+    let cam = [
+        t[0] + k * 5.0 * a.sin(),
+        t[1] - k * 5.0 * a.cos(),
+        t[2] + k * 1.5,
+    ];
+    let place = "scale = 2\nrotate = { axis = [0, 0, 1], degrees = 30 }\ntranslate = [2, 1, 0.5]";
+    for (what, object) in [
+        (
+            "sphere",
+            "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"map\"",
+        ),
+        (
+            "box",
+            "type = \"box\"\nmin = [-1, -1, -1]\nmax = [1, 1, 1]\nmaterial = \"map\"",
+        ),
+        (
+            "checker box",
+            "type = \"box\"\nmin = [-1, -1, -1]\nmax = [1, 1, 1]\nmaterial = \"squares\"",
+        ),
+    ] {
+        let given = d.file(
+            "given.toml",
+            &scene(object, "", [0.0, -5.0, 1.5], [0.0, 0.0, 0.0]),
+        );
+        let placed = d.file("placed.toml", &scene(object, place, cam, t));
+        let (given, placed) = (
+            rest_embree::scene::load_file(&given, &[]).unwrap(),
+            rest_embree::scene::load_file(&placed, &[]).unwrap(),
+        );
+        for b in backends() {
+            let (fa, fb) = (render_with(&given, b), render_with(&placed, b));
+            let lit = fa.pixels.iter().filter(|p| p.color != [0.0; 3]).count();
+            assert!(lit > 800, "{what}, {b}: {lit} pixels show it");
+            same_picture(&fa, &fb, &format!("{what}, {b}"), 0.03, 0.02);
+            // Not a picture that any placement would match: the texture varies across it.
+            let distinct: std::collections::HashSet<[u32; 3]> = fa
+                .pixels
+                .iter()
+                .map(|p| p.color.map(|c| (c * 50.0) as u32))
+                .collect();
+            let least = if what == "checker box" { 3 } else { 9 };
+            assert!(
+                distinct.len() >= least,
+                "{what}, {b}: {} colours",
+                distinct.len()
+            );
+        }
+    }
+}

@@ -17,6 +17,35 @@ pub struct Part {
     pub material: u32,
     /// A mesh's data at its triangles' corners (from its file), if it has any.
     pub corners: Option<std::sync::Arc<Corners>>,
+    /// Where a transform placed the object: textures are laid out in its own coordinates.
+    pub placement: Option<std::sync::Arc<Placement>>,
+}
+
+/// An object placed by `scale`, then `rotate`, then `translate`, and the shape it was before
+/// (a box, sphere or rod; none for a mesh, whose texture coordinates are its own), so that its
+/// textures turn and move with it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Placement {
+    /// Scaled first, along the object's own axes (every factor > 0).
+    pub scale: DVec3,
+    /// Then turned.
+    pub rotation: glam::DMat3,
+    /// Then moved.
+    pub translate: DVec3,
+    /// The box, sphere or rod as given, before all three.
+    pub shape: Option<Primitive>,
+}
+
+impl Placement {
+    /// A point of the group's rest frame in the object's own coordinates.
+    pub fn to_object(&self, p: DVec3) -> DVec3 {
+        (self.rotation.transpose() * (p - self.translate)) / self.scale
+    }
+
+    /// A normal of the group's rest frame in the object's own coordinates (unit).
+    pub fn normal_to_object(&self, n: DVec3) -> DVec3 {
+        (self.scale * (self.rotation.transpose() * n)).normalize_or(n)
+    }
 }
 
 /// Data at a mesh's triangles' corners, by triangle in the part's order: vertex normals (for
@@ -96,6 +125,7 @@ impl Geometry {
                     object,
                     material,
                     corners,
+                    placement: None,
                 },
             );
         }
@@ -127,6 +157,7 @@ impl Geometry {
                 object,
                 material,
                 corners: None,
+                placement: None,
             });
             start = end;
         }
@@ -311,11 +342,30 @@ impl Geometry {
         self.len() == 0
     }
 
+    /// Give every part of `object` its placement.
+    pub fn set_placement(&mut self, object: u32, placement: std::sync::Arc<Placement>) {
+        for p in self.parts.iter_mut().filter(|p| p.object == object) {
+            p.placement = Some(placement.clone());
+        }
+    }
+
     /// The same geometry moved by `d`.
     pub fn translated(&self, d: DVec3) -> Geometry {
         Geometry {
             prims: self.prims.iter().map(|p| p.translated(d)).collect(),
-            parts: self.parts.clone(),
+            parts: self
+                .parts
+                .iter()
+                .map(|p| Part {
+                    placement: p.placement.as_ref().map(|x| {
+                        std::sync::Arc::new(Placement {
+                            translate: x.translate + d,
+                            ..(**x).clone()
+                        })
+                    }),
+                    ..p.clone()
+                })
+                .collect(),
             implicit: self
                 .implicit
                 .iter()

@@ -16,7 +16,7 @@ mod real;
 pub use aabb::Aabb;
 pub use bars::BarArray;
 pub(crate) use box_tree::{walk, BoxTree, TreeNode, PACKET};
-pub use group_geometry::{Corners, Geometry, ImplicitRun, Part};
+pub use group_geometry::{Corners, Geometry, ImplicitRun, Part, Placement};
 pub use implicit::{Blocks, Implicit, Member, BAR, SPHERE};
 pub use lattice::Lattice;
 pub(crate) use light_buffer::LightBuffer;

@@ -214,7 +214,8 @@ impl<'a, B: Band> Shader<'a, B> {
         let scene = self.scene;
         let g = &self.world.groups[hit.group];
         let prim = g.geometry.prim(hit.prim);
-        let mat = &scene.materials[g.geometry.part_of(hit.prim).material as usize];
+        let part = g.geometry.part_of(hit.prim);
+        let mat = &scene.materials[part.material as usize];
         let v = hit.dir / hit.s;
         let n = prim.normal(hit.point);
         let inside = n.dot(v) > 0.0;
@@ -223,10 +224,20 @@ impl<'a, B: Band> Shader<'a, B> {
         let (smooth, corner_uv) = g.geometry.corners_at(hit.prim, hit.point);
         let nf = smooth.map_or(faced, |s| if s.dot(faced) < 0.0 { -s } else { s });
         let event = ray.at(hit.lambda);
+        // Textures are laid out in the object's own coordinates, on its shape before any
+        // transform placed it.
+        let (point, outward, prim) = match &part.placement {
+            Some(pl) => (
+                pl.to_object(hit.point),
+                pl.normal_to_object(n),
+                pl.shape.unwrap_or(prim),
+            ),
+            None => (hit.point, n, prim),
+        };
         let lit = Lit {
             mat,
-            point: hit.point,
-            outward: n,
+            point,
+            outward,
             corner_uv,
             prim,
             group: hit.group,
@@ -412,12 +423,13 @@ struct LightTerm {
 /// A hit prepared for shading: see [`Shader::prepare`].
 pub struct Lit<'a> {
     mat: &'a crate::scene::Material,
-    /// The hit in its group's rest frame (where textures are laid out), and the surface's
+    /// The hit in its object's own coordinates (its group's rest frame, undone by the
+    /// object's transform, if it has one; textures are laid out there), and the surface's
     /// outward normal there.
     point: DVec3,
     outward: DVec3,
-    /// The primitive hit (where an image is mapped from), and a mesh's texture coordinates
-    /// there.
+    /// The primitive hit as the object was before its transform (where an image is mapped
+    /// from), and a mesh's texture coordinates there.
     prim: crate::geometry::Primitive,
     corner_uv: Option<[f64; 2]>,
     group: usize,

@@ -213,12 +213,21 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
                     .flatten()
                     .any(|t| matches!(**t, Texture::Image(_)))
             };
-            let unmapped = geometry.prims.get(first).is_some_and(|p| {
-                let part = geometry.part_of(first as u32);
-                matches!(p, crate::geometry::Primitive::Triangle { .. })
-                    && imaged(part.material)
-                    && part.corners.as_ref().is_none_or(|c| c.uvs.is_none())
-            });
+            // (A box turned into triangles keeps its box's mapping through its placement.)
+            let unmapped = geometry
+                .parts
+                .iter()
+                .filter(|p| p.object == id)
+                .any(|part| {
+                    let triangles = geometry
+                        .prims
+                        .get(part.start as usize)
+                        .is_some_and(|p| matches!(p, crate::geometry::Primitive::Triangle { .. }));
+                    triangles
+                        && imaged(part.material)
+                        && part.corners.as_ref().is_none_or(|c| c.uvs.is_none())
+                        && part.placement.as_ref().is_none_or(|pl| pl.shape.is_none())
+                });
             if unmapped {
                 return Err(o.error(
                     "material",

@@ -226,12 +226,15 @@ pub(super) fn add_object(
         )),
         _ => Ok(transform.map_or(1.0, |x| x.scale.x)),
     };
+    // The shape before its transform, where it is a box, sphere or rod.
+    let mut original = None;
     match kind {
         "box" => {
             let (min, max) = (t.req_vec3("min")?, t.req_vec3("max")?);
             if min.cmpge(max).any() {
                 return Err(t.error("max", "every coordinate of max must exceed min"));
             }
+            original = Some(Primitive::Cuboid { min, max });
             match transform {
                 None => {
                     budget(t, "type", total, 1)?;
@@ -271,6 +274,7 @@ pub(super) fn add_object(
             let center = t.req_vec3("center")?;
             let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
             let s = uniform("sphere")?;
+            original = Some(Primitive::Sphere { center, radius });
             let center = transform.map_or(center, |x| x.point(center));
             budget(t, "type", total, 1)?;
             geo.push_part(
@@ -286,6 +290,7 @@ pub(super) fn add_object(
             let (a, b) = (t.req_vec3("from")?, t.req_vec3("to")?);
             let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
             let s = uniform("rod")?;
+            original = Some(Primitive::Capsule { a, b, radius });
             let (a, b) = transform.map_or((a, b), |x| (x.point(a), x.point(b)));
             budget(t, "type", total, 1)?;
             geo.push_part(
@@ -493,6 +498,19 @@ pub(super) fn add_object(
                 ),
             ));
         }
+    }
+    // Textures turn and move with the object (a box turned by quarter turns as exactly as its
+    // corners were).
+    if let Some(x) = transform {
+        geo.set_placement(
+            id,
+            std::sync::Arc::new(crate::geometry::Placement {
+                scale: x.scale,
+                rotation: x.axis_permutation().unwrap_or(x.rotation),
+                translate: x.translate,
+                shape: original,
+            }),
+        );
     }
     Ok(kind.to_string())
 }
