@@ -53,10 +53,13 @@ pub const BYTES_PER_PIXEL_EXR: u64 = 380;
 /// The memory an object held as itself (a lattice, a bar array) costs rendered: its
 /// primitives', listed, or when it is instanced (more than
 /// [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) of them) one block's and a placement per
-/// block.
+/// block; a mesh's, its vertices and indices.
 pub fn implicit_bytes(shape: &crate::geometry::Implicit) -> u64 {
     if shape.len() <= crate::render::INSTANCE_OVER {
         return shape.len().saturating_mul(BYTES_PER_PRIMITIVE);
+    }
+    if let crate::geometry::Implicit::Mesh(m) = shape {
+        return m.bytes();
     }
     let blocks = crate::geometry::Blocks::of(shape.grid());
     shape.member_count(&blocks) * BYTES_PER_PRIMITIVE + blocks.count() * BYTES_PER_BLOCK

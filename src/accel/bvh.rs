@@ -3,6 +3,7 @@
 
 use super::bvh32::Nodes32;
 use super::instanced_tree::InstancedTree;
+use super::mesh_tree::MeshTree;
 use super::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, BoxTree, Geometry, TreeNode};
 use std::sync::Arc;
@@ -12,8 +13,31 @@ pub struct Bvh {
     /// Over the primitives held one by one.
     nodes: Nodes,
     indices: Vec<u32>,
-    /// The objects held as themselves (lattices, bar arrays), each in two levels.
-    instanced: Vec<InstancedTree>,
+    /// The objects held as themselves: lattices and bar arrays each in two levels, meshes
+    /// each in a tree over its triangles.
+    instanced: Vec<Held>,
+}
+
+/// An object held as itself, as the BVH walks it.
+enum Held {
+    Blocks(InstancedTree),
+    Mesh(MeshTree),
+}
+
+impl Held {
+    fn build(run: &crate::geometry::ImplicitRun) -> Held {
+        match &run.shape {
+            crate::geometry::Implicit::Mesh(m) => Held::Mesh(MeshTree::build(run.first, m)),
+            _ => Held::Blocks(InstancedTree::build(run)),
+        }
+    }
+
+    fn traverse(&self, ray: &Ray, tmax: f64, any: bool) -> Option<Hit> {
+        match self {
+            Held::Blocks(t) => t.traverse(ray, tmax, any),
+            Held::Mesh(t) => t.traverse(ray, tmax, any),
+        }
+    }
 }
 
 /// The tree's nodes in f64, or in f32 about the geometry's centre.
@@ -37,7 +61,7 @@ impl Bvh {
     pub fn build(geometry: Arc<Geometry>) -> Bvh {
         let boxes: Vec<Aabb> = geometry.prims.iter().map(|p| p.bounds()).collect();
         let BoxTree { nodes, indices } = BoxTree::build(&boxes);
-        let instanced = geometry.implicit.iter().map(InstancedTree::build).collect();
+        let instanced = geometry.implicit.iter().map(Held::build).collect();
         Bvh {
             geometry,
             nodes: Nodes::F64(nodes),

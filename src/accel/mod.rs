@@ -15,6 +15,7 @@ mod bvh32;
 mod embree;
 mod fan;
 mod instanced_tree;
+mod mesh_tree;
 
 pub(crate) use bvh::BvhBackend;
 pub(crate) use bvh32::Bvh32Backend;

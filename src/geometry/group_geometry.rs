@@ -140,6 +140,18 @@ impl Geometry {
         runs: &[(u64, u32)],
         shape: Implicit,
     ) -> Result<(), String> {
+        let runs: Vec<_> = runs.iter().map(|&(n, m)| (n, m, None)).collect();
+        self.push_implicit_with(object, &runs, shape)
+    }
+
+    /// [`push_implicit`](Self::push_implicit), each run with its corner data (a mesh's
+    /// normals and texture coordinates, by triangle in the run's order).
+    pub fn push_implicit_with(
+        &mut self,
+        object: u32,
+        runs: &[(u64, u32, Option<std::sync::Arc<Corners>>)],
+        shape: Implicit,
+    ) -> Result<(), String> {
         let first = self.len();
         let total = first as u64 + shape.len();
         if total > u32::MAX as u64 {
@@ -149,14 +161,14 @@ impl Geometry {
             ));
         }
         let mut start = first;
-        for &(count, material) in runs.iter().filter(|(count, _)| *count > 0) {
-            let end = start + count as u32;
+        for (count, material, corners) in runs.iter().filter(|(count, _, _)| *count > 0) {
+            let end = start + *count as u32;
             self.parts.push(Part {
                 start,
                 end,
                 object,
-                material,
-                corners: None,
+                material: *material,
+                corners: corners.clone(),
                 placement: None,
             });
             start = end;
@@ -221,16 +233,28 @@ impl Geometry {
             if run.shape.len() <= max {
                 for p in parts {
                     let ids = (p.start - run.first) as u64..(p.end - run.first) as u64;
-                    g.push_part(p.object, p.material, ids.map(|id| run.shape.prim(id)));
+                    let prims = ids.map(|id| run.shape.prim(id));
+                    g.push_part_with(p.object, p.material, prims, p.corners.clone());
                 }
             } else {
-                let runs: Vec<(u64, u32)> = parts
+                let runs: Vec<_> = parts
                     .clone()
-                    .map(|p| ((p.end - p.start) as u64, p.material))
+                    .map(|p| ((p.end - p.start) as u64, p.material, p.corners.clone()))
                     .collect();
                 let object = parts.clone().next().map_or(0, |p| p.object);
-                g.push_implicit(object, &runs, run.shape.clone())
+                g.push_implicit_with(object, &runs, run.shape.clone())
                     .expect("no more primitives than before");
+            }
+        }
+        // Each object's placement, as it had it.
+        let placed: std::collections::HashMap<u32, &std::sync::Arc<Placement>> = self
+            .parts
+            .iter()
+            .filter_map(|p| Some((p.object, p.placement.as_ref()?)))
+            .collect();
+        if !placed.is_empty() {
+            for p in &mut g.parts {
+                p.placement = placed.get(&p.object).map(|&x| x.clone());
             }
         }
         g
@@ -284,9 +308,7 @@ impl Geometry {
     /// texture coordinates, where its mesh has them (None for other primitives).
     pub fn corners_at(&self, prim: u32, p: DVec3) -> (Option<DVec3>, Option<[f64; 2]>) {
         let part = self.part_of(prim);
-        let (Some(c), Some(Primitive::Triangle { v })) =
-            (&part.corners, self.prims.get(prim as usize))
-        else {
+        let (Some(c), Primitive::Triangle { v }) = (&part.corners, self.prim(prim)) else {
             return (None, None);
         };
         let i = (prim - part.start) as usize;

@@ -1,10 +1,14 @@
 //! Objects held as themselves (`Implicit`): the lattice and the bar array, whose primitives are
-//! numbered and made from their numbers when asked. Backends that instance one cut its grid of
-//! nodes into equal blocks ([`Blocks`]): one block's primitives ([`Member`]s), placed at every
-//! block's first node, with the numbers the object does not have (past its far faces) skipped.
+//! numbered and made from their numbers when asked, and big triangle meshes (an
+//! [`IndexedMesh`]: shared vertices, three indices a triangle). Backends that instance a
+//! lattice or bar array cut its grid of nodes into equal blocks ([`Blocks`]): one block's
+//! primitives ([`Member`]s), placed at every block's first node, with the numbers the object
+//! does not have (past its far faces) skipped. A mesh has no grid: backends build over its
+//! triangles (its grid methods answer as for an object of no nodes).
 
-use super::{Aabb, BarArray, Lattice, Primitive};
+use super::{Aabb, BarArray, IndexedMesh, Lattice, Primitive};
 use glam::DVec3;
+use std::sync::Arc;
 
 /// An object held as itself.
 #[derive(Clone, Debug, PartialEq)]
@@ -13,6 +17,8 @@ pub enum Implicit {
     Lattice(Lattice),
     /// Box-shaped bars on a plane grid.
     Bars(BarArray),
+    /// A triangle mesh, its vertices shared.
+    Mesh(Arc<IndexedMesh>),
 }
 
 /// One of a block's primitives: the sphere or bar at a local node, or the rod from it along an
@@ -47,6 +53,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.len(),
             Implicit::Bars(b) => b.len(),
+            Implicit::Mesh(m) => m.len(),
         }
     }
 
@@ -60,6 +67,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.prim(id),
             Implicit::Bars(b) => b.prim(id),
+            Implicit::Mesh(m) => m.triangle(id),
         }
     }
 
@@ -68,6 +76,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => Box::new(l.spheres().chain(l.rods())),
             Implicit::Bars(b) => Box::new(b.bars()),
+            Implicit::Mesh(m) => Box::new((0..m.len()).map(|i| m.triangle(i))),
         }
     }
 
@@ -76,6 +85,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.bounds(),
             Implicit::Bars(b) => b.bounds(),
+            Implicit::Mesh(m) => m.bounds(),
         }
     }
 
@@ -84,6 +94,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => Implicit::Lattice(l.translated(d)),
             Implicit::Bars(b) => Implicit::Bars(b.translated(d)),
+            Implicit::Mesh(m) => Implicit::Mesh(Arc::new(m.translated(d))),
         }
     }
 
@@ -92,6 +103,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.counts,
             Implicit::Bars(b) => b.grid(),
+            Implicit::Mesh(_) => [0; 3],
         }
     }
 
@@ -100,6 +112,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.node_at(n),
             Implicit::Bars(b) => b.node_at(n),
+            Implicit::Mesh(_) => DVec3::ZERO,
         }
     }
 
@@ -109,6 +122,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.member_prim(n, m),
             Implicit::Bars(b) => b.member_prim(n, m),
+            Implicit::Mesh(mesh) => mesh.triangle(0),
         }
     }
 
@@ -118,6 +132,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.member_id(n, m),
             Implicit::Bars(b) => b.member_id(n, m),
+            Implicit::Mesh(_) => 0,
         }
     }
 
@@ -126,6 +141,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.local_box(m),
             Implicit::Bars(b) => b.local_box(m),
+            Implicit::Mesh(_) => Aabb::EMPTY,
         }
     }
 
@@ -165,6 +181,7 @@ impl Implicit {
                     axis: BAR,
                 })
                 .collect()],
+            Implicit::Mesh(_) => Vec::new(),
         }
     }
 
@@ -175,6 +192,7 @@ impl Implicit {
                 u64::from(l.sphere_count() > 0) + 3 * u64::from(l.rod_count() > 0)
             }
             Implicit::Bars(_) => 1,
+            Implicit::Mesh(_) => 0,
         };
         kinds * u64::from(blocks.nodes())
     }
@@ -193,6 +211,7 @@ impl Implicit {
                 [0, 1, 2].map(|a| (first[a] + blocks.size[a] - 1).min(grid[a] - 1)),
                 bars.reach(),
             ),
+            Implicit::Mesh(_) => return Aabb::EMPTY,
         };
         Aabb::new(self.node(first) - reach, self.node(last) + reach)
     }

@@ -219,10 +219,10 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
                 .iter()
                 .filter(|p| p.object == id)
                 .any(|part| {
-                    let triangles = geometry
-                        .prims
-                        .get(part.start as usize)
-                        .is_some_and(|p| matches!(p, crate::geometry::Primitive::Triangle { .. }));
+                    let triangles = matches!(
+                        geometry.prim(part.start),
+                        crate::geometry::Primitive::Triangle { .. }
+                    );
                     triangles
                         && imaged(part.material)
                         && part.corners.as_ref().is_none_or(|c| c.uvs.is_none())

@@ -434,6 +434,35 @@ impl ply_rs_bw::ply::PropertyAccess for PlySkip {
     }
 }
 
+/// A PLY file's vertices: positions, and normals and texture coordinates where every vertex
+/// has them.
+type VertexData = (Vec<DVec3>, Option<Vec<DVec3>>, Option<Vec<[f64; 2]>>);
+
+fn vertex_data(vertices: Vec<PlyVertex>) -> Result<VertexData, MeshError> {
+    let mut positions = Vec::with_capacity(vertices.len());
+    for (i, v) in vertices.iter().enumerate() {
+        if let Some(k) = (0..3).find(|&k| !v.has(1 << k)) {
+            return Err(MeshError::new(format!(
+                "vertex {i} has no number `{}`",
+                ["x", "y", "z"][k]
+            )));
+        }
+        positions.push(DVec3::new(v.values[0], v.values[1], v.values[2]));
+    }
+    let any = !vertices.is_empty();
+    let normals = (any && vertices.iter().all(|v| v.has(0b111_000))).then(|| {
+        let n = |v: &PlyVertex| DVec3::new(v.values[3], v.values[4], v.values[5]);
+        vertices.iter().map(|v| n(v).normalize_or_zero()).collect()
+    });
+    let uvs = (any && vertices.iter().all(|v| v.has(0b1100_0000))).then(|| {
+        vertices
+            .iter()
+            .map(|v| [v.values[6], v.values[7]])
+            .collect()
+    });
+    Ok((positions, normals, uvs))
+}
+
 fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
     use ply_rs_bw::parser::{Parser, Reader};
     let file =
@@ -450,12 +479,14 @@ fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
     // Elements are read in the header's order, each by the type that keeps what it needs.
     for (name, def) in &header.elements {
         match name.as_str() {
+            // Made into positions (and normals, texture coordinates) at once, so that the
+            // elements as read are freed before the faces are read.
             "vertex" => {
-                vertices = Some(
+                vertices = Some(vertex_data(
                     Parser::<PlyVertex>::new()
                         .read_payload_for_element(&mut reader, def, &header)
                         .map_err(unreadable)?,
-                )
+                )?)
             }
             "face" => {
                 faces = Some(
@@ -471,23 +502,12 @@ fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
             }
         }
     }
-    let vertices = vertices.ok_or_else(|| MeshError::new("it has no `vertex` element"))?;
+    let (positions, vertex_normals, vertex_uvs) =
+        vertices.ok_or_else(|| MeshError::new("it has no `vertex` element"))?;
     let mut mesh = MeshData {
-        positions: Vec::with_capacity(vertices.len()),
+        positions,
         ..Default::default()
     };
-    for (i, v) in vertices.iter().enumerate() {
-        if let Some(k) = (0..3).find(|&k| !v.has(1 << k)) {
-            return Err(MeshError::new(format!(
-                "vertex {i} has no number `{}`",
-                ["x", "y", "z"][k]
-            )));
-        }
-        mesh.positions
-            .push(DVec3::new(v.values[0], v.values[1], v.values[2]));
-    }
-    let n_all = vertices.iter().all(|v| v.has(0b111_000));
-    let uv_all = vertices.iter().all(|v| v.has(0b1100_0000));
     let faces = faces.ok_or_else(|| MeshError::new("it has no `face` element"))?;
     let n = mesh.positions.len() as i64;
     mesh.triangles.reserve(faces.len());
@@ -518,26 +538,13 @@ fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
         }
     }
     drop(faces);
-    let corners = |t: &[u32; 3]| t.map(|i| &vertices[i as usize]);
-    if n_all && !vertices.is_empty() {
-        mesh.normals = Some(
-            mesh.triangles
-                .iter()
-                .map(|t| {
-                    corners(t).map(|v| {
-                        DVec3::new(v.values[3], v.values[4], v.values[5]).normalize_or_zero()
-                    })
-                })
-                .collect(),
-        );
+    if let Some(n) = vertex_normals {
+        let at = |t: &[u32; 3]| t.map(|i| n[i as usize]);
+        mesh.normals = Some(mesh.triangles.iter().map(at).collect());
     }
-    if uv_all && !vertices.is_empty() {
-        mesh.uvs = Some(
-            mesh.triangles
-                .iter()
-                .map(|t| corners(t).map(|v| [v.values[6], v.values[7]]))
-                .collect(),
-        );
+    if let Some(uv) = vertex_uvs {
+        let at = |t: &[u32; 3]| t.map(|i| uv[i as usize]);
+        mesh.uvs = Some(mesh.triangles.iter().map(at).collect());
     }
     Ok(mesh)
 }

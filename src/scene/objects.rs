@@ -313,23 +313,18 @@ pub(super) fn add_object(
             }
             let mesh = read_mesh_file(t)?;
             budget(t, "file", total, mesh.triangles.len() as u64)?;
-            let at = |i: u32| {
-                let p = mesh.positions[i as usize];
-                transform.map_or(p, |x| x.point(p))
-            };
             // Normals turn with the mesh and take the inverse of its scale.
             let normal = |n: DVec3| {
                 transform.map_or(n, |x| (x.rotation * (n / x.scale)).normalize_or_zero())
             };
-            let corners = (mesh.normals.is_some() || mesh.uvs.is_some()).then(|| {
-                std::sync::Arc::new(crate::geometry::Corners {
+            let corners =
+                (mesh.normals.is_some() || mesh.uvs.is_some()).then(|| crate::geometry::Corners {
                     normals: mesh
                         .normals
                         .as_ref()
                         .map(|n| n.iter().map(|c| c.map(normal)).collect()),
                     uvs: mesh.uvs.clone(),
-                })
-            });
+                });
             // Runs of triangles of one material, each a part of the object.
             let chosen = file_materials(t, &mesh.materials, mats, mat)?;
             let material_of = |i: usize| match mesh.material_of.get(i) {
@@ -337,30 +332,32 @@ pub(super) fn add_object(
                 _ => mat,
             };
             let n = mesh.triangles.len();
+            let mut runs = Vec::new();
             let mut start = 0;
             while start < n {
                 let m = material_of(start);
                 let end = (start + 1..n).find(|&i| material_of(i) != m).unwrap_or(n);
                 let corners = corners.as_ref().map(|c| {
-                    if (start, end) == (0, n) {
-                        c.clone()
-                    } else {
-                        std::sync::Arc::new(crate::geometry::Corners {
-                            normals: c.normals.as_ref().map(|v| v[start..end].to_vec()),
-                            uvs: c.uvs.as_ref().map(|v| v[start..end].to_vec()),
-                        })
-                    }
+                    std::sync::Arc::new(crate::geometry::Corners {
+                        normals: c.normals.as_ref().map(|v| v[start..end].to_vec()),
+                        uvs: c.uvs.as_ref().map(|v| v[start..end].to_vec()),
+                    })
                 });
-                geo.push_part_with(
-                    id,
-                    m,
-                    mesh.triangles[start..end]
-                        .iter()
-                        .map(|tri| Primitive::Triangle { v: tri.map(at) }),
-                    corners,
-                );
+                runs.push(((end - start) as u64, m, corners));
                 start = end;
             }
+            drop(corners);
+            // Held as itself: its vertices once, placed, and its triangles' indices.
+            let positions = match transform {
+                Some(x) => mesh.positions.iter().map(|&p| x.point(p)).collect(),
+                None => mesh.positions,
+            };
+            let shape = Implicit::Mesh(std::sync::Arc::new(crate::geometry::IndexedMesh::new(
+                positions,
+                mesh.triangles,
+            )));
+            geo.push_implicit_with(id, &runs, shape)
+                .map_err(|why| at_value(t, "file", why))?;
         }
         "mesh" => {
             let vn = t

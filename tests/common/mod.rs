@@ -33,6 +33,26 @@ pub fn render_with(scene: &Scene, backend: &str) -> Frame {
     frame
 }
 
+/// As [`render_with`], with every object of more than `instance_over` primitives held as
+/// itself (0: lattices and bar arrays instanced, meshes as their shared vertices), however
+/// small.
+pub fn render_held(scene: &Scene, backend: &str, instance_over: u64) -> Frame {
+    use rest_embree::render::{RenderOptions, WorldOptions};
+    let b = rest_embree::accel::backend_by_name(backend).unwrap();
+    let world = WorldOptions {
+        direct_max: 0,
+        instance_over,
+        ..Default::default()
+    };
+    let options = RenderOptions {
+        world,
+        ..Default::default()
+    };
+    let (frame, stats) = rest_embree::render(scene, b.as_ref(), &options).unwrap();
+    assert_eq!(stats.nonfinite_pixels, 0, "no NaN or infinite pixel");
+    frame
+}
+
 /// The vertical field of view, in degrees, that gives focal length `f` pixels at `height`.
 pub fn fov_for_focal(f: f64, height: u32) -> f64 {
     2.0 * (0.5 * height as f64 / f).atan().to_degrees()

@@ -123,6 +123,11 @@ pub fn attach(
     first_instance: u32,
 ) -> crate::Result<BlockScene> {
     let shape = &run.shape;
+    if matches!(shape, Implicit::Mesh(_)) {
+        return Err(crate::Error::backend(
+            "a mesh is a triangle geometry of its own, not instanced blocks",
+        ));
+    }
     let blocks = Blocks::of(shape.grid());
     let bounds = shape.bounds();
     let span = Aabb::new(bounds.min - center, bounds.max - center).max_abs();
@@ -162,7 +167,8 @@ pub fn attach(
             intersect: block_intersect::<Round>,
             occluded: block_occluded::<Round>,
         },
-        Implicit::Bars(_) => UserFunctions {
+        // (Refused above.)
+        Implicit::Bars(_) | Implicit::Mesh(_) => UserFunctions {
             bounds: block_bounds,
             intersect: block_intersect::<Aabb>,
             occluded: block_occluded::<Aabb>,

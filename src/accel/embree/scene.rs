@@ -6,7 +6,9 @@
 use super::exact::{self, Round, Shape, Shapes};
 use super::instanced_blocks::{self, BlockScene};
 use super::rtc::{CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
-use crate::geometry::{Aabb, Blocks, Geometry as SceneGeometry, Primitive};
+use crate::geometry::{
+    Aabb, Blocks, Geometry as SceneGeometry, Implicit, ImplicitRun, IndexedMesh, Primitive,
+};
 use embree_sys::*;
 use glam::DVec3;
 use std::sync::Arc;
@@ -165,6 +167,24 @@ impl EmbreeScene {
             }
             attach(&mut builder, &mut maps, g, tri_map, false)?;
         }
+        // Meshes held as themselves: Embree's triangle geometry over their shared vertices
+        // (rebased, in f32), hits refined in f64 on the triangle as the listed ones are.
+        for run in &geo.implicit {
+            if let Implicit::Mesh(mesh) = &run.shape {
+                let g = mesh_geometry(&device, mesh, center)?;
+                let id = builder.attach(g)? as usize;
+                if maps.len() <= id {
+                    maps.resize_with(id + 1, || PrimMap {
+                        prims: Prims::Listed(Vec::new()),
+                        exact: false,
+                    });
+                }
+                maps[id] = PrimMap {
+                    prims: Prims::From(run.first),
+                    exact: false,
+                };
+            }
+        }
         if let Some(shapes) = &rounds {
             let g = user_geometry(&device, shapes)?;
             attach(&mut builder, &mut maps, g, round_map, true)?;
@@ -175,9 +195,14 @@ impl EmbreeScene {
         }
         // Each object held as itself: a slot for its hits' geomID after the geometries above,
         // and its instances' geomIDs after every slot.
-        let mut first_instance = (maps.len() + geo.implicit.len()) as u32;
-        let mut blocks = Vec::with_capacity(geo.implicit.len());
-        for run in &geo.implicit {
+        let instanced: Vec<&ImplicitRun> = geo
+            .implicit
+            .iter()
+            .filter(|r| !matches!(r.shape, Implicit::Mesh(_)))
+            .collect();
+        let mut first_instance = (maps.len() + instanced.len()) as u32;
+        let mut blocks = Vec::with_capacity(instanced.len());
+        for run in instanced.iter().copied() {
             let slot = maps.len() as u32;
             maps.push(PrimMap {
                 prims: Prims::From(run.first),
@@ -199,7 +224,7 @@ impl EmbreeScene {
             maps,
             exact_runs,
             center,
-            coherent_occlusion: geo.implicit.is_empty(),
+            coherent_occlusion: blocks.is_empty(),
             _rounds: rounds,
             _cuboids: cuboids,
             _blocks: blocks,
@@ -229,6 +254,25 @@ fn user_geometry<S: Shape>(device: &Arc<Device>, shapes: &Shapes<S>) -> crate::R
 }
 
 /// Attach `g`, whose primitives are the scene's `prims`, recording them by geomID.
+/// A mesh's triangles as Embree's triangle geometry: its vertices once (less `center`, in f32)
+/// and its index buffer.
+fn mesh_geometry(
+    device: &Arc<Device>,
+    mesh: &IndexedMesh,
+    center: DVec3,
+) -> crate::Result<Geometry> {
+    let mut g = Geometry::new(device, RTC_GEOMETRY_TYPE_TRIANGLE)?;
+    let p = mesh.positions();
+    let verts = g.new_buffer::<[f32; 3]>(RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, p.len())?;
+    for (slot, &x) in verts.iter_mut().zip(p) {
+        *slot = f3(x - center);
+    }
+    let t = mesh.triangles();
+    let idx = g.new_buffer::<[u32; 3]>(RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, t.len())?;
+    idx.copy_from_slice(t);
+    Ok(g)
+}
+
 fn attach(
     builder: &mut SceneBuilder,
     maps: &mut Vec<PrimMap>,
