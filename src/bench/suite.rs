@@ -216,6 +216,24 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
                 .beside("the same planet against a black background", planet(&size)?),
         )
     }));
+    // What a star field costs (placing 40,000 stars in their pixels, once a frame, and a look
+    // up per ray that meets nothing), against the same planet against a black background.
+    out.push(LazyCase::new("planet 0.9c, star field", move || {
+        let size = vec![
+            format!("image.width={px}"),
+            format!("image.height={px}"),
+            "image.samples=1".into(),
+        ];
+        let mut stars = size.clone();
+        stars.push("sky.stars={count=40000, seed=1}".into());
+        Ok(Case::new(
+            "planet 0.9c, star field",
+            planet(&stars)?,
+            &["embree", "bvh"],
+        )
+        .without_hi_reference()
+        .beside("the same planet against a black background", planet(&size)?))
+    }));
     // Light as a camera records it (Doppler shift and searchlight on every leg of a path)
     // against the RGB render of the same scene, measured side by side.
     out.push(LazyCase::new("lattice beta=0.9, spectral", move || {
