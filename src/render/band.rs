@@ -21,6 +21,9 @@ pub(crate) trait Band: Copy + Mul<f64, Output = Self> {
     fn at(shift: f64) -> Self::At;
     /// The colour `c` in that frame.
     fn of(c: &Colour, at: Self::At) -> Self;
+    /// A spectrum read in a frame whose wavelengths are `shift` times the camera's (in RGB:
+    /// `rest_rgb`, its RGB at rest).
+    fn of_spectrum(s: &crate::spectrum::Spectrum, rest_rgb: DVec3, shift: f64) -> Self;
     /// What the camera records of it (linear sRGB).
     fn to_rgb(&self) -> DVec3;
     /// `self *= o`, wavelength by wavelength.
@@ -46,6 +49,9 @@ impl Band for DVec3 {
     fn at(_shift: f64) {}
     fn of(c: &Colour, _: ()) -> Self {
         c.rgb
+    }
+    fn of_spectrum(_: &crate::spectrum::Spectrum, rest_rgb: DVec3, _: f64) -> Self {
+        rest_rgb
     }
     fn to_rgb(&self) -> DVec3 {
         *self
@@ -82,6 +88,9 @@ impl Band for Sampled {
     }
     fn of(c: &Colour, at: Shift) -> Self {
         c.sampled(at)
+    }
+    fn of_spectrum(s: &crate::spectrum::Spectrum, _: DVec3, shift: f64) -> Self {
+        Sampled::of(s, shift)
     }
     fn to_rgb(&self) -> DVec3 {
         camera::rgb(self)

@@ -220,6 +220,7 @@ struct Rows<'a> {
     cam: CameraRays,
     cull: Option<ScreenCull>,
     stars: Option<star_pixels::StarPixels>,
+    cones: Option<star_pixels::StarCones>,
     spectral: bool,
     progress: Option<&'a Progress>,
 }
@@ -244,6 +245,17 @@ impl<'a> Rows<'a> {
             .sky
             .as_ref()
             .and_then(|sky| star_pixels::StarPixels::new(sky, &cam, seen, spectral));
+        // Rays leaving after a bounce see stars too, where anything reflects or transmits.
+        let bounces = scene.render.max_depth > 0
+            && scene
+                .materials
+                .iter()
+                .any(|m| m.reflect > 0.0 || m.transmit > 0.0);
+        let cones = scene
+            .sky
+            .as_ref()
+            .filter(|_| bounces)
+            .and_then(star_pixels::StarCones::new);
         Self {
             scene,
             world,
@@ -251,6 +263,7 @@ impl<'a> Rows<'a> {
             cam,
             cull,
             stars,
+            cones,
             spectral,
             progress,
         }
@@ -298,6 +311,7 @@ impl<'a> Rows<'a> {
                         cam,
                         cull,
                         stars: self.stars.as_ref(),
+                        cones: self.cones.as_ref(),
                     };
                     let tile = if self.spectral {
                         let seen = Seen::of(scene);

@@ -10,6 +10,7 @@
 
 use super::band::{Band, Seen};
 use super::ray_budget::{Branch, Budget};
+use super::star_pixels::StarCones;
 use super::world::{SurfaceHit, World};
 use crate::scene::{Light, Scene};
 use crate::spacetime::{Boost, Event, NullRay};
@@ -33,6 +34,9 @@ pub struct Shader<'a, B> {
     world: &'a World,
     lights: Vec<LightRt<'a>>,
     sky: Option<SkyRt<'a>>,
+    /// The stars by direction, for rays that leave after a bounce (None: no stars, or no
+    /// material that reflects or transmits).
+    cones: Option<&'a StarCones>,
     seen: Seen,
     band: PhantomData<B>,
 }
@@ -87,23 +91,77 @@ impl<'a, B: Band> Shader<'a, B> {
             world,
             lights,
             sky,
+            cones: None,
             seen,
             band: PhantomData,
         }
     }
 
+    /// This shader, finding stars for the rays that leave after a bounce in `cones`.
+    pub fn with_star_cones(mut self, cones: Option<&'a StarCones>) -> Self {
+        self.cones = cones;
+        self
+    }
+
+    /// Whether rays leaving after a bounce look for stars (so primary hits should say what
+    /// bundle their ray stands for).
+    pub fn finds_star_cones(&self) -> bool {
+        self.cones.is_some()
+    }
+
     /// The light arriving along a world-frame null ray at a receiver whose lookback factor
     /// for the ray's direction is `receiver_s` and whose wavelengths are `shift` times the
-    /// camera's, in the receiver's frame; and the secondary rays spent below its hit.
-    pub fn trace(&self, ray: &NullRay, receiver_s: f64, shift: f64, budget: Budget) -> (B, u64) {
+    /// camera's, in the receiver's frame; and the secondary rays spent below its hit. `spread`:
+    /// the bundle the ray stands for (stars are found in it where it leaves the scene).
+    pub fn trace(
+        &self,
+        ray: &NullRay,
+        receiver_s: f64,
+        shift: f64,
+        budget: Budget,
+        spread: Spread,
+    ) -> (B, u64) {
         match self.world.closest_hit(ray, 0.0) {
             Some(h) => {
-                let (shift, k) = self.arriving(receiver_s, h.s, shift);
-                let (light, spent) = self.shade(ray, &h, shift, budget);
+                let (shift_h, k) = self.arriving(receiver_s, h.s, shift);
+                let sr = spread.into_frame(h.s);
+                let (light, spent) = self.shade(ray, &h, shift_h, budget, sr);
                 (light * k, spent)
             }
-            None => (self.background_along(ray.dir, receiver_s, shift), 0),
+            None => {
+                let mut light = self.background_along(ray.dir, receiver_s, shift);
+                if let Some(stars) = self.stars_along(ray.dir, receiver_s, shift, spread) {
+                    light.add(&stars);
+                }
+                (light, 0)
+            }
         }
+    }
+
+    /// The stars a ray leaving the scene after a bounce sees, as radiance in its receiver's
+    /// frame: those in the cone of the ray's bundle about it (in the sky's frame), each as its
+    /// irradiance, carried into the receiver's frame as a point source's (docs/physics.md
+    /// §5.5), over the bundle's solid angle there. None where there are none to find.
+    fn stars_along(&self, dir: DVec3, receiver_s: f64, shift: f64, spread: Spread) -> Option<B> {
+        let (cones, sky) = (self.cones?, self.sky.as_ref()?);
+        if spread.sr.is_nan() || spread.sr <= 0.0 {
+            return None;
+        }
+        let (dir_sky, s_sky) = match &sky.to_sky {
+            Some(b) => b.view_dir(dir),
+            None => (dir, 1.0),
+        };
+        let (star_shift, k) = self.seen.irradiance(receiver_s / s_sky, shift);
+        let mut sum: Option<B> = None;
+        cones.in_cone(dir_sky, spread.into_frame(s_sky), |kelvin, e| {
+            let (spectrum, rgb) = super::star_pixels::star_spectrum(kelvin, e);
+            let v = B::of_spectrum(&spectrum, rgb, star_shift);
+            match &mut sum {
+                Some(s) => s.add(&v),
+                None => sum = Some(v),
+            }
+        });
+        sum.map(|s| s * (k / spread.sr))
     }
 
     /// The background (at rest in the world frame, lookback factor 1) as a receiver with
@@ -167,10 +225,20 @@ impl<'a, B: Band> Shader<'a, B> {
     /// The light leaving a hit toward the ray's origin, in the surface's frame at wavelengths
     /// `shift` times the camera's: its light from each light not in shadow, and what it
     /// reflects and transmits.
-    pub fn shade(&self, ray: &NullRay, hit: &SurfaceHit, shift: f64, budget: Budget) -> (B, u64) {
+    /// `spread`: the solid angle, in the surface's frame, of the bundle the ray stands for.
+    pub fn shade(
+        &self,
+        ray: &NullRay,
+        hit: &SurfaceHit,
+        shift: f64,
+        budget: Budget,
+        spread: f64,
+    ) -> (B, u64) {
         // On the stack for a few lights: a secondary hit allocates nothing.
         let mut shadows = smallvec::SmallVec::<[Option<ShadowQuery>; 4]>::new();
-        let lit = self.prepare(ray, hit, shift, &mut shadows);
+        let lit = self
+            .prepare(ray, hit, shift, &mut shadows)
+            .with_spread(spread);
         self.finish(
             &lit,
             &shadows,
@@ -246,6 +314,7 @@ impl<'a, B: Band> Shader<'a, B> {
             nf,
             inside,
             shift,
+            spread: 0.0,
         };
         if mat.emission.is_some() {
             shadows.extend(self.lights.iter().map(|_| None));
@@ -360,7 +429,15 @@ impl<'a, B: Band> Shader<'a, B> {
                 };
                 let r = self.spawn(lit.group, event, side, dir);
                 let s = self.lookback_factor(lit.group, r.dir);
-                let (light, spent) = self.trace(&r, s, lit.shift, b);
+                // The bundle keeps its solid angle in the surface's frame (a flat surface).
+                let spread = match self.cones {
+                    Some(_) if lit.spread > 0.0 => Spread {
+                        sr: lit.spread,
+                        s: self.world.groups[lit.group].boost.null_dir(r.dir).1,
+                    },
+                    _ => Spread::NONE,
+                };
+                let (light, spent) = self.trace(&r, s, lit.shift, b, spread);
                 *seen = Some(light);
                 1 + spent
             },
@@ -439,6 +516,38 @@ pub struct Lit<'a> {
     inside: bool,
     /// The surface frame's wavelengths over the camera's.
     shift: f64,
+    /// The solid angle, in the surface's frame, of the bundle the ray that hit stands for (0:
+    /// none is followed).
+    spread: f64,
+}
+
+impl Lit<'_> {
+    /// The hit, its ray standing for a bundle of solid angle `sr` in the surface's frame.
+    pub fn with_spread(mut self, sr: f64) -> Self {
+        self.spread = sr;
+        self
+    }
+}
+
+/// The bundle of rays a ray stands for (a pixel's, carried along): its solid angle in its
+/// receiver's frame, and the receiver's lookback factor for its direction (whatever the
+/// switches say: solid angles follow the geometry).
+#[derive(Clone, Copy, Debug)]
+pub struct Spread {
+    pub sr: f64,
+    pub s: f64,
+}
+
+impl Spread {
+    /// No bundle followed.
+    pub const NONE: Spread = Spread { sr: 0.0, s: 1.0 };
+
+    /// Its solid angle in a frame whose lookback factor for its direction is `s_to`: solid
+    /// angles scale as the inverse square of frequency, Ω_to = Ω (ν_from / ν_to)²
+    /// (docs/physics.md §5.5).
+    pub fn into_frame(self, s_to: f64) -> f64 {
+        self.sr * (self.s / s_to).powi(2)
+    }
 }
 
 #[cfg(test)]

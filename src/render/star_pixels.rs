@@ -7,6 +7,9 @@
 //! irradiance scaled as a point source's (D³ in all, with the Doppler shift and the searchlight
 //! on). A pixel sample that meets nothing adds the light of its pixel's stars; samples that
 //! meet an object hide them, so a star half behind an edge is half seen.
+//!
+//! Rays that leave after a bounce have no pixel of their own: they find the stars in the cone
+//! of their bundle's solid angle ([`StarCones`]).
 
 use super::band::Seen;
 use super::camera::CameraRays;
@@ -76,4 +79,113 @@ pub fn star_rgb(kelvin: f64, irradiance: f64, shift: f64, spectral: bool) -> DVe
 /// The luminance (CIE Y) of linear sRGB.
 pub fn luminance(rgb: DVec3) -> f64 {
     rgb.dot(DVec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// The stars by where they are on the sky (in the sky's frame), for the rays that leave the
+/// scene after a reflection or refraction: a ray stands for a bundle of a pixel's solid angle,
+/// carried from frame to frame, and sees the stars in the cone of that solid angle about it,
+/// each as its irradiance over the cone. Exact for a flat mirror (a star lands in one pixel's
+/// cone or, where cones of neighbouring pixels overlap or leave gaps, in as many as its share
+/// of the sky makes on average); for a curved one, whose true cones are wider or narrower, right
+/// on average (a star is found in proportionally fewer or more pixels).
+pub struct StarCones {
+    /// The stars' directions (sky frame, turned by the sky's `rotate`), temperatures and
+    /// irradiances, by cell.
+    stars: Vec<(DVec3, f64, f64)>,
+    /// Where each cell's stars start in `stars` (cells: `bands` in z, `sectors` in longitude).
+    starts: Vec<u32>,
+    bands: usize,
+    sectors: usize,
+}
+
+impl StarCones {
+    pub fn new(sky: &Sky) -> Option<StarCones> {
+        let field = sky.stars.as_ref()?;
+        let n = field.stars.len().max(1);
+        // About four stars a cell; cells of equal area (uniform in z).
+        let bands = ((n as f64 / 4.0 / 2.0).sqrt().ceil() as usize).clamp(1, 2048);
+        let sectors = 2 * bands;
+        let cell = |d: DVec3| {
+            let b = (((d.z + 1.0) * 0.5 * bands as f64) as usize).min(bands - 1);
+            let phi = d.y.atan2(d.x) + std::f64::consts::PI;
+            let s = ((phi / std::f64::consts::TAU * sectors as f64) as usize).min(sectors - 1);
+            b * sectors + s
+        };
+        let mut placed: Vec<(usize, (DVec3, f64, f64))> = field
+            .stars
+            .iter()
+            .map(|s| {
+                let d = (sky.rotation * s.dir).normalize();
+                (cell(d), (d, s.kelvin, s.irradiance))
+            })
+            .collect();
+        placed.sort_by_key(|p| p.0);
+        let mut starts = vec![0u32; bands * sectors + 1];
+        for (c, _) in &placed {
+            starts[c + 1] += 1;
+        }
+        for i in 0..bands * sectors {
+            starts[i + 1] += starts[i];
+        }
+        Some(StarCones {
+            stars: placed.into_iter().map(|p| p.1).collect(),
+            starts,
+            bands,
+            sectors,
+        })
+    }
+
+    /// Every star within the cone of solid angle `omega` about sky-frame direction `d` (unit):
+    /// `visit(kelvin, irradiance)`.
+    pub fn in_cone(&self, d: DVec3, omega: f64, mut visit: impl FnMut(f64, f64)) {
+        if omega.is_nan() || omega <= 0.0 {
+            return;
+        }
+        // The cone's half-angle: Ω = 2π (1 − cos θ).
+        let cos_t = (1.0 - omega / std::f64::consts::TAU).clamp(-1.0, 1.0);
+        let theta = cos_t.acos();
+        let polar = d.z.clamp(-1.0, 1.0).acos();
+        let z_lo = (polar + theta).min(std::f64::consts::PI).cos();
+        let z_hi = (polar - theta).max(0.0).cos();
+        let band = |z: f64| (((z + 1.0) * 0.5 * self.bands as f64) as usize).min(self.bands - 1);
+        // The longitudes it spans, unless it holds a pole.
+        let sin_p = polar.sin();
+        let all =
+            polar - theta <= 0.0 || polar + theta >= std::f64::consts::PI || theta.sin() >= sin_p;
+        let phi = d.y.atan2(d.x) + std::f64::consts::PI;
+        let half = if all {
+            std::f64::consts::PI
+        } else {
+            (theta.sin() / sin_p).asin()
+        };
+        let per = std::f64::consts::TAU / self.sectors as f64;
+        let (s_lo, s_hi) = if all {
+            (0, self.sectors as i64 - 1)
+        } else {
+            (
+                ((phi - half) / per).floor() as i64,
+                ((phi + half) / per).floor() as i64,
+            )
+        };
+        for b in band(z_lo)..=band(z_hi) {
+            for s in s_lo..=s_hi.min(s_lo + self.sectors as i64 - 1) {
+                let c = b * self.sectors + s.rem_euclid(self.sectors as i64) as usize;
+                let (a, e) = (self.starts[c] as usize, self.starts[c + 1] as usize);
+                for &(dir, kelvin, e_star) in &self.stars[a..e] {
+                    if dir.dot(d) >= cos_t {
+                        visit(kelvin, e_star);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The spectrum of a star at `kelvin` whose light at rest has luminance `irradiance`, and its
+/// RGB at rest.
+pub fn star_spectrum(kelvin: f64, irradiance: f64) -> (Spectrum, DVec3) {
+    let unit = Spectrum::Blackbody { kelvin, scale: 1.0 };
+    let rest = camera::rgb(&Sampled::of(&unit, 1.0));
+    let scale = irradiance / luminance(rest);
+    (Spectrum::Blackbody { kelvin, scale }, rest * scale)
 }

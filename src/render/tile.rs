@@ -7,7 +7,7 @@ use super::frame::{Mattes, PixelValue, MATTE_RANKS};
 use super::sampler::sample_offset;
 use super::screen_cull::ScreenCull;
 use super::shade::Shader;
-use super::star_pixels::StarPixels;
+use super::star_pixels::{StarCones, StarPixels};
 use super::world::{PrimaryHits, SurfaceHit, World};
 use super::{Passes, TILE};
 use crate::scene::Scene;
@@ -192,10 +192,6 @@ pub fn trace_tile(
     (n as u64 * t.total as u64, found)
 }
 
-/// The stars seen in a tile: the frame's, the tile's live pixels (as its primary rays are
-/// ordered) and the tile's offset in the full image.
-type TileStars<'a> = (&'a StarPixels, &'a [(u32, u32)], (u32, u32));
-
 /// The colours (linear sRGB) of primary hits (background where none), with the shadow rays of
 /// all of them traced together, light by light, so they go to the backends in packets.
 fn shade_hits<B: Band>(
@@ -203,8 +199,11 @@ fn shade_hits<B: Band>(
     world: &World,
     cam: &CameraRays,
     primary: &PrimaryHits,
-    stars: Option<TileStars>,
+    (coords, (ox, oy)): (&[(u32, u32)], (u32, u32)),
+    stars: Option<&StarPixels>,
 ) -> Vec<DVec3> {
+    // Stars seen after a bounce are found in the bundle of the pixel's solid angle.
+    let spreads = shader.finds_star_cones();
     // One entry per light and hit (None where there is no shadow ray), hit-major.
     let lights = shader.light_count();
     let budget = shader.primary_budget();
@@ -224,7 +223,15 @@ fn shade_hits<B: Band>(
             match primary.hit(i) {
                 Some(h) => {
                     let (shift, k) = shader.arriving(camera_s, h.s, 1.0);
-                    Ok((shader.prepare(&ray, &h, shift, &mut shadows), k))
+                    let lit = shader.prepare(&ray, &h, shift, &mut shadows);
+                    let lit = if spreads {
+                        let (x, y) = coords[i];
+                        let omega = cam.pixel_solid_angle(x + ox, y + oy);
+                        lit.with_spread(omega * (cam.lookback_factor(ray.dir) / h.s).powi(2))
+                    } else {
+                        lit
+                    };
+                    Ok((lit, k))
                 }
                 None => {
                     shadows.extend((0..lights).map(|_| None));
@@ -273,7 +280,7 @@ fn shade_hits<B: Band>(
                 let sky = shader.background_along(*dir, *camera_s, 1.0).to_rgb();
                 // The stars of the pixel this ray belongs to (`image_points`).
                 match stars {
-                    Some((st, coords, (ox, oy))) => {
+                    Some(st) => {
                         let (x, y) = coords[k];
                         sky + st.at(x + ox, y + oy)
                     }
@@ -290,6 +297,7 @@ pub struct View<'a> {
     pub cam: &'a CameraRays,
     pub cull: Option<&'a ScreenCull>,
     pub stars: Option<&'a StarPixels>,
+    pub cones: Option<&'a StarCones>,
 }
 
 pub struct TilePixel {
@@ -324,7 +332,7 @@ pub fn render_tile<B: Band>(
     let (w, h) = scene.image.frame_size();
     let coords = tile_pixels(x0, y0, w, h);
     let n = scene.image.samples;
-    let shader = Shader::<B>::new(scene, world, seen);
+    let shader = Shader::<B>::new(scene, world, seen).with_star_cones(view.cones);
     // Pixels left out by the cull see the background in every sample (nothing, in a
     // transparent image): the same everywhere
     // unless the camera moves through a background that is not black (then each pixel's, as
@@ -383,8 +391,14 @@ pub fn render_tile<B: Band>(
         let colors = if centre {
             Vec::new()
         } else {
-            let stars = view.stars.map(|st| (st, &live_coords[..], offset));
-            shade_hits(&shader, world, cam, primary, stars)
+            shade_hits(
+                &shader,
+                world,
+                cam,
+                primary,
+                (live_coords, offset),
+                view.stars,
+            )
         };
         for (j, &k) in live.iter().enumerate() {
             if !centre {
