@@ -32,12 +32,13 @@ test: setup
 	$(CARGO) test --release --no-default-features
 	$(CARGO) test --release --workspace
 	@# The backend's conformance suite (grazing packets against single rays, analytic hits)
-	@# again under each of Embree's code paths this CPU has: their packet widths and slab tests
-	@# differ (src/tests/every_isa.rs renders under each in-process).
+	@# and the meshes' (held meshes are Embree triangle geometries) again under each of
+	@# Embree's code paths this CPU has: their packet widths and slab tests differ
+	@# (src/tests/every_isa.rs renders under each in-process).
 	@for isa in sse2 sse4.2 avx avx2 avx512; do \
 	  if REST_EMBREE_ISA=$$isa ./target/release/rest-embree backends >/dev/null 2>&1; then \
 	    echo "conformance under REST_EMBREE_ISA=$$isa"; \
-	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test backend_conformance -q || exit 1; \
+	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test backend_conformance --test meshes -q || exit 1; \
 	  fi; \
 	done
 	scripts/slurm-test.sh target/release/rest-embree

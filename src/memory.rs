@@ -50,6 +50,20 @@ pub const STRIP_PIXELS: u64 = 1 << 18;
 /// figure stays an upper bound.
 pub const BYTES_PER_PIXEL_EXR: u64 = 380;
 
+/// What a triangle of a mesh held as itself costs rendered, its corner data aside: its share of
+/// the shared vertices and of its indices, and of Embree's triangle geometry and tree (the
+/// bench's 10-million-triangle PLY peaks at 135 bytes a triangle, reading included).
+pub const BYTES_PER_HELD_TRIANGLE: u64 = 160;
+
+/// A mesh triangle's corner normals: three, in f64.
+pub const BYTES_PER_CORNER_NORMALS: u64 = 72;
+/// A mesh triangle's corner texture coordinates: three pairs, in f64.
+pub const BYTES_PER_CORNER_UVS: u64 = 48;
+
+/// What a star of `[sky] stars` costs: itself (40 bytes), its entry in the grid that rays after
+/// a bounce search (40), and in a frame its place in a pixel (about 80).
+pub const BYTES_PER_STAR: u64 = 160;
+
 /// The memory an object held as itself (a lattice, a bar array) costs rendered: its
 /// primitives', listed, or when it is instanced (more than
 /// [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) of them) one block's and a placement per
@@ -59,7 +73,7 @@ pub fn implicit_bytes(shape: &crate::geometry::Implicit) -> u64 {
         return shape.len().saturating_mul(BYTES_PER_PRIMITIVE);
     }
     if let crate::geometry::Implicit::Mesh(m) = shape {
-        return m.bytes();
+        return m.len().saturating_mul(BYTES_PER_HELD_TRIANGLE);
     }
     let blocks = crate::geometry::Blocks::of(shape.grid());
     shape.member_count(&blocks) * BYTES_PER_PRIMITIVE + blocks.count() * BYTES_PER_BLOCK

@@ -478,10 +478,22 @@ fn obj_materials_map_to_the_scenes_by_name() {
 /// A mesh file's triangles are held as the file has them (shared vertices, three indices a
 /// triangle; Embree's triangle geometry over them) when the mesh is big, and listed one by one
 /// when it is small: both give the same picture, to the bit, on both backends, with normals,
-/// texture coordinates, materials and a transform, at rest and at 0.9c.
+/// texture coordinates, materials and a transform, at rest and at 0.9c; in a group that also
+/// holds a sphere, a box and a lattice (instanced where the mesh is held), so the held mesh
+/// shares its Embree scene with user geometries and instances.
 #[test]
 fn a_mesh_held_as_itself_renders_as_listed() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let d = Dir::new("mesh-held");
+    let text = std::fs::read_to_string(root.join("rocket.toml"))
+        .unwrap()
+        .replace("\"rocket.obj\"", &format!("{:?}", root.join("rocket.obj")))
+        .replace("\"rocket-paint.png\"", &format!("{:?}", root.join("rocket-paint.png")))
+        + "\n[[group.object]]\ntype = \"sphere\"\ncenter = [-2.5, 0, 1]\nradius = 0.6\n\
+           \n[[group.object]]\ntype = \"box\"\nmin = [-1.5, 0, -1.6]\nmax = [-0.5, 1, -1]\nmaterial = \"fins\"\n\
+           \n[[group.object]]\ntype = \"lattice\"\ncounts = [4, 3, 3]\nspacing = 0.6\norigin = [-3, 0.5, -1.8]\n\
+           rod_radius = 0.04\nsphere_radius = 0.1\n";
+    let path = d.file("rocket.toml", &text);
     for velocity in ["[0, 0, 0]", "[0.9, 0, 0]"] {
         let sets: Vec<(String, String)> = [
             "image.width=96".to_string(),
@@ -492,16 +504,22 @@ fn a_mesh_held_as_itself_renders_as_listed() {
         .into_iter()
         .map(|s| (format!("--set {s}"), s))
         .collect();
-        let scene = rest_embree::scene::load_file(&root.join("scenes/rocket.toml"), &sets).unwrap();
+        let scene = rest_embree::scene::load_file(&path, &sets).unwrap();
         for b in backends() {
             // Listed (the default for a mesh of a few thousand triangles) and held.
             let listed = render_held(&scene, b, u64::MAX);
             let held = render_held(&scene, b, 0);
-            let seen = listed.pixels.iter().filter(|p| p.object_id > 0).count();
-            assert!(
-                seen > 100,
-                "{b} at {velocity}: {seen} pixels see the rocket"
-            );
+            for object in 1..=4 {
+                let seen = listed
+                    .pixels
+                    .iter()
+                    .filter(|p| p.object_id == object)
+                    .count();
+                assert!(
+                    seen > 20,
+                    "{b} at {velocity}: {seen} pixels see object {object}"
+                );
+            }
             for (i, (l, h)) in listed.pixels.iter().zip(&held.pixels).enumerate() {
                 assert_eq!(
                     (l.color, l.object_id, l.material_id),

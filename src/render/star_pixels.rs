@@ -189,3 +189,53 @@ pub fn star_spectrum(kelvin: f64, irradiance: f64) -> (Spectrum, DVec3) {
     let scale = irradiance / luminance(rest);
     (Spectrum::Blackbody { kelvin, scale }, rest * scale)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::stars::StarField;
+
+    /// The cells find exactly the stars a search of every star finds: cones about the poles,
+    /// across the seam of longitude (-x), from a thousandth of a pixel's to a hemisphere's.
+    #[test]
+    fn a_cone_finds_the_stars_a_full_search_finds() {
+        let sky = Sky {
+            map: None,
+            rotation: glam::DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7),
+            intensity: 1.0,
+            stars: Some(StarField::new(5000, 3, [0.0, 6.0], 1.0, [3000.0, 30000.0])),
+            velocity: crate::spacetime::Velocity::ZERO,
+        };
+        let cones = StarCones::new(&sky).unwrap();
+        let all: Vec<(DVec3, f64)> = sky
+            .stars
+            .as_ref()
+            .unwrap()
+            .stars
+            .iter()
+            .map(|s| ((sky.rotation * s.dir).normalize(), s.kelvin))
+            .collect();
+        let mut rng = crate::rng::Rng(9);
+        let mut dirs = vec![DVec3::Z, -DVec3::Z, -DVec3::X, DVec3::new(-1.0, 1e-9, 0.3)];
+        dirs.extend((0..200).map(|_| rng.unit()));
+        let mut found_any = 0;
+        for d in dirs {
+            let d = d.normalize();
+            for omega in [1e-9, 1e-5, 1e-3, 0.05, 0.5, 3.0, 6.0] {
+                let cos_t = 1.0 - omega / std::f64::consts::TAU;
+                let mut want: Vec<u64> = all
+                    .iter()
+                    .filter(|(s, _)| s.dot(d) >= cos_t)
+                    .map(|(_, k)| k.to_bits())
+                    .collect();
+                let mut got = Vec::new();
+                cones.in_cone(d, omega, |k, _| got.push(k.to_bits()));
+                want.sort_unstable();
+                got.sort_unstable();
+                assert_eq!(got, want, "about {d} with {omega} sr");
+                found_any += got.len();
+            }
+        }
+        assert!(found_any > 10_000, "{found_any}");
+    }
+}

@@ -108,8 +108,9 @@ fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
     for line in bytes.split(|&b| b == b'\n') {
         let line = String::from_utf8_lossy(line);
         match line.trim().split_once(char::is_whitespace) {
-            Some(("usemtl", rest)) => {
-                let name = rest.trim().to_string();
+            // The name as tobj reads it: after the line's first space, trimmed.
+            Some(("usemtl", _)) => {
+                let name = line.split_once(' ').map_or("", |x| x.1).trim().to_string();
                 if !name.is_empty() && !names.contains(&name) {
                     names.push(name);
                 }

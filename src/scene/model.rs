@@ -327,21 +327,30 @@ impl Scene {
     }
 
     /// The memory the groups' primitives cost rendered (`memory`): listed ones one by one,
-    /// instanced lattices and bar arrays by their blocks.
+    /// instanced lattices and bar arrays by their blocks, held meshes by their triangles; and
+    /// the sky's stars.
     pub fn primitive_bytes(&self) -> u64 {
-        self.groups
+        let stars = self
+            .sky
             .iter()
-            .map(|g| {
-                let held = g.geometry.prims.len() as u64 * crate::memory::BYTES_PER_PRIMITIVE;
-                let implicit: u64 = g
-                    .geometry
-                    .implicit
-                    .iter()
-                    .map(|r| crate::memory::implicit_bytes(&r.shape))
-                    .sum();
-                held.saturating_add(implicit)
-            })
-            .fold(0, u64::saturating_add)
+            .flat_map(|s| &s.stars)
+            .map(|f| f.count.saturating_mul(crate::memory::BYTES_PER_STAR))
+            .sum::<u64>();
+        stars.saturating_add(
+            self.groups
+                .iter()
+                .map(|g| {
+                    let held = g.geometry.prims.len() as u64 * crate::memory::BYTES_PER_PRIMITIVE;
+                    let implicit: u64 = g
+                        .geometry
+                        .implicit
+                        .iter()
+                        .map(|r| crate::memory::implicit_bytes(&r.shape))
+                        .sum();
+                    held.saturating_add(implicit)
+                })
+                .fold(0, u64::saturating_add),
+        )
     }
 
     /// How many primitives all groups hold.

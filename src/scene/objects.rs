@@ -107,6 +107,25 @@ fn implicit_budget(t: &Table, total: &mut u64, shape: &Implicit) -> SceneResult<
     Ok(())
 }
 
+/// A mesh file of at most [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) triangles is listed
+/// triangle by triangle, counting against the scene's limit as any object does; a bigger one is
+/// held as itself (shared vertices), its memory checked as such, corner data included.
+fn mesh_budget(t: &Table, total: &mut u64, mesh: &super::mesh_file::MeshData) -> SceneResult<()> {
+    use crate::memory::{BYTES_PER_CORNER_NORMALS, BYTES_PER_CORNER_UVS, BYTES_PER_HELD_TRIANGLE};
+    let n = mesh.triangles.len() as u64;
+    let corners = u64::from(mesh.normals.is_some()) * BYTES_PER_CORNER_NORMALS
+        + u64::from(mesh.uvs.is_some()) * BYTES_PER_CORNER_UVS;
+    if n <= crate::render::INSTANCE_OVER {
+        return budget(t, "file", total, n);
+    }
+    let need = n.saturating_mul(BYTES_PER_HELD_TRIANGLE + corners);
+    let what = format!("a mesh of {n} triangles");
+    if let Some(why) = crate::memory::too_much(need, &what) {
+        return Err(at_value(t, "file", why));
+    }
+    Ok(())
+}
+
 /// An error about the value of `key` (on its line), or the table's where it has none.
 fn at_value(t: &Table, key: &str, why: impl Into<String>) -> super::SceneError {
     match t.get(key) {
@@ -312,7 +331,7 @@ pub(super) fn add_object(
                 ));
             }
             let mesh = read_mesh_file(t)?;
-            budget(t, "file", total, mesh.triangles.len() as u64)?;
+            mesh_budget(t, total, &mesh)?;
             // Normals turn with the mesh and take the inverse of its scale.
             let normal = |n: DVec3| {
                 transform.map_or(n, |x| (x.rotation * (n / x.scale)).normalize_or_zero())

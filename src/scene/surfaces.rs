@@ -168,6 +168,11 @@ fn stars(t: &Table) -> SceneResult<super::stars::StarField> {
         "greater than 0",
     )?;
     t.finish(&["count", "seed", "magnitudes", "irradiance", "temperatures"])?;
+    let what = format!("a star field of {count} stars");
+    let need = count.saturating_mul(crate::memory::BYTES_PER_STAR);
+    if let Some(why) = crate::memory::too_much(need, &what) {
+        return Err(t.error("count", why));
+    }
     Ok(StarField::new(
         count,
         seed,
