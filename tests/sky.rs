@@ -97,40 +97,57 @@ fn a_moving_camera_sees_the_sky_remapped_by_aberration() {
         (t(i, j) * (1.0 - fx) + t(i + 1, j) * fx) * (1.0 - fy)
             + (t(i, j + 1) * (1.0 - fx) + t(i + 1, j + 1) * fx) * fy
     };
-    let f = render_with(&s, "bvh");
-    let mut checked = 0;
-    for y in 4..h - 4 {
-        for x in 0..w {
-            // The pixel's direction in the camera's frame (the camera's convention), then the
-            // world's by aberration about the motion (+x), azimuth kept.
-            let lon = ((f64::from(x) + 0.5) / f64::from(w) - 0.5) * 2.0 * PI;
-            let lat = (0.5 - (f64::from(y) + 0.5) / f64::from(h)) * PI;
-            let dc = DVec3::new(lat.cos() * lon.cos(), -lat.cos() * lon.sin(), lat.sin());
-            let cos_c = dc.x;
-            let cos_w = (cos_c - beta) / (1.0 - beta * cos_c);
-            let side = DVec3::new(0.0, dc.y, dc.z);
-            let sin_w = (1.0 - cos_w * cos_w).max(0.0).sqrt();
-            let dw = DVec3::X * cos_w + side.normalize_or(DVec3::Z) * sin_w;
-            let (lw, bw) = ((-dw.y).atan2(dw.x), dw.z.clamp(-1.0, 1.0).asin());
-            let want = map(lw / (2.0 * PI) + 0.5, 0.5 - bw / PI);
-            let got = f.pixels[(y * w + x) as usize].color;
-            // Where the map is smooth (away from its seam at u = 0 and 1).
-            let u = lw / (2.0 * PI) + 0.5;
-            if !(0.02..0.98).contains(&u) {
-                continue;
+    // Without the searchlight, and with it: each texel then D⁴ brighter (radiance across a
+    // change of frame, docs/physics.md §5.4), D = γ(1 + β cos θ_world) for the camera moving
+    // toward the direction it looks in.
+    let gamma = 1.0 / (1.0f64 - beta * beta).sqrt();
+    for searchlight in [false, true] {
+        let s = if searchlight {
+            let set = [(
+                "--set render.searchlight=true".to_string(),
+                "render.searchlight=true".to_string(),
+            )];
+            rest_embree::scene::load_file(&p, &set).unwrap()
+        } else {
+            s.clone()
+        };
+        let f = render_with(&s, "bvh");
+        let mut checked = 0;
+        for y in 4..h - 4 {
+            for x in 0..w {
+                // The pixel's direction in the camera's frame (the camera's convention), then the
+                // world's by aberration about the motion (+x), azimuth kept.
+                let lon = ((f64::from(x) + 0.5) / f64::from(w) - 0.5) * 2.0 * PI;
+                let lat = (0.5 - (f64::from(y) + 0.5) / f64::from(h)) * PI;
+                let dc = DVec3::new(lat.cos() * lon.cos(), -lat.cos() * lon.sin(), lat.sin());
+                let cos_c = dc.x;
+                let cos_w = (cos_c - beta) / (1.0 - beta * cos_c);
+                let side = DVec3::new(0.0, dc.y, dc.z);
+                let sin_w = (1.0 - cos_w * cos_w).max(0.0).sqrt();
+                let dw = DVec3::X * cos_w + side.normalize_or(DVec3::Z) * sin_w;
+                let (lw, bw) = ((-dw.y).atan2(dw.x), dw.z.clamp(-1.0, 1.0).asin());
+                let doppler = gamma * (1.0 + beta * dw.x);
+                let bright = if searchlight { doppler.powi(4) } else { 1.0 };
+                let want = map(lw / (2.0 * PI) + 0.5, 0.5 - bw / PI) * bright;
+                let got = f.pixels[(y * w + x) as usize].color;
+                // Where the map is smooth (away from its seam at u = 0 and 1).
+                let u = lw / (2.0 * PI) + 0.5;
+                if !(0.02..0.98).contains(&u) {
+                    continue;
+                }
+                for k in 0..3 {
+                    assert!(
+                        (f64::from(got[k]) - want[k]).abs() < 2e-3 * bright.max(1.0),
+                        "searchlight {searchlight}: pixel ({x}, {y}) channel {k}: {} against {}",
+                        got[k],
+                        want[k]
+                    );
+                }
+                checked += 1;
             }
-            for k in 0..3 {
-                assert!(
-                    (f64::from(got[k]) - want[k]).abs() < 2e-3,
-                    "pixel ({x}, {y}) channel {k}: {} against {}",
-                    got[k],
-                    want[k]
-                );
-            }
-            checked += 1;
         }
+        assert!(checked > 6000, "{checked} pixels checked");
     }
-    assert!(checked > 6000, "{checked} pixels checked");
 }
 
 // ---- The star field (docs/physics.md §5.5) ----
