@@ -123,18 +123,8 @@ pub(super) fn sky(t: &Table) -> SceneResult<super::Sky> {
 /// `[sky] stars = { count, seed, magnitudes, irradiance, temperatures }`.
 fn stars(t: &Table) -> SceneResult<super::stars::StarField> {
     use super::stars::{StarField, MAX_STARS};
-    let count = t.f64_where(
-        "count",
-        None,
-        |v| v.fract() == 0.0 && (1.0..=MAX_STARS as f64).contains(&v),
-        &format!("a whole number from 1 to {MAX_STARS}"),
-    )? as u64;
-    let seed = t.f64_where(
-        "seed",
-        Some(1.0),
-        |v| v.fract() == 0.0 && (0.0..=9.007_199_254_740_992e15).contains(&v),
-        "a whole number from 0 to 2^53",
-    )? as u64;
+    let count = t.uint("count", None, 1, MAX_STARS)?;
+    let seed = t.uint("seed", Some(1), 0, 1 << 53)?;
     let pair = |key: &str, default: [f64; 2], ok: &dyn Fn(f64) -> bool, what: &str| {
         let Some(n) = t.get(key) else {
             return Ok(default);
