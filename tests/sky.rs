@@ -225,6 +225,20 @@ fn a_star_field_holds_the_same_light_on_every_image_size() {
         }
     }
     assert!((totals[0] / totals[totals.len() - 1] - 1.0).abs() < 1e-4);
+    // An orthographic camera looks one way only: it sees no point of the sky, and says nothing
+    // is wrong.
+    let text = star_scene(
+        "projection = \"orthographic\"\nview_height = 4",
+        32,
+        32,
+        "",
+        "",
+    );
+    let s = rest_embree::scene::load_file(&d.file("ortho.toml", &text), &[]).unwrap();
+    for b in backends() {
+        let f = render_with(&s, b);
+        assert!(f.pixels.iter().all(|p| p.color == [0.0; 3]), "{b}");
+    }
 }
 
 /// The camera's pixel of a camera-frame direction, for the equirectangular camera looking
