@@ -8,9 +8,9 @@ so the file is the same on every run), ice at the poles, and a graticule every 3
 glance. 512 x 256 texels, 8-bit sRGB RGB. Python's standard library only."""
 
 import math
+
+from pngfile import write_png
 import random
-import struct
-import zlib
 
 W, H = 512, 256
 rng = random.Random(1989)
@@ -47,13 +47,5 @@ for y in range(H):
     rows.append(bytes(row))
 
 
-def chunk(kind, data):
-    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-
-
-png = b"\x89PNG\r\n\x1a\n"
-png += chunk(b"IHDR", struct.pack(">IIBBBBB", W, H, 8, 2, 0, 0, 0))
-png += chunk(b"IDAT", zlib.compress(b"".join(rows), 9))
-png += chunk(b"IEND", b"")
-open("scenes/planet-map.png", "wb").write(png)
+write_png("scenes/planet-map.png", W, H, rows)
 print("wrote scenes/planet-map.png")

@@ -10,8 +10,8 @@ white roll pattern of early test rockets (quadrants alternating along the body),
 of the body (Terrell rotation) reads at a glance. Materials by `usemtl`: `hull`, `fins`."""
 
 import math
-import struct
-import zlib
+
+from pngfile import write_png
 
 SEG = 48  # around
 profile = []  # (x, r) from tail to nose
@@ -101,13 +101,5 @@ for y in range(H):
     rows.append(bytes(row))
 
 
-def chunk(kind, data):
-    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-
-
-png = b"\x89PNG\r\n\x1a\n"
-png += chunk(b"IHDR", struct.pack(">IIBBBBB", W, H, 8, 2, 0, 0, 0))
-png += chunk(b"IDAT", zlib.compress(b"".join(rows), 9))
-png += chunk(b"IEND", b"")
-open("scenes/rocket-paint.png", "wb").write(png)
+write_png("scenes/rocket-paint.png", W, H, rows)
 print("wrote scenes/rocket.obj, scenes/rocket.mtl, scenes/rocket-paint.png")

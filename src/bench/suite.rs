@@ -187,11 +187,7 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
     // What an image texture costs (three colour lookups per hit on the map's basis), against
     // the same planet in one colour; and what a sky map costs, against a black background.
     out.push(LazyCase::new("planet 0.9c, image texture", move || {
-        let size = vec![
-            format!("image.width={px}"),
-            format!("image.height={px}"),
-            "image.samples=1".into(),
-        ];
+        let size = size(px);
         let mut plain = size.clone();
         plain.push("material.surface.color=0.6".into());
         Ok(Case::new(
@@ -203,11 +199,7 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
         .beside("the same planet in one colour", planet(&plain)?))
     }));
     out.push(LazyCase::new("planet 0.9c, sky map", move || {
-        let size = vec![
-            format!("image.width={px}"),
-            format!("image.height={px}"),
-            "image.samples=1".into(),
-        ];
+        let size = size(px);
         let mut sky = size.clone();
         sky.push("sky.map=\"planet-map.png\"".into());
         Ok(
@@ -219,11 +211,7 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
     // What a star field costs (placing 40,000 stars in their pixels, once a frame, and a look
     // up per ray that meets nothing), against the same planet against a black background.
     out.push(LazyCase::new("planet 0.9c, star field", move || {
-        let size = vec![
-            format!("image.width={px}"),
-            format!("image.height={px}"),
-            "image.samples=1".into(),
-        ];
+        let size = size(px);
         let mut stars = size.clone();
         stars.push("sky.stars={count=40000, seed=1}".into());
         Ok(Case::new(

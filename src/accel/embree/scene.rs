@@ -165,33 +165,23 @@ impl EmbreeScene {
             for (k, slot) in idx.iter_mut().enumerate() {
                 *slot = [3 * k as u32, 3 * k as u32 + 1, 3 * k as u32 + 2];
             }
-            attach(&mut builder, &mut maps, g, tri_map, false)?;
+            attach(&mut builder, &mut maps, g, Prims::Listed(tri_map), false)?;
         }
         // Meshes held as themselves: Embree's triangle geometry over their shared vertices
         // (rebased, in f32), hits refined in f64 on the triangle as the listed ones are.
         for run in &geo.implicit {
             if let Implicit::Mesh(mesh) = &run.shape {
                 let g = mesh_geometry(&device, mesh, center)?;
-                let id = builder.attach(g)? as usize;
-                if maps.len() <= id {
-                    maps.resize_with(id + 1, || PrimMap {
-                        prims: Prims::Listed(Vec::new()),
-                        exact: false,
-                    });
-                }
-                maps[id] = PrimMap {
-                    prims: Prims::From(run.first),
-                    exact: false,
-                };
+                attach(&mut builder, &mut maps, g, Prims::From(run.first), false)?;
             }
         }
         if let Some(shapes) = &rounds {
             let g = user_geometry(&device, shapes)?;
-            attach(&mut builder, &mut maps, g, round_map, true)?;
+            attach(&mut builder, &mut maps, g, Prims::Listed(round_map), true)?;
         }
         if let Some(shapes) = &cuboids {
             let g = user_geometry(&device, shapes)?;
-            attach(&mut builder, &mut maps, g, cuboid_map, true)?;
+            attach(&mut builder, &mut maps, g, Prims::Listed(cuboid_map), true)?;
         }
         // Each object held as itself: a slot for its hits' geomID after the geometries above,
         // and its instances' geomIDs after every slot.
@@ -277,7 +267,7 @@ fn attach(
     builder: &mut SceneBuilder,
     maps: &mut Vec<PrimMap>,
     g: Geometry,
-    prims: Vec<u32>,
+    prims: Prims,
     exact: bool,
 ) -> crate::Result<()> {
     let id = builder.attach(g)? as usize;
@@ -287,10 +277,7 @@ fn attach(
             exact: false,
         });
     }
-    maps[id] = PrimMap {
-        prims: Prims::Listed(prims),
-        exact,
-    };
+    maps[id] = PrimMap { prims, exact };
     Ok(())
 }
 
