@@ -1,5 +1,5 @@
 //! The validity envelope: the values rest-embree renders correctly on every backend, enforced
-//! when a scene loads (README, "Valid scenes"; docs/scene-format.md, "Valid scenes").
+//! when a scene loads (docs/scene-format.md, "Valid scenes").
 //!
 //! - Every number is at most [`MAX_MAGNITUDE`] in size, and every group's geometry lies within
 //!   that of the origin. Squares and products of such numbers stay far from f64's range (and
