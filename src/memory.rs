@@ -61,8 +61,9 @@ pub const BYTES_PER_CORNER_NORMALS: u64 = 72;
 pub const BYTES_PER_CORNER_UVS: u64 = 48;
 
 /// What a star of `[sky] stars` costs: itself (40 bytes), its entry in the grid that rays after
-/// a bounce search (40), and in a frame its place in a pixel (about 80).
-pub const BYTES_PER_STAR: u64 = 160;
+/// a bounce search (88: direction, spectrum, RGB), and in a frame its place in a pixel (about
+/// 80).
+pub const BYTES_PER_STAR: u64 = 210;
 
 /// The memory an object held as itself (a lattice, a bar array) costs rendered: its
 /// primitives', listed, or when it is instanced (more than

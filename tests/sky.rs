@@ -440,7 +440,7 @@ fn bad_skies_are_clear_errors() {
     ] {
         fails(name, &format!("{cam}{sky}"), &[], needles);
     }
-    // Ten million stars are 1.6 GB with what finds them: refused within 100 MB, before any
+    // Ten million stars are 2.1 GB with what finds them: refused within 100 MB, before any
     // star is made.
     fails(
         "stars-memory",

@@ -185,43 +185,40 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
         ))
     }));
     // What an image texture costs (three colour lookups per hit on the map's basis), against
-    // the same planet in one colour; and what a sky map costs, against a black background.
-    out.push(LazyCase::new("planet 0.9c, image texture", move || {
-        let size = size(px);
-        let mut plain = size.clone();
-        plain.push("material.surface.color=0.6".into());
-        Ok(Case::new(
+    // the same planet in one colour; what a sky map costs, and a star field (placing 40,000
+    // stars in their pixels, once a frame, and a look up per ray that meets nothing), against
+    // a black background.
+    for (name, set, beside, beside_set) in [
+        (
             "planet 0.9c, image texture",
-            planet(&size)?,
-            &["embree", "bvh"],
-        )
-        .without_hi_reference()
-        .beside("the same planet in one colour", planet(&plain)?))
-    }));
-    out.push(LazyCase::new("planet 0.9c, sky map", move || {
-        let size = size(px);
-        let mut sky = size.clone();
-        sky.push("sky.map=\"planet-map.png\"".into());
-        Ok(
-            Case::new("planet 0.9c, sky map", planet(&sky)?, &["embree", "bvh"])
-                .without_hi_reference()
-                .beside("the same planet against a black background", planet(&size)?),
-        )
-    }));
-    // What a star field costs (placing 40,000 stars in their pixels, once a frame, and a look
-    // up per ray that meets nothing), against the same planet against a black background.
-    out.push(LazyCase::new("planet 0.9c, star field", move || {
-        let size = size(px);
-        let mut stars = size.clone();
-        stars.push("sky.stars={count=40000, seed=1}".into());
-        Ok(Case::new(
+            None,
+            "the same planet in one colour",
+            Some("material.surface.color=0.6"),
+        ),
+        (
+            "planet 0.9c, sky map",
+            Some("sky.map=\"planet-map.png\""),
+            "the same planet against a black background",
+            None,
+        ),
+        (
             "planet 0.9c, star field",
-            planet(&stars)?,
-            &["embree", "bvh"],
-        )
-        .without_hi_reference()
-        .beside("the same planet against a black background", planet(&size)?))
-    }));
+            Some("sky.stars={count=40000, seed=1}"),
+            "the same planet against a black background",
+            None,
+        ),
+    ] {
+        out.push(LazyCase::new(name, move || {
+            let with = |extra: Option<&str>| {
+                let mut s = size(px);
+                s.extend(extra.map(String::from));
+                planet(&s)
+            };
+            Ok(Case::new(name, with(set)?, &["embree", "bvh"])
+                .without_hi_reference()
+                .beside(beside, with(beside_set)?))
+        }));
+    }
     // Light as a camera records it (Doppler shift and searchlight on every leg of a path)
     // against the RGB render of the same scene, measured side by side.
     out.push(LazyCase::new("lattice beta=0.9, spectral", move || {

@@ -153,9 +153,8 @@ impl<'a, B: Band> Shader<'a, B> {
         };
         let (star_shift, k) = self.seen.irradiance(receiver_s / s_sky, shift);
         let mut sum: Option<B> = None;
-        cones.in_cone(dir_sky, spread.into_frame(s_sky), |kelvin, e| {
-            let (spectrum, rgb) = super::star_pixels::star_spectrum(kelvin, e);
-            let v = B::of_spectrum(&spectrum, rgb, star_shift);
+        cones.in_cone(dir_sky, spread.into_frame(s_sky), |spectrum, rgb| {
+            let v = B::of_spectrum(spectrum, rgb, star_shift);
             match &mut sum {
                 Some(s) => s.add(&v),
                 None => sum = Some(v),

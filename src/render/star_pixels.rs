@@ -63,16 +63,13 @@ impl StarPixels {
 
 /// What the camera records (linear sRGB) of a star at `kelvin` whose light at rest has
 /// luminance `irradiance` (the Y of linear sRGB), seen from a frame whose wavelengths are
-/// `shift` times the star's (`spectral`), or its RGB at rest (not `spectral`). Its spectrum is
-/// Planck's law read at the shifted wavelengths, scaled to that luminance.
+/// `shift` times the star's (`spectral`), or its RGB at rest (not `spectral`).
 pub fn star_rgb(kelvin: f64, irradiance: f64, shift: f64, spectral: bool) -> DVec3 {
-    let unit = Spectrum::Blackbody { kelvin, scale: 1.0 };
-    let rest = camera::rgb(&Sampled::of(&unit, 1.0));
-    let scale = irradiance / luminance(rest);
+    let (spectrum, rest) = star_spectrum(kelvin, irradiance);
     if spectral {
-        camera::rgb(&Sampled::of(&unit, shift)) * scale
+        camera::rgb(&Sampled::of(&spectrum, shift))
     } else {
-        rest * scale
+        rest
     }
 }
 
@@ -89,9 +86,9 @@ pub fn luminance(rgb: DVec3) -> f64 {
 /// of the sky makes on average); for a curved one, whose true cones are wider or narrower, right
 /// on average (a star is found in proportionally fewer or more pixels).
 pub struct StarCones {
-    /// The stars' directions (sky frame, turned by the sky's `rotate`), temperatures and
-    /// irradiances, by cell.
-    stars: Vec<(DVec3, f64, f64)>,
+    /// The stars' directions (sky frame, turned by the sky's `rotate`), spectra and RGB at
+    /// rest ([`star_spectrum`], made once here, not per ray), by cell.
+    stars: Vec<(DVec3, Spectrum, DVec3)>,
     /// Where each cell's stars start in `stars` (cells: `bands` in z, `sectors` in longitude).
     starts: Vec<u32>,
     bands: usize,
@@ -111,15 +108,16 @@ impl StarCones {
             let s = ((phi / std::f64::consts::TAU * sectors as f64) as usize).min(sectors - 1);
             b * sectors + s
         };
-        let mut placed: Vec<(usize, (DVec3, f64, f64))> = field
+        let mut placed: Vec<(usize, (DVec3, Spectrum, DVec3))> = field
             .stars
-            .iter()
+            .par_iter()
             .map(|s| {
                 let d = (sky.rotation * s.dir).normalize();
-                (cell(d), (d, s.kelvin, s.irradiance))
+                let (spectrum, rest) = star_spectrum(s.kelvin, s.irradiance);
+                (cell(d), (d, spectrum, rest))
             })
             .collect();
-        placed.sort_by_key(|p| p.0);
+        placed.par_sort_by_key(|p| p.0);
         let mut starts = vec![0u32; bands * sectors + 1];
         for (c, _) in &placed {
             starts[c + 1] += 1;
@@ -136,8 +134,8 @@ impl StarCones {
     }
 
     /// Every star within the cone of solid angle `omega` about sky-frame direction `d` (unit):
-    /// `visit(kelvin, irradiance)`.
-    pub fn in_cone(&self, d: DVec3, omega: f64, mut visit: impl FnMut(f64, f64)) {
+    /// `visit(spectrum, rgb at rest)`.
+    pub fn in_cone(&self, d: DVec3, omega: f64, mut visit: impl FnMut(&Spectrum, DVec3)) {
         if omega.is_nan() || omega <= 0.0 {
             return;
         }
@@ -171,9 +169,9 @@ impl StarCones {
             for s in s_lo..=s_hi.min(s_lo + self.sectors as i64 - 1) {
                 let c = b * self.sectors + s.rem_euclid(self.sectors as i64) as usize;
                 let (a, e) = (self.starts[c] as usize, self.starts[c + 1] as usize);
-                for &(dir, kelvin, e_star) in &self.stars[a..e] {
+                for (dir, spectrum, rest) in &self.stars[a..e] {
                     if dir.dot(d) >= cos_t {
-                        visit(kelvin, e_star);
+                        visit(spectrum, *rest);
                     }
                 }
             }
@@ -229,7 +227,11 @@ mod tests {
                     .map(|(_, k)| k.to_bits())
                     .collect();
                 let mut got = Vec::new();
-                cones.in_cone(d, omega, |k, _| got.push(k.to_bits()));
+                cones.in_cone(d, omega, |spectrum, _| {
+                    if let Spectrum::Blackbody { kelvin, .. } = spectrum {
+                        got.push(kelvin.to_bits());
+                    }
+                });
                 want.sort_unstable();
                 got.sort_unstable();
                 assert_eq!(got, want, "about {d} with {omega} sr");

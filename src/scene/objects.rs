@@ -330,20 +330,20 @@ pub(super) fn add_object(
                     "a mesh is given by `file` or by `vertices` and `indices`, not both",
                 ));
             }
-            let mesh = read_mesh_file(t)?;
+            let mut mesh = read_mesh_file(t)?;
             mesh_budget(t, total, &mesh)?;
-            // Normals turn with the mesh and take the inverse of its scale.
-            let normal = |n: DVec3| {
-                transform.map_or(n, |x| (x.rotation * (n / x.scale)).normalize_or_zero())
+            // The corner data, moved out of the mesh as read; normals turn with the mesh and
+            // take the inverse of its scale.
+            let normals = match transform {
+                Some(x) => mesh.normals.take().map(|n| {
+                    let turn = |n: DVec3| (x.rotation * (n / x.scale)).normalize_or_zero();
+                    n.into_iter().map(|c| c.map(turn)).collect()
+                }),
+                None => mesh.normals.take(),
             };
-            let corners =
-                (mesh.normals.is_some() || mesh.uvs.is_some()).then(|| crate::geometry::Corners {
-                    normals: mesh
-                        .normals
-                        .as_ref()
-                        .map(|n| n.iter().map(|c| c.map(normal)).collect()),
-                    uvs: mesh.uvs.clone(),
-                });
+            let uvs = mesh.uvs.take();
+            let corners = (normals.is_some() || uvs.is_some())
+                .then_some(crate::geometry::Corners { normals, uvs });
             // Runs of triangles of one material, each a part of the object.
             let chosen = file_materials(t, &mesh.materials, mats, mat)?;
             let material_of = |i: usize| match mesh.material_of.get(i) {
@@ -351,21 +351,30 @@ pub(super) fn add_object(
                 _ => mat,
             };
             let n = mesh.triangles.len();
-            let mut runs = Vec::new();
+            let mut bounds = Vec::new();
             let mut start = 0;
             while start < n {
                 let m = material_of(start);
                 let end = (start + 1..n).find(|&i| material_of(i) != m).unwrap_or(n);
-                let corners = corners.as_ref().map(|c| {
-                    std::sync::Arc::new(crate::geometry::Corners {
-                        normals: c.normals.as_ref().map(|v| v[start..end].to_vec()),
-                        uvs: c.uvs.as_ref().map(|v| v[start..end].to_vec()),
-                    })
-                });
-                runs.push(((end - start) as u64, m, corners));
+                bounds.push((start, end, m));
                 start = end;
             }
-            drop(corners);
+            // One material: the corner data as read, not a copy of it.
+            let runs: Vec<_> = match (bounds.as_slice(), corners) {
+                ([(_, _, m)], c) => vec![(n as u64, *m, c.map(std::sync::Arc::new))],
+                (_, c) => bounds
+                    .iter()
+                    .map(|&(start, end, m)| {
+                        let part = c.as_ref().map(|c| {
+                            std::sync::Arc::new(crate::geometry::Corners {
+                                normals: c.normals.as_ref().map(|v| v[start..end].to_vec()),
+                                uvs: c.uvs.as_ref().map(|v| v[start..end].to_vec()),
+                            })
+                        });
+                        ((end - start) as u64, m, part)
+                    })
+                    .collect(),
+            };
             // Held as itself: its vertices once, placed, and its triangles' indices.
             let positions = match transform {
                 Some(x) => mesh.positions.iter().map(|&p| x.point(p)).collect(),
