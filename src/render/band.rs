@@ -24,6 +24,10 @@ pub(crate) trait Band: Copy + Mul<f64, Output = Self> {
     /// A spectrum read in a frame whose wavelengths are `shift` times the camera's (in RGB:
     /// `rest_rgb`, its RGB at rest).
     fn of_spectrum(s: &crate::spectrum::Spectrum, rest_rgb: DVec3, shift: f64) -> Self;
+    /// The same value at every wavelength (or in every channel).
+    fn splat(v: f64) -> Self;
+    /// Its largest value over the wavelengths (or channels).
+    fn max_value(&self) -> f64;
     /// What the camera records of it (linear sRGB).
     fn to_rgb(&self) -> DVec3;
     /// `self *= o`, wavelength by wavelength.
@@ -52,6 +56,12 @@ impl Band for DVec3 {
     }
     fn of_spectrum(_: &crate::spectrum::Spectrum, rest_rgb: DVec3, _: f64) -> Self {
         rest_rgb
+    }
+    fn splat(v: f64) -> Self {
+        DVec3::splat(v)
+    }
+    fn max_value(&self) -> f64 {
+        self.max_element()
     }
     fn to_rgb(&self) -> DVec3 {
         *self
@@ -91,6 +101,12 @@ impl Band for Sampled {
     }
     fn of_spectrum(s: &crate::spectrum::Spectrum, _: DVec3, shift: f64) -> Self {
         Sampled::of(s, shift)
+    }
+    fn splat(v: f64) -> Self {
+        Sampled([v; crate::spectrum::SAMPLES])
+    }
+    fn max_value(&self) -> f64 {
+        self.0.iter().copied().fold(f64::NEG_INFINITY, f64::max)
     }
     fn to_rgb(&self) -> DVec3 {
         camera::rgb(self)

@@ -8,6 +8,7 @@ mod camera;
 mod frame;
 mod group_tree;
 mod light_tree;
+mod path;
 mod progress;
 mod ray_budget;
 mod sampler;
@@ -32,6 +33,7 @@ pub(crate) use {
     apparent_tree::apparent_box,
     group_tree::{world_box, GroupTree, SlicedGroupTree},
     light_tree::{reach_box, LightTree},
+    shade::Shader,
 };
 
 use crate::accel::Backend;
@@ -221,6 +223,8 @@ struct Rows<'a> {
     cull: Option<ScreenCull>,
     stars: Option<star_pixels::StarPixels>,
     cones: Option<star_pixels::StarCones>,
+    /// The glowing primitives, where the path integrator renders.
+    emitters: Option<path::Emitters>,
     spectral: bool,
     progress: Option<&'a Progress>,
 }
@@ -256,6 +260,8 @@ impl<'a> Rows<'a> {
             .as_ref()
             .filter(|_| bounces)
             .and_then(star_pixels::StarCones::new);
+        let emitters = (scene.render.integrator == crate::scene::Integrator::Path)
+            .then(|| path::Emitters::new(scene, world));
         Self {
             scene,
             world,
@@ -264,6 +270,7 @@ impl<'a> Rows<'a> {
             cull,
             stars,
             cones,
+            emitters,
             spectral,
             progress,
         }
@@ -312,6 +319,7 @@ impl<'a> Rows<'a> {
                         cull,
                         stars: self.stars.as_ref(),
                         cones: self.cones.as_ref(),
+                        emitters: self.emitters.as_ref(),
                     };
                     let tile = if self.spectral {
                         let seen = Seen::of(scene);

@@ -1,7 +1,7 @@
 //! Reproducible stratified pixel samples: the same scene gives the same image on any number of
 //! threads, because every sample's jitter is a hash of its pixel and index.
 
-fn splitmix(mut z: u64) -> u64 {
+pub(super) fn splitmix(mut z: u64) -> u64 {
     z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);

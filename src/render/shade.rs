@@ -17,8 +17,8 @@ use crate::spacetime::{Boost, Event, NullRay};
 use glam::DVec3;
 use std::marker::PhantomData;
 
-struct LightRt<'a> {
-    light: &'a Light,
+pub(super) struct LightRt<'a> {
+    pub light: &'a Light,
     to_light: Boost,
     from_light: Boost,
 }
@@ -29,15 +29,52 @@ struct SkyRt<'a> {
     to_sky: Option<Boost>,
 }
 
+impl LightRt<'_> {
+    /// Toward this light from world event `from`, seen in group `g`'s frame: the emission
+    /// event on the light's worldline that lies on `from`'s past light cone, found in the
+    /// light's rest frame, where the light is static. None where `from` is at the light.
+    pub(super) fn toward(&self, from: Event, g: &super::world::WorldGroup) -> Option<ToLight> {
+        let at_light = self.to_light.event(from);
+        let delta = self.light.position - at_light.x;
+        let dist = delta.length();
+        if dist == 0.0 {
+            return None;
+        }
+        let (dir_w, k) = self.from_light.view_dir(delta / dist);
+        let (to_light, s_surface) = g.boost.view_dir(dir_w);
+        Some(ToLight {
+            dir_w,
+            k,
+            to_light,
+            s_surface,
+            dist,
+        })
+    }
+}
+
+/// The way from a surface to a point light (see [`LightRt::toward`]).
+pub(super) struct ToLight {
+    /// The world-frame looking direction toward the light.
+    pub dir_w: DVec3,
+    /// ν_world / ν_light along it.
+    pub k: f64,
+    /// The unit direction toward the light in the surface's frame.
+    pub to_light: DVec3,
+    /// ν_surface / ν_world along it.
+    pub s_surface: f64,
+    /// The distance in the light's frame (its lookback time there).
+    pub dist: f64,
+}
+
 pub struct Shader<'a, B> {
-    scene: &'a Scene,
-    world: &'a World,
-    lights: Vec<LightRt<'a>>,
+    pub(super) scene: &'a Scene,
+    pub(super) world: &'a World,
+    pub(super) lights: Vec<LightRt<'a>>,
     sky: Option<SkyRt<'a>>,
     /// The stars by direction, for rays that leave after a bounce (None: no stars, or no
     /// material that reflects or transmits).
     cones: Option<&'a StarCones>,
-    seen: Seen,
+    pub(super) seen: Seen,
     band: PhantomData<B>,
 }
 
@@ -200,7 +237,7 @@ impl<'a, B: Band> Shader<'a, B> {
 
     /// A group's lookback factor for a world-frame direction (1 where no change of frame
     /// alters light, so it need not be computed).
-    fn lookback_factor(&self, group: usize, dir_w: DVec3) -> f64 {
+    pub(super) fn lookback_factor(&self, group: usize, dir_w: DVec3) -> f64 {
         if !self.seen.any() {
             return 1.0;
         }
@@ -209,14 +246,14 @@ impl<'a, B: Band> Shader<'a, B> {
 
     /// Spawn a secondary ray at a hit: rest-frame direction `dir`, origin pushed off the
     /// surface by ε along `side` (rest frame), both boosted back to the world frame.
-    fn spawn(&self, group: usize, hit_event: Event, side: DVec3, dir: DVec3) -> NullRay {
+    pub(super) fn spawn(&self, group: usize, hit_event: Event, side: DVec3, dir: DVec3) -> NullRay {
         let (dir_w, _) = self.world.groups[group].boost.inverse().view_dir(dir);
         NullRay::new(self.pushed_off(group, hit_event, side), dir_w)
     }
 
     /// The world-frame event ε off the surface at a hit, along rest-frame `side`: where a
     /// secondary ray of the hit starts.
-    fn pushed_off(&self, group: usize, hit_event: Event, side: DVec3) -> Event {
+    pub(super) fn pushed_off(&self, group: usize, hit_event: Event, side: DVec3) -> Event {
         let g = &self.world.groups[group];
         hit_event + g.boost.inverse().event(Event::new(0.0, g.epsilon * side))
     }
@@ -233,10 +270,22 @@ impl<'a, B: Band> Shader<'a, B> {
         budget: Budget,
         spread: f64,
     ) -> (B, u64) {
+        self.shade_at(hit, ray.at(hit.lambda), shift, budget, spread)
+    }
+
+    /// [`Shader::shade`] of a hit at world event `event`.
+    fn shade_at(
+        &self,
+        hit: &SurfaceHit,
+        event: Event,
+        shift: f64,
+        budget: Budget,
+        spread: f64,
+    ) -> (B, u64) {
         // On the stack for a few lights: a secondary hit allocates nothing.
         let mut shadows = smallvec::SmallVec::<[Option<ShadowQuery>; 4]>::new();
         let lit = self
-            .prepare(ray, hit, shift, &mut shadows)
+            .prepare_at(hit, event, shift, &mut shadows)
             .with_spread(spread);
         self.finish(
             &lit,
@@ -278,43 +327,25 @@ impl<'a, B: Band> Shader<'a, B> {
         shift: f64,
         shadows: &mut impl Extend<Option<ShadowQuery>>,
     ) -> Lit<'a> {
-        let scene = self.scene;
-        let g = &self.world.groups[hit.group];
-        let prim = g.geometry.prim(hit.prim);
-        let part = g.geometry.part_of(hit.prim);
-        let mat = &scene.materials[part.material as usize];
-        let v = hit.dir / hit.s;
-        let n = prim.normal(hit.point);
-        let inside = n.dot(v) > 0.0;
-        let faced = if inside { -n } else { n };
-        // A mesh's vertex normals shade it smoothly, turned to the side the ray sees.
-        let (smooth, corner_uv) = g.geometry.corners_at(hit.prim, hit.point);
-        let nf = smooth.map_or(faced, |s| if s.dot(faced) < 0.0 { -s } else { s });
-        let event = ray.at(hit.lambda);
-        // Textures are laid out in the object's own coordinates, on its shape before any
-        // transform placed it.
-        let (point, outward, prim) = match &part.placement {
-            Some(pl) => (
-                pl.to_object(hit.point),
-                pl.normal_to_object(n),
-                pl.shape.unwrap_or(prim),
-            ),
-            None => (hit.point, n, prim),
-        };
-        let lit = Lit {
-            mat,
-            point,
-            outward,
-            corner_uv,
-            prim,
-            group: hit.group,
-            event,
-            v,
-            nf,
-            inside,
-            shift,
-            spread: 0.0,
-        };
+        self.prepare_at(hit, ray.at(hit.lambda), shift, shadows)
+    }
+
+    /// [`Shader::prepare`] of a hit at world event `event`.
+    fn prepare_at(
+        &self,
+        hit: &SurfaceHit,
+        event: Event,
+        shift: f64,
+        shadows: &mut impl Extend<Option<ShadowQuery>>,
+    ) -> Lit<'a> {
+        let lit = self.lit_at(hit, event, shift);
+        let (g, mat, nf, event, v) = (
+            &self.world.groups[hit.group],
+            lit.mat,
+            lit.nf,
+            lit.event,
+            lit.v,
+        );
         if mat.emission.is_some() {
             shadows.extend(self.lights.iter().map(|_| None));
             return lit;
@@ -325,16 +356,13 @@ impl<'a, B: Band> Shader<'a, B> {
         let glints = !mat.specular.is_black();
         let from = self.pushed_off(hit.group, event, nf);
         shadows.extend(self.lights.iter().map(|l| {
-            // The emission event on the light's worldline that lies on `from`'s past light
-            // cone, found in the light's rest frame, where the light is static.
-            let at_light = l.to_light.event(from);
-            let delta = l.light.position - at_light.x;
-            let dist = delta.length();
-            if dist == 0.0 {
-                return None;
-            }
-            let (dir_w, k) = l.from_light.view_dir(delta / dist);
-            let (to_light, s_surface) = g.boost.view_dir(dir_w);
+            let ToLight {
+                dir_w,
+                k,
+                to_light,
+                s_surface,
+                dist,
+            } = l.toward(from, g)?;
             let ndl = nf.dot(to_light);
             if ndl <= 0.0 {
                 return None;
@@ -363,6 +391,81 @@ impl<'a, B: Band> Shader<'a, B> {
             })
         }));
         lit
+    }
+
+    /// A hit at world event `event`, seen at wavelengths `shift` times the camera's: its
+    /// material, the normal turned toward the ray, and where its textures are read.
+    pub(super) fn lit_at(&self, hit: &SurfaceHit, event: Event, shift: f64) -> Lit<'a> {
+        let g = &self.world.groups[hit.group];
+        let prim = g.geometry.prim(hit.prim);
+        let part = g.geometry.part_of(hit.prim);
+        let mat = &self.scene.materials[part.material as usize];
+        let v = hit.dir / hit.s;
+        let n = prim.normal(hit.point);
+        let inside = n.dot(v) > 0.0;
+        let faced = if inside { -n } else { n };
+        // A mesh's vertex normals shade it smoothly, turned to the side the ray sees.
+        let (smooth, corner_uv) = g.geometry.corners_at(hit.prim, hit.point);
+        let nf = smooth.map_or(faced, |s| if s.dot(faced) < 0.0 { -s } else { s });
+        // Textures are laid out in the object's own coordinates, on its shape before any
+        // transform placed it.
+        let (point, outward, prim) = match &part.placement {
+            Some(pl) => (
+                pl.to_object(hit.point),
+                pl.normal_to_object(n),
+                pl.shape.unwrap_or(prim),
+            ),
+            None => (hit.point, n, prim),
+        };
+        Lit {
+            mat,
+            point,
+            outward,
+            corner_uv,
+            prim,
+            group: hit.group,
+            event,
+            v,
+            nf,
+            n,
+            inside,
+            shift,
+            spread: 0.0,
+        }
+    }
+
+    /// The light a ray that leaves a hit into the inside of its object (rest-frame direction
+    /// `dir`, starting ε off the surface along `side`) meets first: light inside a material
+    /// of index `ior` travels at c/ior in the material's rest frame (docs/physics.md §9), so the
+    /// event it left is found in that frame, `ior` times the distance back in time, and only
+    /// the object's own group is searched. The hit (its direction the unit rest-frame one, its
+    /// lookback factor 1: no change of frame on the way) and the event; None where the ray
+    /// meets nothing of its group (an object that is not closed), and leaves as a null ray.
+    pub(crate) fn inside_hit(
+        &self,
+        group: usize,
+        event: Event,
+        side: DVec3,
+        dir: DVec3,
+        ior: f64,
+    ) -> Option<(SurfaceHit, Event)> {
+        let g = &self.world.groups[group];
+        let from = g.boost.event(self.pushed_off(group, event, side));
+        let (prim, t) = self.world.hit_in_group(group, from.x, dir)?;
+        let point = from.x + t * dir;
+        // The delay from the surface point itself (not the pushed-off start): exact.
+        let entry = g.boost.event(event);
+        let at_rest = Event::new(entry.t - ior * (point - entry.x).length(), point);
+        let at = g.boost.inverse().event(at_rest);
+        let hit = SurfaceHit {
+            group,
+            prim,
+            lambda: event.t - at.t,
+            point: at_rest.x,
+            dir,
+            s: 1.0,
+        };
+        Some((hit, at))
     }
 
     /// The colour of a prepared hit, given its shadow rays and `reaches(light, query)`: whether
@@ -426,6 +529,15 @@ impl<'a, B: Band> Shader<'a, B> {
                     Branch::Reflected => (nf, reflect(v, nf), &mut seen_r),
                     Branch::Refracted => (-nf, refracted.expect("a refracted ray"), &mut seen_t),
                 };
+                // Into a glass object, light is slower (`inside_hit`) and never changes frame.
+                if mat.transmit > 0.0 && dir.dot(lit.n) < 0.0 {
+                    if let Some((h, at)) = self.inside_hit(lit.group, event, side, dir, mat.ior) {
+                        let sr = lit.spread;
+                        let (light, spent) = self.shade_at(&h, at, lit.shift, b, sr);
+                        *seen = Some(light);
+                        return 1 + spent;
+                    }
+                }
                 let r = self.spawn(lit.group, event, side, dir);
                 let s = self.lookback_factor(lit.group, r.dir);
                 // The bundle keeps its solid angle in the surface's frame (a flat surface).
@@ -454,7 +566,7 @@ impl<'a, B: Band> Shader<'a, B> {
 
 /// A material's colour at a hit, or its texture's there, in the band. An image's RGB becomes a
 /// spectrum on its basis (`ImageTexture`): in RGB the texel itself.
-fn surface_colour<B: Band>(
+pub(super) fn surface_colour<B: Band>(
     colour: &crate::spectrum::Colour,
     texture: Option<&crate::scene::Texture>,
     lit: &Lit,
@@ -498,7 +610,7 @@ struct LightTerm {
 
 /// A hit prepared for shading: see [`Shader::prepare`].
 pub struct Lit<'a> {
-    mat: &'a crate::scene::Material,
+    pub(super) mat: &'a crate::scene::Material,
     /// The hit in its object's own coordinates (its group's rest frame, undone by the
     /// object's transform, if it has one; textures are laid out there), and the surface's
     /// outward normal there.
@@ -508,13 +620,15 @@ pub struct Lit<'a> {
     /// from), and a mesh's texture coordinates there.
     prim: crate::geometry::Primitive,
     corner_uv: Option<[f64; 2]>,
-    group: usize,
-    event: Event,
-    v: DVec3,
-    nf: DVec3,
-    inside: bool,
+    pub(super) group: usize,
+    pub(super) event: Event,
+    pub(super) v: DVec3,
+    pub(super) nf: DVec3,
+    /// The surface's outward normal (rest frame).
+    pub(super) n: DVec3,
+    pub(super) inside: bool,
     /// The surface frame's wavelengths over the camera's.
-    shift: f64,
+    pub(super) shift: f64,
     /// The solid angle, in the surface's frame, of the bundle the ray that hit stands for (0:
     /// none is followed).
     spread: f64,

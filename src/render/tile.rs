@@ -4,6 +4,7 @@
 use super::band::{Band, Seen};
 use super::camera::CameraRays;
 use super::frame::{Mattes, PixelValue, MATTE_RANKS};
+use super::path::{sample_rng, Emitters, PathTracer};
 use super::sampler::sample_offset;
 use super::screen_cull::ScreenCull;
 use super::shade::Shader;
@@ -277,15 +278,61 @@ fn shade_hits<B: Band>(
             }
             Err(_) if black_sky => DVec3::ZERO,
             Err((camera_s, dir)) => {
-                let sky = shader.background_along(*dir, *camera_s, 1.0).to_rgb();
-                // The stars of the pixel this ray belongs to (`image_points`).
-                match stars {
-                    Some(st) => {
-                        let (x, y) = coords[k];
-                        sky + st.at(x + ox, y + oy)
-                    }
-                    None => sky,
+                let (x, y) = coords[k];
+                missed(shader, *camera_s, *dir, stars, (x + ox, y + oy))
+            }
+        })
+        .collect()
+}
+
+/// What a primary ray that meets nothing sees (along `dir`, the camera's lookback factor
+/// `camera_s` for it): the sky or background, and the stars of its pixel (image coordinates).
+fn missed<B: Band>(
+    shader: &Shader<B>,
+    camera_s: f64,
+    dir: DVec3,
+    stars: Option<&StarPixels>,
+    (x, y): (u32, u32),
+) -> DVec3 {
+    let sky = shader.background_along(dir, camera_s, 1.0).to_rgb();
+    match stars {
+        Some(st) => sky + st.at(x, y),
+        None => sky,
+    }
+}
+
+/// The colours (linear sRGB) of primary hits by the path integrator: one path per hit, its
+/// random numbers those of sample `sample` of its pixel; as [`shade_hits`] where a ray meets
+/// nothing.
+fn shade_paths<B: Band>(
+    tracer: &PathTracer<B>,
+    shader: &Shader<B>,
+    cam: &CameraRays,
+    primary: &PrimaryHits,
+    (coords, (ox, oy)): (&[(u32, u32)], (u32, u32)),
+    stars: Option<&StarPixels>,
+    sample: u32,
+) -> Vec<DVec3> {
+    let follows = shader.follows_frames();
+    let black_sky = shader.primary_misses_add_nothing();
+    let seed = shader.scene.render.seed;
+    (0..primary.len())
+        .map(|i| {
+            let ray = primary.ray(i);
+            let camera_s = if follows {
+                cam.lookback_factor(ray.dir)
+            } else {
+                1.0
+            };
+            let (x, y) = (coords[i].0 + ox, coords[i].1 + oy);
+            match primary.hit(i) {
+                Some(h) => {
+                    let (shift, k) = shader.arriving(camera_s, h.s, 1.0);
+                    let mut rng = sample_rng(seed, x, y, sample);
+                    tracer.radiance(&ray, &h, shift, &mut rng).to_rgb() * k
                 }
+                None if black_sky => DVec3::ZERO,
+                None => missed(shader, camera_s, ray.dir, stars, (x, y)),
             }
         })
         .collect()
@@ -298,6 +345,8 @@ pub struct View<'a> {
     pub cull: Option<&'a ScreenCull>,
     pub stars: Option<&'a StarPixels>,
     pub cones: Option<&'a StarCones>,
+    /// The glowing primitives, where the path integrator renders.
+    pub emitters: Option<&'a Emitters>,
 }
 
 pub struct TilePixel {
@@ -333,6 +382,7 @@ pub fn render_tile<B: Band>(
     let coords = tile_pixels(x0, y0, w, h);
     let n = scene.image.samples;
     let shader = Shader::<B>::new(scene, world, seen).with_star_cones(view.cones);
+    let tracer = view.emitters.map(|e| PathTracer::new(&shader, e));
     // Pixels left out by the cull see the background in every sample (nothing, in a
     // transparent image): the same everywhere
     // unless the camera moves through a background that is not black (then each pixel's, as
@@ -390,6 +440,9 @@ pub fn render_tile<B: Band>(
         world.primary_hits(cam, px, primary);
         let colors = if centre {
             Vec::new()
+        } else if let Some(t) = &tracer {
+            let at = (live_coords.as_slice(), offset);
+            shade_paths(t, &shader, cam, primary, at, view.stars, s)
         } else {
             shade_hits(
                 &shader,

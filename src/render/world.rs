@@ -499,6 +499,17 @@ impl World {
         (sh.lambda < tmax).then_some(sh)
     }
 
+    /// The first surface of group `gi` on the rest-frame ray `origin + t dir` (unit `dir`,
+    /// t > 0), searched in that group alone: the primitive and t (the rest-frame distance).
+    pub fn hit_in_group(&self, gi: usize, origin: DVec3, dir: DVec3) -> Option<(u32, f64)> {
+        let g = &self.groups[gi];
+        let (t0, _) = g.bounds.clip(origin, dir.recip(), 0.0, f64::INFINITY)?;
+        // From where the ray enters the bounds, so the backend sees small coordinates.
+        let start = t0.max(0.0);
+        let ray = Ray::new(origin + start * dir, dir, 0.0, f64::INFINITY);
+        g.intersect1(&ray).map(|h| (h.prim, start + h.t))
+    }
+
     /// The visible hit on one ray (secondary rays, and every ray when there are many groups).
     pub fn closest_hit(&self, ray: &NullRay, tmin: f64) -> Option<SurfaceHit> {
         let mut best: Option<SurfaceHit> = None;

@@ -591,8 +591,27 @@ fn render_settings(t: &Table) -> SceneResult<RenderSettings> {
         ambient: t.colour("ambient", Role::Emitter)?.unwrap_or(d.ambient),
         doppler: t.bool_or("doppler", d.doppler)?,
         searchlight: t.bool_or("searchlight", d.searchlight)?,
+        integrator: match t.string("integrator")?.unwrap_or("whitted") {
+            "whitted" => Integrator::Whitted,
+            "path" => Integrator::Path,
+            other => {
+                return Err(t.error(
+                    "integrator",
+                    format!("unknown integrator `{other}` (whitted, path)"),
+                ))
+            }
+        },
+        seed: t.uint("seed", Some(0), 0, i64::MAX as u64)?,
     };
-    t.finish(&["max_depth", "max_rays", "ambient", "doppler", "searchlight"])?;
+    t.finish(&[
+        "max_depth",
+        "max_rays",
+        "ambient",
+        "doppler",
+        "searchlight",
+        "integrator",
+        "seed",
+    ])?;
     Ok(s)
 }
 

@@ -162,6 +162,22 @@ pub struct RenderSettings {
     /// Scale radiance by D⁴ (and a point light's irradiance by D²) at every change of frame
     /// (the searchlight effect).
     pub searchlight: bool,
+    /// How light is followed from the camera: Whitted's ray tree, or Monte Carlo paths.
+    pub integrator: Integrator,
+    /// The seed of the path integrator's random numbers: the same seed gives the same image
+    /// on any number of threads.
+    pub seed: u64,
+}
+
+/// How light is followed from the camera (`[render] integrator`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Integrator {
+    /// Whitted: point lights, Phong, mirror and refracted rays (the default).
+    #[default]
+    Whitted,
+    /// Unbiased Monte Carlo path tracing: glowing objects light others, light bounces between
+    /// surfaces, rough metal and glass (src/render/path/).
+    Path,
 }
 
 /// The largest `max_rays` a scene may give.
@@ -176,6 +192,8 @@ impl Default for RenderSettings {
             ambient: Colour::grey(0.1, Role::Emitter),
             doppler: true,
             searchlight: true,
+            integrator: Integrator::Whitted,
+            seed: 0,
         }
     }
 }
@@ -204,6 +222,10 @@ pub struct Material {
     pub transmit: f64,
     /// The index of refraction, for `transmit`.
     pub ior: f64,
+    /// The microfacet roughness of the mirror (`reflect`) and glass (`transmit`) lobes, 0 to 1
+    /// (GGX, α = roughness²): 0 is a perfect mirror and clear glass. The path integrator's;
+    /// Whitted's rays are perfect.
+    pub roughness: f64,
     /// Radiance emitted in the surface's rest frame (the surface then reflects nothing).
     pub emission: Option<Colour>,
     /// A texture giving the diffuse reflectance in place of `color`.
@@ -233,6 +255,7 @@ impl Material {
             reflect: 0.0,
             transmit: 0.0,
             ior: 1.5,
+            roughness: 0.0,
             emission: None,
             color_texture: None,
             emission_texture: None,

@@ -273,6 +273,7 @@ pub(super) fn material(t: &Table, textures: &[ReadTexture]) -> SceneResult<Mater
         reflect: t.f64_where("reflect", Some(0.0), unit, "between 0 and 1")?,
         transmit: t.f64_where("transmit", Some(0.0), unit, "between 0 and 1")?,
         ior: t.f64_where("ior", Some(d.ior), |v| v >= 1.0, "1 or more")?,
+        roughness: t.f64_where("roughness", Some(d.roughness), unit, "between 0 and 1")?,
         emission,
         color_texture,
         emission_texture,
@@ -285,6 +286,7 @@ pub(super) fn material(t: &Table, textures: &[ReadTexture]) -> SceneResult<Mater
         "reflect",
         "transmit",
         "ior",
+        "roughness",
         "emission",
     ])?;
     Ok(m)

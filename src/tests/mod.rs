@@ -12,6 +12,7 @@ mod light_buffer;
 mod many_groups;
 mod screen_cull;
 mod shadow_batches;
+mod slow_light;
 mod strips;
 mod toml_tree;
 

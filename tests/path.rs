@@ -1,0 +1,472 @@
+//! The path integrator (`[render] integrator = "path"`) against answers known in closed form:
+//! a white furnace (a diffuse sphere around a glowing ball) at rest and riding along with the
+//! camera at 0.6c, a diffuse plane under a uniform sky, a glowing sphere over a plane (direct
+//! light only, small and large), a glowing ceiling sliding at 0.6c over a floor at rest (the
+//! floor's light the integral of D⁵ cos θ over the ceiling's directions), Whitted's picture with
+//! point lights and no bounce, the same bytes on any number of threads, and bad input.
+
+mod common;
+use common::*;
+use rest_embree::render::Frame;
+
+/// The mean red value of the pixels whose object id is `id`, and how many there are.
+fn mean_of(frame: &Frame, id: u32) -> (f64, usize) {
+    let (mut sum, mut n) = (0.0, 0);
+    for y in 0..frame.height {
+        for x in 0..frame.width {
+            let p = frame.get(x, y);
+            if p.object_id == id {
+                sum += f64::from(p.color[0]);
+                n += 1;
+            }
+        }
+    }
+    (sum / n.max(1) as f64, n)
+}
+
+/// A closed diffuse sphere (radius 10, albedo `rho`) around a glowing ball (radius 1, radiance
+/// 100) at its centre; the camera inside, looking at the wall away from the ball; every group
+/// and the camera moving at `velocity`.
+fn furnace(rho: f64, velocity: &str, emission: &str) -> String {
+    format!(
+        r#"
+[camera]
+position = [0, 0, 5]
+direction = [0, 0, 1]
+up = [0, 1, 0]
+fov_y = 40
+velocity = {velocity}
+[image]
+width = 24
+height = 24
+samples = 256
+background = 0
+transparent = false
+[render]
+integrator = "path"
+max_depth = 64
+[[material]]
+name = "wall"
+color = {rho}
+[[material]]
+name = "lamp"
+emission = {emission}
+[[group]]
+name = "wall"
+velocity = {velocity}
+[[group.object]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 10
+material = "wall"
+[[group]]
+name = "lamp"
+velocity = {velocity}
+[[group.object]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "lamp"
+"#
+    )
+}
+
+/// The furnace's wall radiance: every point of the inner wall sees the ball (radiance L, a
+/// fraction q = (r/R)² of its cosine-weighted view) and the rest of the wall, so
+/// L_w = ρ (q L + (1 − q) L_w) (docs/physics.md §10.4).
+fn furnace_answer(rho: f64, l: f64) -> f64 {
+    let q: f64 = 0.01;
+    rho * q * l / (1.0 - rho * (1.0 - q))
+}
+
+#[test]
+fn white_furnace_at_rest() {
+    for backend in backends() {
+        for rho in [0.5, 0.8] {
+            let f = render_with(&scene(&furnace(rho, "[0, 0, 0]", "100")), backend);
+            let (mean, n) = mean_of(&f, 1);
+            assert_eq!(n, 24 * 24, "every pixel sees the wall");
+            let want = furnace_answer(rho, 100.0);
+            report("furnace at rest", backend, want, mean, 0.01 * want, "");
+            assert_rel(mean, want, 0.01, &format!("furnace ρ = {rho} on {backend}"));
+        }
+    }
+}
+
+#[test]
+fn white_furnace_riding_along_at_0_6c_is_the_one_at_rest() {
+    // A blackbody lamp makes the render spectral, so every change of frame is followed.
+    let lamp = "{ blackbody = 5000, luminance = 100 }";
+    for backend in backends() {
+        let rest = render_with(&scene(&furnace(0.8, "[0, 0, 0]", lamp)), backend);
+        let moving = render_with(&scene(&furnace(0.8, "[0.6, 0, 0]", lamp)), backend);
+        for c in 0..3 {
+            let m = |f: &Frame| {
+                let s: f64 = (0..f.height)
+                    .flat_map(|y| (0..f.width).map(move |x| (x, y)))
+                    .map(|(x, y)| f64::from(f.get(x, y).color[c]))
+                    .sum();
+                s / f64::from(f.width * f.height)
+            };
+            let (a, b) = (m(&rest), m(&moving));
+            assert!(a > 1.0, "the wall glows ({a})");
+            assert_rel(
+                b,
+                a,
+                0.005,
+                &format!("channel {c} moving against at rest, {backend}"),
+            );
+        }
+    }
+}
+
+#[test]
+fn diffuse_plane_under_a_uniform_sky_is_albedo_times_sky() {
+    for backend in backends() {
+        for depth in [0, 3] {
+            let text = format!(
+                r#"
+[camera]
+position = [0, 5, 5]
+look_at = [0, 0, 0]
+fov_y = 30
+[image]
+width = 16
+height = 16
+samples = 4
+background = 2.5
+transparent = false
+[render]
+integrator = "path"
+max_depth = {depth}
+[[material]]
+name = "floor"
+color = 0.4
+[[group]]
+name = "floor"
+[[group.object]]
+type = "box"
+min = [-100, -1, -100]
+max = [100, 0, 100]
+material = "floor"
+"#
+            );
+            let f = render_with(&scene(&text), backend);
+            let (mean, n) = mean_of(&f, 1);
+            assert_eq!(n, 256);
+            // Cosine-weighted draws meet the sky with weight ρ exactly: no noise at all.
+            assert_rel(
+                mean,
+                0.4 * 2.5,
+                1e-9,
+                &format!("depth {depth} on {backend}"),
+            );
+        }
+    }
+}
+
+/// A glowing sphere (radiance 10, radius r) with its centre d above a diffuse plane (albedo
+/// 0.5), a camera looking at the point below it from the side, direct light only.
+fn lamp_over_plane(r: f64, d: f64) -> String {
+    format!(
+        r#"
+[camera]
+position = [5, 2, 0]
+look_at = [0, 0, 0]
+fov_y = 0.2
+[image]
+width = 4
+height = 4
+samples = 2048
+background = 0
+transparent = false
+[render]
+integrator = "path"
+max_depth = 0
+[[material]]
+name = "floor"
+color = 0.5
+[[material]]
+name = "lamp"
+emission = 10
+[[group]]
+name = "floor"
+[[group.object]]
+type = "box"
+min = [-100, -1, -100]
+max = [100, 0, 100]
+material = "floor"
+[[group.object]]
+type = "sphere"
+center = [0, {d}, 0]
+radius = {r}
+material = "lamp"
+"#
+    )
+}
+
+#[test]
+fn glowing_sphere_lights_a_plane_as_its_solid_angle_says() {
+    // A Lambert sphere of radiance L filling a cone of half-angle α straight overhead gives
+    // irradiance π L sin²α; the plane sends back ρ/π of it: ρ L (r/d)².
+    for backend in backends() {
+        for (r, d) in [(0.25, 2.0), (1.5, 2.0)] {
+            let f = render_with(&scene(&lamp_over_plane(r, d)), backend);
+            let (got, _) = mean_of(&f, 1);
+            let want = 0.5 * 10.0 * (r / d) * (r / d);
+            report("lamp over plane", backend, want, got, 0.01 * want, "");
+            assert_rel(got, want, 0.01, &format!("r = {r}, d = {d} on {backend}"));
+        }
+    }
+}
+
+/// A floor at rest (albedo 0.5) under a glowing ceiling 1 above it (radiance 1, flat
+/// spectrum), the ceiling sliding along x at `beta`; the camera at rest between them.
+fn sliding_ceiling(beta: f64, look_at: [f64; 3]) -> String {
+    let [x, y, z] = look_at;
+    format!(
+        r#"
+[camera]
+position = [0, 0.5, 0]
+look_at = [{x}, {y}, {z}]
+fov_y = 10
+[image]
+width = 8
+height = 8
+samples = 256
+background = 0
+transparent = false
+[render]
+integrator = "path"
+max_depth = 0
+[[material]]
+name = "floor"
+color = 0.5
+[[material]]
+name = "glow"
+emission = {{ wavelengths = [300, 900], values = [1, 1] }}
+[[group]]
+name = "floor"
+[[group.object]]
+type = "box"
+min = [-3000, -1, -3000]
+max = [3000, 0, 3000]
+material = "floor"
+[[group]]
+name = "ceiling"
+velocity = [{beta}, 0, 0]
+[[group.object]]
+type = "box"
+min = [-3000, 1, -3000]
+max = [3000, 2, 3000]
+material = "glow"
+"#
+    )
+}
+
+/// (1/π) ∫ cos θ D⁵ dω over the upper hemisphere, D = 1/(γ(1 − β u_x)) for light travelling
+/// along u (downward) from an emitter moving at β along x: what the sliding ceiling's light on
+/// the floor is, relative to its light at rest (flat spectra: the shift changes nothing else).
+fn sliding_ceiling_factor(beta: f64) -> f64 {
+    let gamma = 1.0 / (1.0 - beta * beta).sqrt();
+    let (n_theta, n_phi) = (2000, 2000);
+    let mut sum = 0.0;
+    for i in 0..n_theta {
+        let theta = (i as f64 + 0.5) / n_theta as f64 * std::f64::consts::FRAC_PI_2;
+        for j in 0..n_phi {
+            let phi = (j as f64 + 0.5) / n_phi as f64 * 2.0 * std::f64::consts::PI;
+            let ux = theta.sin() * phi.cos();
+            let d = 1.0 / (gamma * (1.0 - beta * ux));
+            sum += theta.cos() * theta.sin() * d.powi(5);
+        }
+    }
+    let dw =
+        std::f64::consts::FRAC_PI_2 / n_theta as f64 * 2.0 * std::f64::consts::PI / n_phi as f64;
+    sum * dw / std::f64::consts::PI
+}
+
+#[test]
+fn sliding_glowing_ceiling_lights_a_floor_by_d5() {
+    assert_rel(
+        sliding_ceiling_factor(0.0),
+        1.0,
+        1e-6,
+        "the quadrature at rest",
+    );
+    let (down, up) = ([0.3, 0.0, 0.2], [0.3, 1.0, 0.2]);
+    for backend in backends() {
+        let ceiling = mean_of(&render_with(&scene(&sliding_ceiling(0.0, up)), backend), 2).0;
+        let rest = mean_of(
+            &render_with(&scene(&sliding_ceiling(0.0, down)), backend),
+            1,
+        )
+        .0;
+        assert_rel(
+            rest,
+            0.5 * ceiling,
+            0.01,
+            "the floor under a ceiling at rest",
+        );
+        let moving = mean_of(
+            &render_with(&scene(&sliding_ceiling(0.6, down)), backend),
+            1,
+        )
+        .0;
+        let want = sliding_ceiling_factor(0.6);
+        report(
+            "sliding ceiling",
+            backend,
+            want,
+            moving / rest,
+            0.015 * want,
+            "",
+        );
+        assert_rel(moving / rest, want, 0.015, &format!("D⁵ on {backend}"));
+    }
+}
+
+/// Two groups and a camera in motion, diffuse surfaces, two point lights (one moving), no
+/// ambient light: with `integrator` and `max_depth`.
+fn lit_by_points(integrator: &str, depth: u32) -> String {
+    format!(
+        r#"
+[camera]
+position = [0, 2, 9]
+look_at = [0, 0.5, 0]
+fov_y = 40
+velocity = [0.3, 0, 0]
+[image]
+width = 40
+height = 30
+samples = 1
+background = 0
+transparent = false
+[render]
+integrator = "{integrator}"
+max_depth = {depth}
+ambient = 0
+[[material]]
+name = "floor"
+color = [0.7, 0.6, 0.5]
+[[material]]
+name = "ball"
+color = {{ wavelengths = [400, 550, 700], values = [0.2, 0.7, 0.4] }}
+[[light]]
+position = [3, 5, 4]
+intensity = 30
+[[light]]
+position = [-4, 3, 2]
+intensity = 12
+velocity = [0, 0, -0.5]
+[[group]]
+name = "floor"
+[[group.object]]
+type = "box"
+min = [-20, -1, -20]
+max = [20, 0, 20]
+material = "floor"
+[[group]]
+name = "balls"
+velocity = [0.5, 0, 0]
+[[group.object]]
+type = "sphere"
+center = [-1, 1, 0]
+radius = 1
+material = "ball"
+[[group.object]]
+type = "box"
+min = [1, 0, -1]
+max = [2.5, 1.5, 0.5]
+material = "ball"
+"#
+    )
+}
+
+#[test]
+fn point_lights_without_bounces_give_whitted_picture() {
+    // A white Lambert surface facing a point light of intensity I at distance 1 shows
+    // radiance I in both integrators; with no bounce and no ambient light nothing else adds.
+    for backend in backends() {
+        let w = render_with(&scene(&lit_by_points("whitted", 0)), backend);
+        let p = render_with(&scene(&lit_by_points("path", 0)), backend);
+        let mut lit = 0;
+        for y in 0..w.height {
+            for x in 0..w.width {
+                let (a, b) = (w.get(x, y), p.get(x, y));
+                assert_eq!(a.object_id, b.object_id);
+                for c in 0..3 {
+                    let (a, b) = (f64::from(a.color[c]), f64::from(b.color[c]));
+                    assert!(
+                        (a - b).abs() <= 1e-5 * a.abs().max(1e-3),
+                        "pixel ({x}, {y}) channel {c}: Whitted {a}, path {b} on {backend}"
+                    );
+                }
+                lit += usize::from(a.color[0] > 0.01);
+            }
+        }
+        assert!(lit > 400, "most of the picture is lit ({lit})");
+    }
+}
+
+#[test]
+fn same_seed_same_bytes_on_any_number_of_threads() {
+    let text = lit_by_points("path", 3).replace("samples = 1", "samples = 4");
+    let sc = scene(&text);
+    let render_on = |threads: usize, sc: &rest_embree::scene::Scene| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| render_with(sc, "bvh"))
+    };
+    let one = render_on(1, &sc);
+    let two = render_on(2, &sc);
+    let three = render_on(3, &sc);
+    let bytes = |f: &Frame| -> Vec<u32> {
+        f.pixels
+            .iter()
+            .flat_map(|p| p.color.map(f32::to_bits))
+            .collect()
+    };
+    assert_eq!(bytes(&one), bytes(&two), "1 thread against 2");
+    assert_eq!(bytes(&one), bytes(&three), "1 thread against 3");
+    let other = scene(&text.replace("max_depth = 3", "max_depth = 3\nseed = 7"));
+    assert_ne!(
+        bytes(&one),
+        bytes(&render_on(2, &other)),
+        "another seed, other noise"
+    );
+}
+
+#[test]
+fn bad_integrator_and_roughness_are_named() {
+    let base = lit_by_points("path", 1);
+    for (from, to, needles) in [
+        (
+            "integrator = \"path\"",
+            "integrator = \"pathtracer\"",
+            vec![
+                "integrator",
+                "unknown integrator `pathtracer`",
+                "whitted, path",
+            ],
+        ),
+        (
+            "name = \"floor\"\ncolor = [0.7, 0.6, 0.5]",
+            "name = \"floor\"\ncolor = [0.7, 0.6, 0.5]\nroughness = 1.5",
+            vec!["roughness", "between 0 and 1"],
+        ),
+        ("max_depth = 1", "max_depth = 1\nseed = -1", vec!["seed"]),
+    ] {
+        assert!(base.contains(from), "{from}");
+        let text = base.replace(from, to);
+        let err = rest_embree::scene::load_str("bad.toml", &text, &[])
+            .err()
+            .unwrap_or_else(|| panic!("{to} is refused"))
+            .to_string();
+        assert!(err.contains("bad.toml:"), "{err}");
+        for n in needles {
+            assert!(err.contains(n), "`{n}` in: {err}");
+        }
+    }
+}
