@@ -158,9 +158,28 @@ pub(crate) struct RenderArgs {
     /// Which tile of --tiles: 0 is the top left, counted row by row.
     #[arg(long, value_name = "I", requires = "tiles")]
     pub tile: Option<u32>,
+    /// Render in rounds of samples until this many seconds have passed (a round that would
+    /// end later is not begun; at least one is rendered); the scene's samples stay the most.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = positive)]
+    pub max_time: Option<f64>,
+    /// Render in rounds of samples until the estimated RMS noise of the image (the standard
+    /// error of the pixels' means, linear RGB) is at most this; the scene's samples stay the
+    /// most.
+    #[arg(long, value_name = "RMS", allow_negative_numbers = true, value_parser = positive)]
+    pub target_rms: Option<f64>,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+impl RenderArgs {
+    /// When a progressive render stops (None: not progressive, every sample at once).
+    fn stop_at(&self) -> Option<render::StopAt> {
+        (self.max_time.is_some() || self.target_rms.is_some()).then(|| render::StopAt {
+            max_time: self.max_time.map(std::time::Duration::from_secs_f64),
+            target_rms: self.target_rms,
+        })
+    }
 }
 
 impl RenderArgs {
@@ -201,6 +220,14 @@ impl RenderArgs {
 }
 
 /// A finite number (clap takes `nan` and `inf` for f64).
+/// A finite number above 0 (a budget of time or noise).
+fn positive(text: &str) -> Result<f64, String> {
+    match finite(text)? {
+        v if v > 0.0 => Ok(v),
+        v => Err(format!("must be above 0 (got {v})")),
+    }
+}
+
 fn finite(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
@@ -337,7 +364,7 @@ fn render_to_file(
                     true => Passes::Colour,
                     false => Passes::All,
                 };
-                stats = render::render_world_in_strips(scene, world, passes, strip, progress, put)?;
+                stats = render_pixels(scene, world, passes, strip, progress, args, put)?;
                 Ok(())
             });
             progress.inspect(|p| p.finish());
@@ -352,7 +379,7 @@ fn render_to_file(
             let written = output::write_png_in_strips(path, (w, h), alpha, Some(&id), |put| {
                 let strip = memory::STRIP_PIXELS;
                 let colour = Passes::Colour;
-                stats = render::render_world_in_strips(scene, world, colour, strip, progress, put)?;
+                stats = render_pixels(scene, world, colour, strip, progress, args, put)?;
                 Ok(())
             });
             progress.inspect(|p| p.finish());
@@ -371,6 +398,36 @@ fn render_to_file(
         )),
         e => e,
     })?;
+    Ok(stats)
+}
+
+/// Render the frame and hand its pixels to `put`: strip by strip as they are rendered, or,
+/// with --max-time or --target-rms, whole after the last round (and say what the rounds did).
+fn render_pixels(
+    scene: &scene::Scene,
+    world: &render::World,
+    passes: Passes,
+    strip: u64,
+    progress: Option<&render::Progress>,
+    args: &RenderArgs,
+    put: &mut dyn FnMut(&render::Frame) -> std::result::Result<(), crate::Cause>,
+) -> std::result::Result<render::RenderStats, crate::Cause> {
+    let Some(stop) = args.stop_at() else {
+        return render::render_world_in_strips(scene, world, passes, strip, progress, put);
+    };
+    let (frame, stats, done) = render::render_progressive(scene, world, passes, stop)?;
+    put(&frame)?;
+    if !args.quiet {
+        let rms = done
+            .rms
+            .map_or("not estimated (one round)".to_string(), |r| {
+                format!("{r:.3e}")
+            });
+        eprintln!(
+            "{} spp in {} rounds, stopped by {}: estimated RMS noise {rms}",
+            done.samples, done.rounds, done.stopped_by
+        );
+    }
     Ok(stats)
 }
 
@@ -487,6 +544,18 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         eprintln!("{w}");
     }
     if scene.film.is_some() || args.frames.is_some() {
+        if let Some(flag) = [
+            ("--max-time", args.max_time),
+            ("--target-rms", args.target_rms),
+        ]
+        .iter()
+        .find_map(|(f, v)| v.map(|_| *f))
+        {
+            return Err(Error::flag(
+                flag,
+                "applies to a still image; a film's frames render their `samples` each",
+            ));
+        }
         return film::run(&scene, backend.as_ref(), &backend_name, format, args);
     }
     let t0 = std::time::Instant::now();
@@ -511,7 +580,7 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
             args.output.display(),
             scene.image.frame_size().0,
             scene.image.frame_size().1,
-            scene.image.samples,
+            stats.samples.unwrap_or(scene.image.samples),
             scene.primitive_count(),
             scene.groups.len(),
             stats.build_time.as_secs_f64(),

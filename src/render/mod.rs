@@ -10,6 +10,7 @@ mod group_tree;
 mod light_tree;
 mod path;
 mod progress;
+mod progressive;
 mod ray_budget;
 mod sampler;
 mod screen_cull;
@@ -20,11 +21,13 @@ mod world;
 
 pub use band::{extrapolation_warning, needs_spectra};
 pub use frame::{pass, Frame, Mattes, PixelValue, CHANNELS, DEPTH_FAR, MATTE_RANKS};
+pub use progressive::{Converged, StopAt};
 pub use world::{WorldOptions, INSTANCE_OVER};
 
 pub(crate) use band::Seen;
 pub(crate) use camera::CameraRays;
 pub(crate) use progress::Progress;
+pub(crate) use progressive::render as render_progressive;
 pub(crate) use screen_cull::ScreenCull;
 pub(crate) use world::{RestGroups, World};
 // What the tests of the internals reach (src/tests/).
@@ -56,6 +59,8 @@ pub struct RenderStats {
     pub primary_rays: u64,
     /// Pixels whose colour came out NaN or infinite and were replaced by black (a bug if > 0).
     pub nonfinite_pixels: u64,
+    /// Samples per pixel rendered, where a progressive render chose (None: the scene's).
+    pub samples: Option<u32>,
 }
 
 /// What a render fills in besides the colour and alpha of each pixel.
@@ -225,6 +230,8 @@ struct Rows<'a> {
     cones: Option<star_pixels::StarCones>,
     /// The glowing primitives, where the path integrator renders.
     emitters: Option<path::Emitters>,
+    /// The index of this round's first sample in each pixel's samples (progressive renders).
+    sample_base: u32,
     spectral: bool,
     progress: Option<&'a Progress>,
 }
@@ -271,9 +278,16 @@ impl<'a> Rows<'a> {
             stars,
             cones,
             emitters,
+            sample_base: 0,
             spectral,
             progress,
         }
+    }
+
+    /// These rows as a round of samples that starts at sample `base` of each pixel.
+    fn with_sample_base(mut self, base: u32) -> Self {
+        self.sample_base = base;
+        self
     }
 
     /// Rows `rows` of the frame (`rows.start` a multiple of TILE), as a frame of their own.
@@ -320,6 +334,7 @@ impl<'a> Rows<'a> {
                         stars: self.stars.as_ref(),
                         cones: self.cones.as_ref(),
                         emitters: self.emitters.as_ref(),
+                        sample_base: self.sample_base,
                     };
                     let tile = if self.spectral {
                         let seen = Seen::of(scene);

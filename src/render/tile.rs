@@ -38,20 +38,21 @@ pub fn tile_pixels(x0: u32, y0: u32, w: u32, h: u32) -> Vec<(u32, u32)> {
 }
 
 /// The image points of `coords` (frame pixels; `offset` places the frame in the full image),
-/// in pixels from the image's top-left corner: sample `(s, n)` of each pixel, or the pixel
-/// centre for None.
+/// in pixels from the image's top-left corner: sample `(s, n)` of each pixel in the round of
+/// samples that starts at `base` (`sample_offset`), or the pixel centre for None.
 fn image_points(
     coords: &[(u32, u32)],
     offset: (u32, u32),
     sample: Option<(u32, u32)>,
+    base: u32,
     px: &mut Vec<(f64, f64)>,
 ) {
     px.clear();
     let (dx, dy) = (offset.0 as f64, offset.1 as f64);
     match sample {
-        Some((s, n)) if n > 1 => px.extend(coords.iter().map(|&(fx, fy)| {
+        Some((s, n)) if n > 1 || base > 0 => px.extend(coords.iter().map(|&(fx, fy)| {
             let (x, y) = (fx + offset.0, fy + offset.1);
-            let (ox, oy) = sample_offset(x, y, s, n);
+            let (ox, oy) = sample_offset(x, y, s, n, base);
             (x as f64 + ox, y as f64 + oy)
         })),
         // One sample per pixel is its centre (`sample_offset`), in a loop without the test
@@ -74,7 +75,7 @@ pub fn primary_rays(
     rays: &mut Vec<NullRay>,
 ) {
     let mut px = Vec::with_capacity(coords.len());
-    image_points(coords, offset, sample, &mut px);
+    image_points(coords, offset, sample, 0, &mut px);
     rays.clear();
     rays.extend(px.iter().map(|&(x, y)| cam.ray(x, y)));
 }
@@ -186,7 +187,7 @@ pub fn trace_tile(
     let n = scene.image.samples;
     let mut found = 0;
     for s in 0..n {
-        image_points(&t.live_coords, t.offset, Some((s, n)), px);
+        image_points(&t.live_coords, t.offset, Some((s, n)), 0, px);
         world.primary_hits(cam, px, primary);
         found += primary.hit_count() as u64;
     }
@@ -347,6 +348,9 @@ pub struct View<'a> {
     pub cones: Option<&'a StarCones>,
     /// The glowing primitives, where the path integrator renders.
     pub emitters: Option<&'a Emitters>,
+    /// The index of the first sample of this round in each pixel's samples (a progressive
+    /// render's rounds; 0 otherwise).
+    pub sample_base: u32,
 }
 
 pub struct TilePixel {
@@ -435,14 +439,15 @@ pub fn render_tile<B: Band>(
     for s in 0..n + u32::from(aov_pass) {
         let centre = s == n;
         let sample = if centre { None } else { Some((s, n)) };
-        image_points(live_coords, offset, sample, px);
+        image_points(live_coords, offset, sample, view.sample_base, px);
         traced += coords.len() as u64;
         world.primary_hits(cam, px, primary);
         let colors = if centre {
             Vec::new()
         } else if let Some(t) = &tracer {
             let at = (live_coords.as_slice(), offset);
-            shade_paths(t, &shader, cam, primary, at, view.stars, s)
+            let index = view.sample_base + s;
+            shade_paths(t, &shader, cam, primary, at, view.stars, index)
         } else {
             shade_hits(
                 &shader,

@@ -10,6 +10,7 @@ mod fused_primary;
 mod instanced_lattice;
 mod light_buffer;
 mod many_groups;
+mod progressive;
 mod screen_cull;
 mod shadow_batches;
 mod slow_light;
