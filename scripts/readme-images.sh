@@ -28,6 +28,10 @@ $r render scenes/star_flight.toml -o "$o/stars-0.99.png" "${sky[@]}"
 # A textured OBJ model at rest and approaching at 0.9c, against the stars.
 $r render scenes/rocket.toml -o "$o/rocket-0.png" "${sky[@]}" --samples 4 --set 'group.rocket.velocity=[0, 0, 0]' --set 'camera.direction=[0, 1, 0]'
 $r render scenes/rocket.toml -o "$o/rocket-0.9.png" "${sky[@]}" --samples 4
+# Glowing spheres passing over a floor, lit by the path integrator: at rest, and at 0.7c.
+glow=(--width 384 --height 216 --samples 256 --quiet)
+$r render scenes/glowing_pass.toml -o "$o/glow-0.png" "${glow[@]}" --set 'group.lamps.velocity=[0, 0, 0]'
+$r render scenes/glowing_pass.toml -o "$o/glow-0.7.png" "${glow[@]}"
 # Six frames of the planet film, as one picture.
 film=$(mktemp -d)
 $r render scenes/planet_film.toml -o "$film/planet-####.png" --width 320 --height 180 --quiet --frames 12..46
