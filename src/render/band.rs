@@ -28,6 +28,11 @@ pub(crate) trait Band: Copy + Mul<f64, Output = Self> {
     fn splat(v: f64) -> Self;
     /// Its largest value over the wavelengths (or channels).
     fn max_value(&self) -> f64;
+    /// Its mean over the wavelengths (or channels).
+    fn mean_value(&self) -> f64;
+    /// e^(−v d) of each value v: the transmittance of a path of length d through a medium of
+    /// these attenuation coefficients.
+    fn exp_neg(&self, d: f64) -> Self;
     /// What the camera records of it (linear sRGB).
     fn to_rgb(&self) -> DVec3;
     /// `self *= o`, wavelength by wavelength.
@@ -62,6 +67,16 @@ impl Band for DVec3 {
     }
     fn max_value(&self) -> f64 {
         self.max_element()
+    }
+    fn mean_value(&self) -> f64 {
+        self.element_sum() / 3.0
+    }
+    fn exp_neg(&self, d: f64) -> Self {
+        DVec3::new(
+            (-self.x * d).exp(),
+            (-self.y * d).exp(),
+            (-self.z * d).exp(),
+        )
     }
     fn to_rgb(&self) -> DVec3 {
         *self
@@ -107,6 +122,12 @@ impl Band for Sampled {
     }
     fn max_value(&self) -> f64 {
         self.0.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+    fn mean_value(&self) -> f64 {
+        self.0.iter().sum::<f64>() / self.0.len() as f64
+    }
+    fn exp_neg(&self, d: f64) -> Self {
+        Sampled(self.0.map(|v| (-v * d).exp()))
     }
     fn to_rgb(&self) -> DVec3 {
         camera::rgb(self)

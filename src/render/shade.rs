@@ -75,6 +75,8 @@ pub struct Shader<'a, B> {
     /// material that reflects or transmits).
     cones: Option<&'a StarCones>,
     pub(super) seen: Seen,
+    /// Whether some material is only the boundary of a medium.
+    invisible: bool,
     band: PhantomData<B>,
 }
 
@@ -130,6 +132,7 @@ impl<'a, B: Band> Shader<'a, B> {
             sky,
             cones: None,
             seen,
+            invisible: scene.materials.iter().any(|m| m.is_invisible()),
             band: PhantomData,
         }
     }
@@ -346,7 +349,7 @@ impl<'a, B: Band> Shader<'a, B> {
             lit.event,
             lit.v,
         );
-        if mat.emission.is_some() {
+        if mat.emission.is_some() || mat.is_invisible() {
             shadows.extend(self.lights.iter().map(|_| None));
             return lit;
         }
@@ -381,6 +384,7 @@ impl<'a, B: Band> Shader<'a, B> {
             Some(ShadowQuery {
                 ray: NullRay::new(from, dir_w),
                 tmax: dist * k * (1.0 - 1e-9),
+                s: s_surface,
                 term: LightTerm {
                     shift: light_shift,
                     atten,
@@ -424,6 +428,8 @@ impl<'a, B: Band> Shader<'a, B> {
             corner_uv,
             prim,
             group: hit.group,
+            prim_id: hit.prim,
+            reach: hit.s * hit.lambda,
             event,
             v,
             nf,
@@ -441,6 +447,7 @@ impl<'a, B: Band> Shader<'a, B> {
     /// the object's own group is searched. The hit (its direction the unit rest-frame one, its
     /// lookback factor 1: no change of frame on the way) and the event; None where the ray
     /// meets nothing of its group (an object that is not closed), and leaves as a null ray.
+    /// The hit's lookback is 0: the caller accounts for the way (`dist`, the third value).
     pub(crate) fn inside_hit(
         &self,
         group: usize,
@@ -448,24 +455,138 @@ impl<'a, B: Band> Shader<'a, B> {
         side: DVec3,
         dir: DVec3,
         ior: f64,
-    ) -> Option<(SurfaceHit, Event)> {
+    ) -> Option<(SurfaceHit, Event, f64)> {
         let g = &self.world.groups[group];
         let from = g.boost.event(self.pushed_off(group, event, side));
         let (prim, t) = self.world.hit_in_group(group, from.x, dir)?;
         let point = from.x + t * dir;
         // The delay from the surface point itself (not the pushed-off start): exact.
         let entry = g.boost.event(event);
-        let at_rest = Event::new(entry.t - ior * (point - entry.x).length(), point);
+        let dist = (point - entry.x).length();
+        let at_rest = Event::new(entry.t - ior * dist, point);
         let at = g.boost.inverse().event(at_rest);
         let hit = SurfaceHit {
             group,
             prim,
-            lambda: event.t - at.t,
+            lambda: 0.0,
             point: at_rest.x,
             dir,
             s: 1.0,
         };
-        Some((hit, at))
+        Some((hit, at, dist))
+    }
+
+    /// The attenuation coefficient σ_a + σ_s of a material's medium at wavelengths `shift` times
+    /// the camera's (None: it has none).
+    pub(super) fn sigma_t(&self, material: u32, shift: f64) -> Option<B> {
+        let m = self.scene.materials[material as usize].medium.as_ref()?;
+        let at = B::at(shift);
+        let mut t = B::of(&m.sigma_a, at);
+        t.add(&B::of(&m.sigma_s, at));
+        Some(t)
+    }
+
+    /// The share of light that crosses a length `d` (its rest frame) of a material's medium, at
+    /// wavelengths `shift` times the camera's (Beer-Lambert; None: no medium, all of it).
+    fn attenuation(&self, material: u32, shift: f64, d: f64) -> Option<B> {
+        self.sigma_t(material, shift).map(|s| s.exp_neg(d))
+    }
+
+    /// Whether some object's surface is only the boundary of a medium (then shadow rays cross
+    /// such surfaces, attenuated, instead of stopping at them).
+    pub(super) fn has_invisible(&self) -> bool {
+        self.invisible
+    }
+
+    /// The share of light that reaches the start of a shadow ray from lookback `tmax` along it,
+    /// crossing the boundaries of media (attenuated in each, in its own frame) and stopped by
+    /// any other surface (None). `within`: the medium the ray starts in (world group and
+    /// material); `shift`: the wavelengths of the ray's start, `s` its frame's lookback factor
+    /// for the ray (the medium's own wavelengths follow from the two frames).
+    pub(super) fn transmittance(
+        &self,
+        ray: &NullRay,
+        tmax: f64,
+        mut within: Option<(usize, u32)>,
+        shift: f64,
+        s: f64,
+    ) -> Option<B> {
+        let mut share: Option<B> = None;
+        let mut cross = |within: Option<(usize, u32)>, from: f64, to: f64| {
+            let Some((g, m)) = within else {
+                return;
+            };
+            let gs = self.world.groups[g].boost.null_dir(ray.dir).1;
+            let shift_m = self.seen.radiance(s / gs, shift).0;
+            if let Some(a) = self.attenuation(m, shift_m, gs * (to - from)) {
+                match &mut share {
+                    Some(t) => t.mul_by(&a),
+                    None => share = Some(a),
+                }
+            }
+        };
+        let mut t0 = 0.0;
+        loop {
+            let Some(h) = self.world.closest_hit(ray, t0).filter(|h| h.lambda < tmax) else {
+                cross(within, t0, tmax);
+                return Some(share.unwrap_or(B::splat(1.0)));
+            };
+            let g = &self.world.groups[h.group];
+            let material = g.geometry.part_of(h.prim).material;
+            if !self.scene.materials[material as usize].is_invisible() {
+                return None;
+            }
+            let exiting = g.geometry.prim(h.prim).normal(h.point).dot(h.dir) > 0.0;
+            // Leaving a medium not entered on the way: the ray started in it (media are
+            // closed and not nested).
+            if exiting && within.is_none() {
+                within = Some((h.group, material));
+            }
+            cross(within, t0, h.lambda);
+            within = (!exiting).then_some((h.group, material));
+            // Past the boundary, by its group's ε (rest frame) in world lookback.
+            t0 = h.lambda + g.epsilon / h.s;
+        }
+    }
+
+    /// What a ray that meets the invisible boundary of a medium (`lit`) sees beyond it: going
+    /// in, the first surface of the object's group inside (its own far side, or an object in
+    /// the medium), attenuated by the medium over the way (Beer-Lambert, rest frame), and
+    /// through the far side what lies beyond; coming out, what lies beyond. The ray keeps its
+    /// direction: the boundary bends nothing.
+    fn pass_through(&self, lit: &Lit, budget: Budget) -> (B, u64) {
+        let outward = lit.v.dot(lit.n) > 0.0;
+        let side = if outward { lit.n } else { -lit.n };
+        let material = self.world.groups[lit.group]
+            .geometry
+            .part_of(lit.prim_id)
+            .material;
+        if !outward {
+            if let Some((h, at, d)) = self.inside_hit(lit.group, lit.event, side, lit.v, 1.0) {
+                let (mut light, spent) = self.shade_at(&h, at, lit.shift, budget, lit.spread);
+                if let Some(a) = self.attenuation(material, lit.shift, d) {
+                    light.mul_by(&a);
+                }
+                return (light, spent);
+            }
+        }
+        let r = self.spawn(lit.group, lit.event, side, lit.v);
+        let s = self.lookback_factor(lit.group, r.dir);
+        let spread = match self.cones {
+            Some(_) if lit.spread > 0.0 => Spread {
+                sr: lit.spread,
+                s: self.world.groups[lit.group].boost.null_dir(r.dir).1,
+            },
+            _ => Spread::NONE,
+        };
+        let (mut light, spent) = self.trace(&r, s, lit.shift, budget, spread);
+        // Coming out of a medium the ray started in (a camera in a fog bank): its way in it.
+        if outward && lit.reach > 0.0 {
+            if let Some(a) = self.attenuation(material, lit.shift, lit.reach) {
+                light.mul_by(&a);
+            }
+        }
+        (light, spent)
     }
 
     /// The colour of a prepared hit, given its shadow rays and `reaches(light, query)`: whether
@@ -478,6 +599,9 @@ impl<'a, B: Band> Shader<'a, B> {
         budget: Budget,
     ) -> (B, u64) {
         let (mat, at) = (lit.mat, B::at(lit.shift));
+        if mat.is_invisible() {
+            return self.pass_through(lit, budget);
+        }
         if let Some(e) = &mat.emission {
             return (
                 surface_colour(e, mat.emission_texture.as_deref(), lit, at),
@@ -489,9 +613,24 @@ impl<'a, B: Band> Shader<'a, B> {
         color.mul_by(&diffuse);
         let specular = (!mat.specular.is_black()).then(|| B::of(&mat.specular, at));
         for (l, q) in shadows.iter().enumerate() {
-            if let Some(q) = q.as_ref().filter(|q| reaches(l, q)) {
+            let Some(q) = q else {
+                continue;
+            };
+            // Through media the light arrives attenuated; otherwise it arrives or it does not.
+            let through = match self.invisible {
+                true => match self.transmittance(&q.ray, q.tmax, None, lit.shift, q.s) {
+                    Some(t) => Some(t),
+                    None => continue,
+                },
+                false if reaches(l, q) => None,
+                false => continue,
+            };
+            {
                 let t = &q.term;
-                let light = B::of(&self.lights[l].light.radiance, B::at(t.shift));
+                let mut light = B::of(&self.lights[l].light.radiance, B::at(t.shift));
+                if let Some(through) = &through {
+                    light.mul_by(through);
+                }
                 let glint = specular.as_ref().zip(t.highlight);
                 color.add_lit(&light, t.atten, &diffuse, t.ndl, glint, t.k);
             }
@@ -531,9 +670,14 @@ impl<'a, B: Band> Shader<'a, B> {
                 };
                 // Into a glass object, light is slower (`inside_hit`) and never changes frame.
                 if mat.transmit > 0.0 && dir.dot(lit.n) < 0.0 {
-                    if let Some((h, at)) = self.inside_hit(lit.group, event, side, dir, mat.ior) {
+                    if let Some((h, at, d)) = self.inside_hit(lit.group, event, side, dir, mat.ior)
+                    {
                         let sr = lit.spread;
-                        let (light, spent) = self.shade_at(&h, at, lit.shift, b, sr);
+                        let (mut light, spent) = self.shade_at(&h, at, lit.shift, b, sr);
+                        let material = self.world.groups[lit.group].geometry.part_of(lit.prim_id);
+                        if let Some(a) = self.attenuation(material.material, lit.shift, d) {
+                            light.mul_by(&a);
+                        }
                         *seen = Some(light);
                         return 1 + spent;
                     }
@@ -593,6 +737,8 @@ fn texel<B: Band>(img: &crate::scene::ImageTexture, rgb: DVec3, at: B::At) -> B 
 pub struct ShadowQuery {
     pub ray: NullRay,
     pub tmax: f64,
+    /// The surface frame's lookback factor for the ray (ν_surface / ν_world).
+    s: f64,
     term: LightTerm,
 }
 
@@ -621,6 +767,11 @@ pub struct Lit<'a> {
     prim: crate::geometry::Primitive,
     corner_uv: Option<[f64; 2]>,
     pub(super) group: usize,
+    /// The primitive hit (its index in its group).
+    pub(super) prim_id: u32,
+    /// How far the ray came to the hit in the surface's frame (0 for a ray inside an object,
+    /// whose way the caller accounts for).
+    pub(super) reach: f64,
     pub(super) event: Event,
     pub(super) v: DVec3,
     pub(super) nf: DVec3,

@@ -328,9 +328,8 @@ fn shade_paths<B: Band>(
             let (x, y) = (coords[i].0 + ox, coords[i].1 + oy);
             match primary.hit(i) {
                 Some(h) => {
-                    let (shift, k) = shader.arriving(camera_s, h.s, 1.0);
                     let mut rng = sample_rng(seed, x, y, sample);
-                    tracer.radiance(&ray, &h, shift, &mut rng).to_rgb() * k
+                    tracer.camera_path(&ray, &h, camera_s, &mut rng).to_rgb()
                 }
                 None if black_sky => DVec3::ZERO,
                 None => missed(shader, camera_s, ray.dir, stars, (x, y)),

@@ -21,8 +21,8 @@ mod transform;
 pub use error::SceneError;
 pub use load::{load_file, load_file_as, load_str, FrameSize};
 pub use model::{
-    Camera, Film, FrameSpacing, Group, ImageSettings, Integrator, Light, Material, ObjectInfo,
-    Projection, RenderSettings, Scene, MAX_FRAMES, MAX_FRAME_PIXELS, MAX_RAYS,
+    Camera, Film, FrameSpacing, Group, ImageSettings, Integrator, Light, Material, Medium,
+    ObjectInfo, Projection, RenderSettings, Scene, MAX_FRAMES, MAX_FRAME_PIXELS, MAX_RAYS,
 };
 pub use pass_set::{Pass, PassSet};
 pub use texture::{ImageTexture, Sample as TextureSample, Sky, Texture};

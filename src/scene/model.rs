@@ -228,6 +228,10 @@ pub struct Material {
     pub roughness: f64,
     /// Radiance emitted in the surface's rest frame (the surface then reflects nothing).
     pub emission: Option<Colour>,
+    /// What fills the object (`medium`): light inside is absorbed and scattered. With
+    /// `transmit` 0 the object's surface is invisible (a fog bank); with `transmit` it is glass
+    /// (coloured or murky).
+    pub medium: Option<Medium>,
     /// A texture giving the diffuse reflectance in place of `color`.
     pub color_texture: Option<std::sync::Arc<super::Texture>>,
     /// A texture giving the emitted radiance in place of `emission` (which then holds its first
@@ -235,12 +239,30 @@ pub struct Material {
     pub emission_texture: Option<std::sync::Arc<super::Texture>>,
 }
 
+/// A homogeneous medium at rest in its object's frame: absorption and scattering coefficients
+/// (per unit length, spectra) and the Henyey-Greenstein asymmetry g of its scattering.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Medium {
+    /// Absorption per unit length.
+    pub sigma_a: Colour,
+    /// Scattering per unit length.
+    pub sigma_s: Colour,
+    /// −1 (back) to 1 (forward); 0 scatters alike in every direction.
+    pub g: f64,
+}
+
 impl Material {
+    /// Whether the surface is only the boundary of a medium: light crosses it unchanged.
+    pub fn is_invisible(&self) -> bool {
+        self.medium.is_some() && self.transmit == 0.0
+    }
+
     /// Every colour the material may show: its own and its textures'.
     pub fn colours(&self) -> impl Iterator<Item = &Colour> {
         [&self.color, &self.specular]
             .into_iter()
             .chain(self.emission.as_ref())
+            .chain(self.medium.iter().flat_map(|m| [&m.sigma_a, &m.sigma_s]))
             .chain(self.color_texture.iter().flat_map(|t| t.colours()))
             .chain(self.emission_texture.iter().flat_map(|t| t.colours()))
     }
@@ -256,6 +278,7 @@ impl Material {
             transmit: 0.0,
             ior: 1.5,
             roughness: 0.0,
+            medium: None,
             emission: None,
             color_texture: None,
             emission_texture: None,

@@ -4,7 +4,7 @@
 use super::model::Material;
 use super::reader::{SceneResult, Table};
 use super::Texture;
-use crate::spectrum::Role;
+use crate::spectrum::{Colour, Role};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -258,6 +258,45 @@ fn colour_or_texture(
     Ok((Some(first), Some(texture)))
 }
 
+/// `medium = { sigma_a, sigma_s, g }`: coefficients per unit length, any non-negative colour
+/// (RGB is read as a reflectance scaled by its largest component, so a grey is flat).
+fn medium(t: &Table) -> SceneResult<crate::scene::Medium> {
+    let coefficient = |key: &str| -> SceneResult<Colour> {
+        let Some(c) = t.colour(key, Role::Emitter)? else {
+            return Ok(Colour::grey(0.0, Role::Reflectance));
+        };
+        if !c.from_rgb {
+            return Ok(c);
+        }
+        let m = c.rgb.max_element();
+        if c.rgb.min_element() < 0.0 || !m.is_finite() {
+            return Err(t.error(key, "must be 0 or more per unit length"));
+        }
+        if m == 0.0 {
+            return Ok(Colour::grey(0.0, Role::Reflectance));
+        }
+        Ok(Colour::rgb(c.rgb / m, Role::Reflectance).scaled(m))
+    };
+    if !t.has("sigma_a") && !t.has("sigma_s") {
+        return Err(t.error(
+            "sigma_a",
+            "missing: give `sigma_a` (absorption) or `sigma_s` (scattering) per unit length",
+        ));
+    }
+    let m = crate::scene::Medium {
+        sigma_a: coefficient("sigma_a")?,
+        sigma_s: coefficient("sigma_s")?,
+        g: t.f64_where(
+            "g",
+            Some(0.0),
+            |g| g > -1.0 && g < 1.0,
+            "between -1 and 1 (not either)",
+        )?,
+    };
+    t.finish(&["sigma_a", "sigma_s", "g"])?;
+    Ok(m)
+}
+
 pub(super) fn material(t: &Table, textures: &[ReadTexture]) -> SceneResult<Material> {
     let d = Material::default_white();
     let unit = |v: f64| (0.0..=1.0).contains(&v);
@@ -277,8 +316,31 @@ pub(super) fn material(t: &Table, textures: &[ReadTexture]) -> SceneResult<Mater
         emission,
         color_texture,
         emission_texture,
+        medium: match t.table("medium")? {
+            Some(m) => Some(medium(&m)?),
+            None => None,
+        },
     };
+    if m.is_invisible() {
+        // Its surface is nothing but where the medium begins: what would shade it is a mistake.
+        for key in ["color", "specular", "reflect", "roughness", "emission"] {
+            if t.has(key) {
+                return Err(t.error(
+                    key,
+                    "a material with a `medium` and no `transmit` has no surface (light crosses \
+                     it unchanged): leave this out, or give `transmit` for a glass boundary",
+                ));
+            }
+        }
+    }
+    if m.medium.is_some() && m.emission.is_some() {
+        return Err(t.error(
+            "emission",
+            "a medium does not glow (give its object another material)",
+        ));
+    }
     t.finish(&[
+        "medium",
         "name",
         "color",
         "specular",

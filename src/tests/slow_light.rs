@@ -60,10 +60,14 @@ fn light_crossing_a_moving_slab_is_dragged_as_fizeau_found() {
                     (dir - DVec3::NEG_X).length() < 1e-12,
                     "along the axis in its frame"
                 );
-                let (_, exit) = shader
+                let (_, exit, dist) = shader
                     .inside_hit(hit.group, entry, DVec3::NEG_X, dir, n)
                     .expect("the back face");
                 let delay = entry.t - exit.t;
+                assert!(
+                    (dist - 2.0).abs() < 1e-9,
+                    "the way through, rest frame: {dist}"
+                );
                 let gamma = 1.0 / (1.0 - beta * beta).sqrt();
                 let u = (1.0 / n + beta) / (1.0 + beta / n);
                 let want = 2.0 / (gamma * (u - beta));

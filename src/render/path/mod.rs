@@ -10,12 +10,13 @@
 
 mod bsdf;
 mod emitters;
+mod phase;
 
 pub(crate) use emitters::Emitters;
 
 use super::band::Band;
 use super::sampler::splitmix;
-use super::shade::{surface_colour, Lit, Shader};
+use super::shade::{surface_colour, Shader};
 use super::world::SurfaceHit;
 use crate::rng::Rng;
 use crate::spacetime::{Event, NullRay};
@@ -64,94 +65,392 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         }
     }
 
-    /// The light leaving `hit` (met by `ray`) back along the ray, in the hit's frame at
-    /// wavelengths `shift` times the camera's: one path's estimate.
-    pub fn radiance(&self, ray: &NullRay, hit: &SurfaceHit, shift: f64, rng: &mut Rng) -> B {
-        let sh = self.shader;
-        let world = sh.world;
+    /// The light a camera ray brings to the camera (its lookback factor `camera_s` for the
+    /// ray, as the switches have it), which first meets `first`: one path's estimate, at the
+    /// camera's wavelengths.
+    pub fn camera_path(
+        &self,
+        ray: &NullRay,
+        first: &SurfaceHit,
+        camera_s: f64,
+        rng: &mut Rng,
+    ) -> B {
         let mut out = B::splat(0.0);
-        let mut beta = B::splat(1.0);
-        let (mut hit, mut event, mut shift) = (*hit, ray.at(hit.lambda), shift);
-        let mut came: Option<Came> = None;
+        let mut path = Path {
+            beta: B::splat(1.0),
+            shift: 1.0,
+            came: None,
+        };
+        let mut leg = Leg::Null {
+            ray: *ray,
+            receiver_s: camera_s,
+            within: None,
+            first: Some(*first),
+        };
         for depth in 0.. {
-            let lit = sh.lit_at(&hit, event, shift);
-            let (mat, at) = (lit.mat, B::at(shift));
-            if let Some(e) = &mat.emission {
-                let weight = came.as_ref().map_or(1.0, |c| self.mis_met(c, &hit));
-                let mut le = surface_colour::<B>(e, mat.emission_texture.as_deref(), &lit, at);
-                le.mul_by(&beta);
-                out.add(&(le * weight));
-                break;
-            }
-            // Past the last bounce a vertex only says what light it sends (above).
-            if depth > self.max_depth {
-                break;
-            }
-            let diffuse = surface_colour::<B>(&mat.color, mat.color_texture.as_deref(), &lit, at);
-            let phong =
-                (!mat.specular.is_black()).then(|| (B::of(&mat.specular, at), mat.shininess));
-            let eta = if lit.inside { 1.0 / mat.ior } else { mat.ior };
-            let lobes = Lobes::new(
-                diffuse,
-                phong,
-                mat.reflect,
-                mat.transmit,
-                mat.roughness,
-                eta,
-            );
-            if lobes.is_black() {
-                break;
-            }
-            let basis = Basis::new(lit.nf);
-            let wo = basis.to_local(-lit.v);
-            if lobes.has_glossy() {
-                self.point_lights(&lit, &lobes, &basis, wo, &beta, &mut out);
-                self.emitter_light(&lit, &lobes, &basis, wo, &beta, rng, &mut out);
-            }
-            let u = [rng.f(), rng.f(), rng.f(), rng.f()];
-            let Some(bs) = lobes.sample(wo, u) else {
-                break;
+            let reached = match leg {
+                Leg::Null {
+                    ray,
+                    receiver_s,
+                    within,
+                    first,
+                } => self.walk(&ray, receiver_s, within, first, &mut path, rng),
+                Leg::Slow {
+                    group,
+                    event,
+                    side,
+                    dir,
+                    material,
+                    outside,
+                } => self.walk_inside(group, event, side, dir, material, outside, &mut path, rng),
             };
-            beta.mul_by(&bs.weight);
-            if depth + 1 >= ROULETTE_FROM && depth < self.max_depth {
-                let q = beta.max_value().min(ROULETTE_MAX);
-                // A NaN q ends the path too.
-                if q.is_nan() || q <= 0.0 || rng.f() >= q {
-                    break;
+            let next = match reached {
+                Reached::Sky { dir, receiver_s } => {
+                    let mut sky = self.shader.background_along(dir, receiver_s, path.shift);
+                    sky.mul_by(&path.beta);
+                    out.add(&sky);
+                    None
                 }
-                beta = beta * (1.0 / q);
-            }
-            let wi = basis.to_world(bs.wi);
-            let side = if bs.wi.z > 0.0 { lit.nf } else { -lit.nf };
-            let pdf = (!bs.delta).then_some(bs.pdf);
-            // Into a glass object: slower light, and no change of frame.
-            if mat.transmit > 0.0 && wi.dot(lit.n) < 0.0 {
-                if let Some((h, at_event)) = sh.inside_hit(lit.group, event, side, wi, mat.ior) {
-                    let from = sh.pushed_off(lit.group, event, side);
-                    came = pdf.map(|pdf| Came { pdf, from, s: 1.0 });
-                    (hit, event) = (h, at_event);
-                    continue;
+                Reached::Surface { hit, event, within } => {
+                    self.at_surface(&hit, event, within, depth, &mut path, rng, &mut out)
                 }
-            }
-            let r = sh.spawn(lit.group, event, side, wi);
-            let receiver_s = sh.lookback_factor(lit.group, r.dir);
-            let Some(h) = world.closest_hit(&r, 0.0) else {
-                let mut sky = sh.background_along(r.dir, receiver_s, shift);
-                sky.mul_by(&beta);
-                out.add(&sky);
-                break;
+                Reached::Scatter(at) => self.in_medium(&at, depth, &mut path, rng, &mut out),
+                Reached::Lost => None,
             };
-            let (shift_h, k) = sh.arriving(receiver_s, h.s, shift);
-            beta = beta * k;
-            let s = world.groups[lit.group].boost.null_dir(r.dir).1;
-            came = pdf.map(|pdf| Came {
-                pdf,
-                from: r.origin,
-                s,
-            });
-            (hit, event, shift) = (h, r.at(h.lambda), shift_h);
+            match next {
+                Some(l) => leg = l,
+                None => break,
+            }
         }
         out
+    }
+
+    /// Follow a null ray from its receiver (lookback factor `receiver_s`, as the switches have
+    /// it) until it meets a surface or scatters in a medium, crossing the boundaries of media
+    /// as it goes (`within`: the medium it starts in). The throughput and the wavelengths are
+    /// carried into the frame of what it reaches. `first`: its first hit, where known.
+    fn walk(
+        &self,
+        ray: &NullRay,
+        receiver_s: f64,
+        mut within: Option<(usize, u32)>,
+        first: Option<SurfaceHit>,
+        path: &mut Path<B>,
+        rng: &mut Rng,
+    ) -> Reached {
+        let (sh, world) = (self.shader, self.shader.world);
+        let mut t = 0.0;
+        let mut known = first;
+        loop {
+            let hit = known.take().or_else(|| world.closest_hit(ray, t));
+            if let Some((g, m)) = within {
+                // Free flight through the medium, in its frame.
+                let gs = world.groups[g].boost.null_dir(ray.dir).1;
+                let (shift_m, _) =
+                    sh.arriving(receiver_s, sh.lookback_factor(g, ray.dir), path.shift);
+                let end = hit.map_or(f64::INFINITY, |h| h.lambda);
+                match self.fly(m, shift_m, gs * (end - t), path, rng) {
+                    Some(ts) => {
+                        let lambda = t + ts / gs;
+                        let (shift_g, k) =
+                            sh.arriving(receiver_s, sh.lookback_factor(g, ray.dir), path.shift);
+                        path.beta = path.beta * k;
+                        path.shift = shift_g;
+                        return Reached::Scatter(Scatter {
+                            group: g,
+                            material: m,
+                            event: ray.at(lambda),
+                            look: world.groups[g].boost.view_dir(ray.dir).0,
+                            slow: None,
+                        });
+                    }
+                    None if hit.is_none() => return Reached::Lost,
+                    None => {}
+                }
+            }
+            let Some(h) = hit else {
+                return Reached::Sky {
+                    dir: ray.dir,
+                    receiver_s,
+                };
+            };
+            let part = world.groups[h.group].geometry.part_of(h.prim);
+            if !sh.scene.materials[part.material as usize].is_invisible() {
+                let (shift_h, k) = sh.arriving(receiver_s, h.s, path.shift);
+                path.beta = path.beta * k;
+                path.shift = shift_h;
+                return Reached::Surface {
+                    hit: h,
+                    event: ray.at(h.lambda),
+                    within,
+                };
+            }
+            let g = &world.groups[h.group];
+            let exiting = g.geometry.prim(h.prim).normal(h.point).dot(h.dir) > 0.0;
+            within = (!exiting).then_some((h.group, part.material));
+            t = h.lambda + g.epsilon / h.s;
+        }
+    }
+
+    /// Follow a ray inside a glass object (its group's frame, light at c/n, `Shader::inside_hit`)
+    /// to its next surface, or to where it scatters in the object's medium.
+    #[allow(clippy::too_many_arguments)]
+    fn walk_inside(
+        &self,
+        group: usize,
+        event: Event,
+        side: DVec3,
+        dir: DVec3,
+        material: u32,
+        outside: Option<(usize, u32)>,
+        path: &mut Path<B>,
+        rng: &mut Rng,
+    ) -> Reached {
+        let sh = self.shader;
+        let ior = sh.scene.materials[material as usize].ior;
+        let Some((h, at, d)) = sh.inside_hit(group, event, side, dir, ior) else {
+            // Not closed: the ray leaves as a null ray.
+            let r = sh.spawn(group, event, side, dir);
+            let receiver_s = sh.lookback_factor(group, r.dir);
+            return self.walk(&r, receiver_s, outside, None, path, rng);
+        };
+        // The way is in the object's frame: no change of wavelengths; the throughput changes
+        // by the medium alone (`fly` sees to it).
+        let from = sh.pushed_off(group, event, side);
+        if sh.scene.materials[material as usize].medium.is_some() {
+            if let Some(ts) = self.fly(material, path.shift, d, path, rng) {
+                let g = &sh.world.groups[group];
+                let start = g.boost.event(event);
+                let point = g.boost.event(from).x + ts * dir;
+                let at_rest = Event::new(start.t - ior * (point - start.x).length(), point);
+                return Reached::Scatter(Scatter {
+                    group,
+                    material,
+                    event: g.boost.inverse().event(at_rest),
+                    look: dir,
+                    slow: Some(outside),
+                });
+            }
+        }
+        Reached::Surface {
+            hit: h,
+            event: at,
+            within: outside,
+        }
+    }
+
+    /// Free flight over a rest-frame length `d` of material `m`'s medium (wavelengths `shift`
+    /// times the camera's): a distance drawn with density σ̄ e^(−σ̄ t), σ̄ the mean attenuation
+    /// over the band; Some(t) where it falls short of `d` (the light scattered there), the
+    /// throughput weighed by σ_s e^(−σ_t t) / (σ̄ e^(−σ̄ t)); else by e^(−σ_t d) / e^(−σ̄ d).
+    fn fly(&self, m: u32, shift: f64, d: f64, path: &mut Path<B>, rng: &mut Rng) -> Option<f64> {
+        let sh = self.shader;
+        let sigma_t = sh.sigma_t(m, shift)?;
+        let mean = sigma_t.mean_value();
+        if mean <= 0.0 {
+            return None;
+        }
+        let medium = sh.scene.materials[m as usize]
+            .medium
+            .as_ref()
+            .expect("a medium");
+        let sigma_s = B::of(&medium.sigma_s, B::at(shift));
+        // A medium that only absorbs: Beer-Lambert, no draw.
+        if sigma_s.max_value() <= 0.0 {
+            if d.is_finite() {
+                path.beta.mul_by(&sigma_t.exp_neg(d));
+            } else {
+                path.beta = path.beta * 0.0;
+            }
+            return None;
+        }
+        let ts = -(1.0 - rng.f()).ln() / mean;
+        if ts < d {
+            let mut w = sigma_s;
+            w.mul_by(&sigma_t.exp_neg(ts));
+            path.beta.mul_by(&(w * (1.0 / (mean * (-mean * ts).exp()))));
+            return Some(ts);
+        }
+        if d.is_finite() {
+            path.beta.mul_by(&(sigma_t.exp_neg(d) * (mean * d).exp()));
+        }
+        None
+    }
+
+    /// Shade a surface the path met: its light if it glows, the lights it gathers, and the next
+    /// leg (None: the path ends).
+    #[allow(clippy::too_many_arguments)]
+    fn at_surface(
+        &self,
+        hit: &SurfaceHit,
+        event: Event,
+        within: Option<(usize, u32)>,
+        depth: u32,
+        path: &mut Path<B>,
+        rng: &mut Rng,
+        out: &mut B,
+    ) -> Option<Leg> {
+        let sh = self.shader;
+        let lit = sh.lit_at(hit, event, path.shift);
+        let (mat, at) = (lit.mat, B::at(path.shift));
+        if let Some(e) = &mat.emission {
+            let weight = path.came.as_ref().map_or(1.0, |c| self.mis_met(c, hit));
+            let mut le = surface_colour::<B>(e, mat.emission_texture.as_deref(), &lit, at);
+            le.mul_by(&path.beta);
+            out.add(&(le * weight));
+            return None;
+        }
+        // Past the last bounce a vertex only says what light it sends (above).
+        if depth > self.max_depth {
+            return None;
+        }
+        let diffuse = surface_colour::<B>(&mat.color, mat.color_texture.as_deref(), &lit, at);
+        let phong = (!mat.specular.is_black()).then(|| (B::of(&mat.specular, at), mat.shininess));
+        let eta = if lit.inside { 1.0 / mat.ior } else { mat.ior };
+        let lobes = Lobes::new(
+            diffuse,
+            phong,
+            mat.reflect,
+            mat.transmit,
+            mat.roughness,
+            eta,
+        );
+        if lobes.is_black() {
+            return None;
+        }
+        let basis = Basis::new(lit.nf);
+        let wo = basis.to_local(-lit.v);
+        let here = Gather {
+            group: lit.group,
+            event: lit.event,
+            shift: lit.shift,
+            nf: Some(lit.nf),
+            within,
+        };
+        if lobes.has_glossy() {
+            let scatter = |wi: DVec3| {
+                let l = basis.to_local(wi);
+                let (f, pdf) = lobes.eval(wo, l);
+                (f * l.z.abs(), pdf)
+            };
+            self.gather(&here, &scatter, &path.beta, rng, out);
+        }
+        let u = [rng.f(), rng.f(), rng.f(), rng.f()];
+        let bs = lobes.sample(wo, u)?;
+        path.beta.mul_by(&bs.weight);
+        self.roulette(depth, path, rng)?;
+        let wi = basis.to_world(bs.wi);
+        let side = if bs.wi.z > 0.0 { lit.nf } else { -lit.nf };
+        let pdf = (!bs.delta).then_some(bs.pdf);
+        let from = sh.pushed_off(lit.group, lit.event, side);
+        // Into a glass object: slower light, no change of frame, maybe a medium.
+        if mat.transmit > 0.0 && wi.dot(lit.n) < 0.0 {
+            path.came = pdf.map(|pdf| Came { pdf, from, s: 1.0 });
+            return Some(Leg::Slow {
+                group: lit.group,
+                event: lit.event,
+                side,
+                dir: wi,
+                material: sh.world.groups[lit.group]
+                    .geometry
+                    .part_of(hit.prim)
+                    .material,
+                outside: within,
+            });
+        }
+        let r = sh.spawn(lit.group, lit.event, side, wi);
+        let s = sh.world.groups[lit.group].boost.null_dir(r.dir).1;
+        path.came = pdf.map(|pdf| Came {
+            pdf,
+            from: r.origin,
+            s,
+        });
+        Some(Leg::Null {
+            ray: r,
+            receiver_s: sh.lookback_factor(lit.group, r.dir),
+            within,
+            first: None,
+        })
+    }
+
+    /// A point where the path's light scattered in a medium: the lights it gathers there, and
+    /// the next leg, drawn from the medium's phase function.
+    fn in_medium(
+        &self,
+        at: &Scatter,
+        depth: u32,
+        path: &mut Path<B>,
+        rng: &mut Rng,
+        out: &mut B,
+    ) -> Option<Leg> {
+        if depth > self.max_depth {
+            return None;
+        }
+        let sh = self.shader;
+        let medium = sh.scene.materials[at.material as usize].medium.as_ref()?;
+        let phase = phase::Hg::new(medium.g);
+        let wo = -at.look;
+        let here = Gather {
+            group: at.group,
+            event: at.event,
+            shift: path.shift,
+            nf: None,
+            within: Some((at.group, at.material)),
+        };
+        // Inside glass the shadow rays meet the glass: only light that refracts in arrives.
+        if at.slow.is_none() {
+            let scatter = |wi: DVec3| {
+                let p = phase.eval(wo, wi);
+                (B::splat(p), p)
+            };
+            self.gather(&here, &scatter, &path.beta, rng, out);
+        }
+        let (wi, pdf) = phase.sample(wo, rng.f(), rng.f());
+        self.roulette(depth, path, rng)?;
+        let s = match at.slow {
+            Some(_) => 1.0,
+            None => {
+                let dir_w = sh.world.groups[at.group].boost.inverse().view_dir(wi).0;
+                sh.world.groups[at.group].boost.null_dir(dir_w).1
+            }
+        };
+        path.came = Some(Came {
+            pdf,
+            from: at.event,
+            s,
+        });
+        Some(match at.slow {
+            Some(outside) => Leg::Slow {
+                group: at.group,
+                event: at.event,
+                side: DVec3::ZERO,
+                dir: wi,
+                material: at.material,
+                outside,
+            },
+            None => {
+                let r = sh.spawn(at.group, at.event, DVec3::ZERO, wi);
+                Leg::Null {
+                    ray: r,
+                    receiver_s: sh.lookback_factor(at.group, r.dir),
+                    within: Some((at.group, at.material)),
+                    first: None,
+                }
+            }
+        })
+    }
+
+    /// Russian roulette from the third bounce: None where the path ends.
+    fn roulette(&self, depth: u32, path: &mut Path<B>, rng: &mut Rng) -> Option<()> {
+        if depth + 1 >= ROULETTE_FROM && depth < self.max_depth {
+            let q = path.beta.max_value().min(ROULETTE_MAX);
+            // A NaN q ends the path too.
+            if q.is_nan() || q <= 0.0 || rng.f() >= q {
+                return None;
+            }
+            path.beta = path.beta * (1.0 / q);
+        }
+        Some(())
     }
 
     /// The weight of an emitter a BSDF draw met (power heuristic against next-event
@@ -168,64 +467,108 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         power(came.pdf, p_pick * pdf_e * d * d)
     }
 
-    /// `beta` times the light of every point light that reaches the vertex, to `out`.
+    /// Whether the way from `here` back along a shadow ray (`ray`, to lookback `tmax`) is clear,
+    /// and what share of the light crosses it: media attenuate it (where the scene has any
+    /// whose surface is invisible), any other surface stops it (None).
+    fn reaches(
+        &self,
+        here: &Gather,
+        ray: &NullRay,
+        tmax: f64,
+        light: Option<usize>,
+    ) -> Option<Option<B>> {
+        let sh = self.shader;
+        if sh.has_invisible() {
+            let s = sh.world.groups[here.group].boost.null_dir(ray.dir).1;
+            return sh
+                .transmittance(ray, tmax, here.within, here.shift, s)
+                .map(Some);
+        }
+        let blocked = match light {
+            None => sh.world.occluded(ray, 0.0, tmax),
+            Some(l) => sh.world.shadowed(l, ray, tmax),
+        };
+        (!blocked).then_some(None)
+    }
+
+    /// `beta` times the light `here` gathers from every point light and one glowing primitive
+    /// (next-event estimation), to `out`. `scatter(wi)`: for light arriving from rest-frame
+    /// direction `wi`, the factor on its radiance (BSDF times cosine, or the phase function)
+    /// and the density with which the vertex's own draw would have chosen `wi`.
+    fn gather(
+        &self,
+        here: &Gather,
+        scatter: &dyn Fn(DVec3) -> (B, f64),
+        beta: &B,
+        rng: &mut Rng,
+        out: &mut B,
+    ) {
+        self.point_lights(here, scatter, beta, out);
+        self.emitter_light(here, scatter, beta, rng, out);
+    }
+
+    /// The start of a shadow ray toward rest-frame direction `toward`: ε off the surface on
+    /// that side (a point in a medium starts where it is).
+    fn shadow_start(&self, here: &Gather, toward: DVec3) -> Event {
+        match here.nf {
+            Some(nf) => {
+                let side = if toward.dot(nf) > 0.0 { nf } else { -nf };
+                self.shader.pushed_off(here.group, here.event, side)
+            }
+            None => here.event,
+        }
+    }
+
     fn point_lights(
         &self,
-        lit: &Lit,
-        lobes: &Lobes<B>,
-        basis: &Basis,
-        wo: DVec3,
+        here: &Gather,
+        scatter: &dyn Fn(DVec3) -> (B, f64),
         beta: &B,
         out: &mut B,
     ) {
         let sh = self.shader;
-        let g = &sh.world.groups[lit.group];
+        let g = &sh.world.groups[here.group];
         for (i, l) in sh.lights.iter().enumerate() {
-            let mut from = sh.pushed_off(lit.group, lit.event, lit.nf);
-            let Some(mut to) = l.toward(from, g) else {
+            let Some(first) = l.toward(here.event, g) else {
                 continue;
             };
-            // Through a rough glass: the shadow ray leaves from the far side.
-            if to.to_light.dot(lit.nf) < 0.0 {
-                from = sh.pushed_off(lit.group, lit.event, -lit.nf);
-                let Some(t) = l.toward(from, g) else {
-                    continue;
-                };
-                to = t;
-            }
-            let wi = basis.to_local(to.to_light);
-            let (f, _) = lobes.eval(wo, wi);
+            let from = self.shadow_start(here, first.to_light);
+            let Some(to) = l.toward(from, g) else {
+                continue;
+            };
+            let (f, _) = scatter(to.to_light);
             if f.max_value() <= 0.0 {
                 continue;
             }
             let ray = NullRay::new(from, to.dir_w);
-            if sh.world.shadowed(i, &ray, to.dist * to.k * (1.0 - 1e-9)) {
+            let Some(through) = self.reaches(here, &ray, to.dist * to.k * (1.0 - 1e-9), Some(i))
+            else {
                 continue;
-            }
+            };
             let atten = if l.light.inverse_square {
                 1.0 / (to.dist * to.dist)
             } else {
                 1.0
             };
-            let (light_shift, k) = sh.seen.irradiance(to.k * to.s_surface, lit.shift);
+            let (light_shift, k) = sh.seen.irradiance(to.k * to.s_surface, here.shift);
             // A point light's `intensity` is Whitted's: a white Lambert surface facing it at
             // distance 1 shows that radiance, so its irradiance there is π times it.
             let mut c = B::of(&l.light.radiance, B::at(light_shift));
             c.mul_by(&f);
             c.mul_by(beta);
-            out.add(&(c * (PI * atten * wi.z.abs() * k)));
+            if let Some(t) = &through {
+                c.mul_by(t);
+            }
+            out.add(&(c * (PI * atten * k)));
         }
     }
 
     /// `beta` times the light of one glowing primitive, drawn on its area in its rest frame,
-    /// weighed against the BSDF's draws, to `out`.
-    #[allow(clippy::too_many_arguments)]
+    /// weighed against the vertex's own draws, to `out`.
     fn emitter_light(
         &self,
-        lit: &Lit,
-        lobes: &Lobes<B>,
-        basis: &Basis,
-        wo: DVec3,
+        here: &Gather,
+        scatter: &dyn Fn(DVec3) -> (B, f64),
         beta: &B,
         rng: &mut Rng,
         out: &mut B,
@@ -240,20 +583,15 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         let prim_e = ge.geometry.prim(prim);
         // The vertex in the emitter's frame, where the emitter is static: the event on its
         // surface on the vertex's past light cone is `dist` before, at the drawn point.
-        let x = ge.boost.event(lit.event).x;
+        let x = ge.boost.event(here.event).x;
         let Some(pt) = emitters::sample_point(&prim_e, x, u) else {
             return;
         };
         // The shadow ray starts ε off the surface, on the side the light comes from; the
         // distance and the density are taken from there (as a BSDF draw's are, `mis_met`).
-        let n_e = ge.boost.inverse().view_dir(pt.point - x).0;
-        let toward = world.groups[lit.group].boost.view_dir(n_e).0;
-        let side = if toward.dot(lit.nf) > 0.0 {
-            lit.nf
-        } else {
-            -lit.nf
-        };
-        let from = sh.pushed_off(lit.group, lit.event, side);
+        let toward_w = ge.boost.inverse().view_dir(pt.point - x).0;
+        let toward = world.groups[here.group].boost.view_dir(toward_w).0;
+        let from = self.shadow_start(here, toward);
         let x = ge.boost.event(from).x;
         let delta = pt.point - x;
         let dist = delta.length();
@@ -263,20 +601,20 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         let look_e = delta / dist;
         // ν_world / ν_emitter, then ν_vertex / ν_world, along the ray.
         let (dir_w, k_world) = ge.boost.inverse().view_dir(look_e);
-        let (look, s_vertex) = world.groups[lit.group].boost.view_dir(dir_w);
+        let (look, s_vertex) = world.groups[here.group].boost.view_dir(dir_w);
         let d = k_world * s_vertex;
-        let wi = basis.to_local(look);
-        let (f, pdf_bsdf) = lobes.eval(wo, wi);
+        let (f, pdf_own) = scatter(look);
         if f.max_value() <= 0.0 {
             return;
         }
         let ray = NullRay::new(from, dir_w);
-        if world.occluded(&ray, 0.0, dist * k_world * (1.0 - 1e-6)) {
+        let tmax = dist * k_world * (1.0 - 1e-6);
+        let Some(through) = self.reaches(here, &ray, tmax, None) else {
             return;
-        }
+        };
         let pdf_e = emitters::pdf_point(&prim_e, x, pt.point);
         let p_light = p_pick * pdf_e * d * d;
-        let (shift_e, k) = sh.seen.radiance(d, lit.shift);
+        let (shift_e, k) = sh.seen.radiance(d, here.shift);
         let on = SurfaceHit {
             group: eg,
             prim,
@@ -285,7 +623,7 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             dir: look_e,
             s: 1.0,
         };
-        let elit = sh.lit_at(&on, lit.event, shift_e);
+        let elit = sh.lit_at(&on, here.event, shift_e);
         let Some(e) = &elit.mat.emission else {
             return;
         };
@@ -293,9 +631,85 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         let mut c = surface_colour::<B>(e, elit.mat.emission_texture.as_deref(), &elit, at);
         c.mul_by(&f);
         c.mul_by(beta);
-        let w = power(p_light, pdf_bsdf);
-        out.add(&(c * (k * wi.z.abs() * w / p_light)));
+        if let Some(t) = &through {
+            c.mul_by(t);
+        }
+        let w = power(p_light, pdf_own);
+        out.add(&(c * (k * w / p_light)));
     }
+}
+
+/// A path's state between vertices: its throughput, the wavelengths of the frame it is in,
+/// and what its last draw was (for weighing an emitter it meets).
+struct Path<B> {
+    beta: B,
+    shift: f64,
+    came: Option<Came>,
+}
+
+/// A leg of a path: a null ray (through the media whose boundaries it crosses), or a ray
+/// inside a glass object, in its frame.
+#[derive(Clone, Copy)]
+enum Leg {
+    Null {
+        ray: NullRay,
+        /// The lookback factor of the ray's receiver (as the switches have it).
+        receiver_s: f64,
+        /// The medium it starts in.
+        within: Option<(usize, u32)>,
+        /// Its first hit, where known (a camera ray's).
+        first: Option<SurfaceHit>,
+    },
+    Slow {
+        group: usize,
+        event: Event,
+        side: DVec3,
+        dir: DVec3,
+        /// The glass object's material (its `ior`, and its medium if it has one).
+        material: u32,
+        /// The medium outside the object, to go back into.
+        outside: Option<(usize, u32)>,
+    },
+}
+
+/// What a leg reaches.
+enum Reached {
+    Sky {
+        dir: DVec3,
+        receiver_s: f64,
+    },
+    Surface {
+        hit: SurfaceHit,
+        event: Event,
+        /// The medium the surface is in.
+        within: Option<(usize, u32)>,
+    },
+    Scatter(Scatter),
+    /// The path ends (a medium with no far side).
+    Lost,
+}
+
+/// A point where light scattered in a medium.
+struct Scatter {
+    group: usize,
+    material: u32,
+    event: Event,
+    /// The leg's looking direction there, in the medium's frame.
+    look: DVec3,
+    /// Inside a glass object: Some(the medium outside it).
+    slow: Option<Option<(usize, u32)>>,
+}
+
+/// Where next-event estimation gathers light.
+struct Gather {
+    group: usize,
+    event: Event,
+    /// The frame's wavelengths over the camera's.
+    shift: f64,
+    /// A surface's normal toward the side the path came from (None: a point in a medium).
+    nf: Option<DVec3>,
+    /// The medium the point is in.
+    within: Option<(usize, u32)>,
 }
 
 /// The power heuristic's weight for a strategy of density `a` against one of density `b`.

@@ -1,0 +1,262 @@
+//! Media (`[[material]] medium = { sigma_a, sigma_s, g }`): Beer-Lambert through an absorbing
+//! slab, at rest and moving at 0.6c seen at an angle (the way through is the slab's rest-frame
+//! length, found from the aberrated direction), shadows through a medium, and the path
+//! integrator's scattering held to equilibrium: inside a uniformly glowing enclosure a fog ball
+//! or a milky glass ball that scatters but absorbs nothing changes nothing (docs/physics.md §9.3).
+
+mod common;
+use common::*;
+
+/// A camera at the origin looking along `look` at a glowing backdrop (radiance 1) beyond a
+/// slab 1 thick across z (z from −3 to −2), absorbing `sigma_a`, moving at `beta` along x.
+fn slab(integrator: &str, sigma_a: f64, beta: f64, look: [f64; 3]) -> String {
+    let [x, y, z] = look;
+    format!(
+        r#"
+[camera]
+position = [0, 0, 0]
+direction = [{x}, {y}, {z}]
+up = [0, 1, 0]
+fov_y = 0.5
+[image]
+width = 3
+height = 3
+background = 0
+transparent = false
+[render]
+integrator = "{integrator}"
+max_depth = 0
+ambient = 0
+[[material]]
+name = "glow"
+emission = 1
+[[material]]
+name = "smoke"
+medium = {{ sigma_a = {sigma_a} }}
+[[group]]
+name = "backdrop"
+[[group.object]]
+type = "box"
+min = [-200, -200, -30]
+max = [200, 200, -29]
+material = "glow"
+[[group]]
+name = "slab"
+velocity = [{beta}, 0, 0]
+[[group.object]]
+type = "box"
+min = [-200, -200, -3]
+max = [200, 200, -2]
+material = "smoke"
+"#
+    )
+}
+
+fn centre(f: &rest_embree::render::Frame) -> f64 {
+    f64::from(f.get(1, 1).color[0])
+}
+
+#[test]
+fn beer_lambert_through_a_slab_at_rest_and_moving() {
+    let a: [f64; 3] = [0.5, 0.0, -1.0];
+    let n = (a[0] * a[0] + a[2] * a[2]).sqrt();
+    let a = [a[0] / n, a[1], a[2] / n];
+    for backend in backends() {
+        for integrator in ["whitted", "path"] {
+            for (beta, look) in [(0.0, [0.0, 0.0, -1.0]), (0.0, a), (0.6, a), (-0.6, a)] {
+                let clear = centre(&render_with(
+                    &scene(&slab(integrator, 0.0, beta, look)),
+                    backend,
+                ));
+                let seen = centre(&render_with(
+                    &scene(&slab(integrator, 0.4, beta, look)),
+                    backend,
+                ));
+                // The looking direction in the slab's frame (boost along x): its z part is
+                // a_z / (γ (1 + β a_x)); the way through the slab is 1 / |that|.
+                let gamma = 1.0 / (1.0 - beta * beta).sqrt();
+                let way = gamma * (1.0 + beta * look[0]) / look[2].abs();
+                let want = (-0.4 * way).exp();
+                assert!(clear > 0.5, "the backdrop is seen ({clear})");
+                // Embree's hits on boxes carry f32 rounding into the way's length.
+                assert_rel(
+                    seen / clear,
+                    want,
+                    1e-4,
+                    &format!("{integrator}, β = {beta}, look {look:?} on {backend}"),
+                );
+            }
+        }
+    }
+}
+
+/// A floor (white, Lambert) under a point light at height 4 (no fall-off), with an absorbing
+/// slab 1 thick between them (σ_a = `sigma_a`); the camera looks at the point below the light.
+fn shadow_through(integrator: &str, sigma_a: f64) -> String {
+    format!(
+        r#"
+[camera]
+position = [3, 1, 0]
+look_at = [0, 0, 0]
+fov_y = 0.5
+[image]
+width = 3
+height = 3
+background = 0
+transparent = false
+[render]
+integrator = "{integrator}"
+max_depth = 0
+ambient = 0
+[[material]]
+name = "white"
+color = 1
+[[material]]
+name = "smoke"
+medium = {{ sigma_a = {sigma_a} }}
+[[light]]
+position = [0, 4, 0]
+intensity = 2
+[[group]]
+name = "floor"
+[[group.object]]
+type = "box"
+min = [-50, -1, -50]
+max = [50, 0, 50]
+material = "white"
+[[group.object]]
+type = "box"
+min = [-2, 2, -2]
+max = [2, 3, 2]
+material = "smoke"
+"#
+    )
+}
+
+#[test]
+fn light_through_a_medium_is_attenuated_not_stopped() {
+    for backend in backends() {
+        for integrator in ["whitted", "path"] {
+            let open = centre(&render_with(
+                &scene(&shadow_through(integrator, 0.0)),
+                backend,
+            ));
+            let dim = centre(&render_with(
+                &scene(&shadow_through(integrator, 0.5)),
+                backend,
+            ));
+            assert_rel(open, 2.0, 1e-3, &format!("{integrator}: I · cos"));
+            let what = format!("{integrator} on {backend}");
+            assert_rel(dim / open, (-0.5f64).exp(), 1e-4, &what);
+        }
+    }
+}
+
+/// Inside a glowing sphere (radius 10, radiance 1, emitting inward and reflecting nothing),
+/// looking at a ball of radius 2 that scatters (σ_s = 1.5, g = 0.6) and absorbs nothing: a fog
+/// ball (`glass` false: its surface invisible) or milky glass (`ior` 1.5).
+fn enclosure(glass: bool) -> String {
+    let surface = if glass {
+        "color = 0\ntransmit = 1\nior = 1.5\n"
+    } else {
+        ""
+    };
+    format!(
+        r#"
+[camera]
+position = [0, 0, 6]
+look_at = [0, 0, 0]
+up = [0, 1, 0]
+fov_y = 30
+[image]
+width = 16
+height = 16
+samples = 128
+background = 0
+transparent = false
+[render]
+integrator = "path"
+max_depth = 64
+[[material]]
+name = "glow"
+emission = 1
+[[material]]
+name = "fog"
+{surface}medium = {{ sigma_s = 1.5, g = 0.6 }}
+[[group]]
+name = "room"
+[[group.object]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 10
+material = "glow"
+[[group]]
+name = "ball"
+[[group.object]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 2
+material = "fog"
+"#
+    )
+}
+
+#[test]
+fn scattering_without_absorption_keeps_a_uniform_glow() {
+    for backend in backends() {
+        for glass in [false, true] {
+            let f = render_with(&scene(&enclosure(glass)), backend);
+            let mut sum = 0.0;
+            for p in &f.pixels {
+                sum += f64::from(p.color[0]);
+            }
+            let mean = sum / f.pixels.len() as f64;
+            let what = if glass { "milky glass" } else { "fog ball" };
+            report("medium in equilibrium", backend, 1.0, mean, 0.01, "");
+            assert_rel(mean, 1.0, 0.01, &format!("{what} on {backend}"));
+        }
+    }
+}
+
+#[test]
+fn bad_media_are_named() {
+    let base = slab("path", 0.4, 0.0, [0.0, 0.0, -1.0]);
+    for (from, to, needles) in [
+        (
+            "medium = { sigma_a = 0.4 }",
+            "medium = { g = 0.2 }",
+            vec!["sigma_a", "missing"],
+        ),
+        (
+            "medium = { sigma_a = 0.4 }",
+            "medium = { sigma_s = 1, g = 1 }",
+            vec!["g", "between -1 and 1"],
+        ),
+        (
+            "medium = { sigma_a = 0.4 }",
+            "medium = { sigma_a = -1 }",
+            vec!["sigma_a"],
+        ),
+        (
+            "medium = { sigma_a = 0.4 }",
+            "medium = { sigma_a = 0.4 }\ncolor = 0.5",
+            vec!["color", "no surface"],
+        ),
+        (
+            "medium = { sigma_a = 0.4 }",
+            "medium = { sigma_a = 0.4, sigma_x = 1 }",
+            vec!["sigma_x"],
+        ),
+    ] {
+        assert!(base.contains(from));
+        let text = base.replace(from, to);
+        let err = rest_embree::scene::load_str("bad.toml", &text, &[])
+            .err()
+            .unwrap_or_else(|| panic!("{to} is refused"))
+            .to_string();
+        assert!(err.contains("bad.toml:"), "{err}");
+        for n in needles {
+            assert!(err.contains(n), "`{n}` in: {err}");
+        }
+    }
+}
