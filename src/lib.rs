@@ -18,6 +18,7 @@ pub mod bench;
 pub mod cli;
 pub mod compare;
 mod error;
+mod exr_read;
 pub mod geometry;
 pub mod memory;
 pub mod output;

@@ -67,10 +67,10 @@ pub const BYTES_PER_STAR: u64 = 210;
 
 /// The memory an object held as itself (a lattice, a bar array) costs rendered: its
 /// primitives', listed, or when it is instanced (more than
-/// [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) of them) one block's and a placement per
+/// [`INSTANCE_OVER`](crate::geometry::INSTANCE_OVER) of them) one block's and a placement per
 /// block; a mesh's, its vertices and indices.
 pub fn implicit_bytes(shape: &crate::geometry::Implicit) -> u64 {
-    if shape.len() <= crate::render::INSTANCE_OVER {
+    if shape.len() <= crate::geometry::INSTANCE_OVER {
         return shape.len().saturating_mul(BYTES_PER_PRIMITIVE);
     }
     if let crate::geometry::Implicit::Mesh(m) = shape {

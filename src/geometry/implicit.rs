@@ -10,6 +10,12 @@ use super::{Aabb, BarArray, IndexedMesh, Lattice, Primitive};
 use glam::DVec3;
 use std::sync::Arc;
 
+/// Lattices, bar arrays and meshes of more primitives than this are held as themselves
+/// (instanced, or as shared vertices) by default (`WorldOptions::instance_over`): about where
+/// holding them so starts to pay for itself; the bench measures both sides of it
+/// (docs/performance.md, the lattice and bar array rows, instanced and listed).
+pub const INSTANCE_OVER: u64 = 100_000;
+
 /// An object held as itself.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Implicit {

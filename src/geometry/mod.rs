@@ -18,7 +18,7 @@ pub use aabb::Aabb;
 pub use bars::BarArray;
 pub(crate) use box_tree::{walk, BoxTree, TreeNode, PACKET};
 pub use group_geometry::{Corners, Geometry, ImplicitRun, Part, Placement};
-pub use implicit::{Blocks, Implicit, Member, BAR, SPHERE};
+pub use implicit::{Blocks, Implicit, Member, BAR, INSTANCE_OVER, SPHERE};
 pub use indexed_mesh::IndexedMesh;
 pub use lattice::Lattice;
 pub(crate) use light_buffer::LightBuffer;

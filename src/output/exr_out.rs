@@ -3,10 +3,9 @@ use super::file::cause;
 use super::{cryptomatte, Attribute, ExrOptions};
 use crate::render::{Frame, CHANNELS};
 use crate::scene::Pass;
-use crate::{Cause, Error};
+use crate::Cause;
 use exr::prelude::*;
 use smallvec::SmallVec;
-use std::collections::HashMap;
 use std::path::Path;
 
 /// Channels that may be stored as half floats (`--half`): colour, coverage, normals and the
@@ -447,41 +446,10 @@ fn name_of<'a>(header: &'a [u8], span: &std::ops::Range<usize>) -> &'a [u8] {
     &s[..s.iter().position(|&b| b == 0).unwrap_or(s.len())]
 }
 
-/// Width, height and every channel by name (f32, row-major) of an EXR file's first layer.
-pub type Channels = (usize, usize, HashMap<String, Vec<f32>>);
-
-/// The first layer of an EXR file with every channel and attribute, as stored.
-pub(super) fn read_layer(
-    path: &Path,
-) -> exr::error::Result<Image<Layer<AnyChannels<FlatSamples>>>> {
-    read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-}
-
-/// Every channel of the first layer of an EXR file.
-pub fn read_channels(path: &Path) -> crate::Result<Channels> {
-    let image = read_layer(path).map_err(|e| {
-        let message = format!("cannot read `{}`: {e}", path.display());
-        Error::image(path, message, Some(cause(e)))
-    })?;
-    let layer = &image.layer_data;
-    let map = layer
-        .channel_data
-        .list
-        .iter()
-        .map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect()))
-        .collect();
-    Ok((layer.size.width(), layer.size.height(), map))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::exr_read::read_channels;
     use crate::output::Compression as Packing;
 
     /// The predictor is OpenEXR's, written the plain way: split, then differences.

@@ -223,5 +223,5 @@ pub fn srgb_encode(linear: f32) -> f32 {
     }
 }
 
+pub use crate::exr_read::read_channels as read_exr_channels;
 pub use assemble::assemble;
-pub use exr_out::read_channels as read_exr_channels;

@@ -39,11 +39,7 @@ const LIGHT_SLICES: usize = 128;
 /// structure (and a call into it) costs more than the primitives themselves.
 pub const DIRECT_MAX: usize = 4;
 
-/// Lattices of more primitives than this are instanced by default (`WorldOptions`). Measured
-/// (`rest-embree bench`, docs/performance.md): a 30³ lattice (105,300 primitives) instanced is
-/// as fast to render on Embree and faster as a whole command on both backends (no build); the
-/// paper's 10³ lattice renders faster listed.
-pub const INSTANCE_OVER: u64 = 100_000;
+pub use crate::geometry::INSTANCE_OVER;
 
 /// The largest distance from `p` to a corner of `b`.
 fn corner_distance(b: &Aabb, p: DVec3) -> f64 {

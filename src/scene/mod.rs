@@ -4,7 +4,6 @@
 mod colour;
 pub(crate) mod doc;
 mod envelope;
-mod error;
 mod load;
 mod mesh_file;
 mod model;
@@ -18,7 +17,7 @@ mod texture;
 pub(crate) mod toml_tree;
 mod transform;
 
-pub use error::SceneError;
+pub use crate::error::SceneError;
 pub use load::{load_file, load_file_as, load_str, FrameSize};
 pub use model::{
     Camera, Film, FrameSpacing, Group, ImageSettings, Integrator, Light, Material, Medium,

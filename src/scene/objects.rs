@@ -89,11 +89,11 @@ fn budget(t: &Table, key: &str, total: &mut u64, add: u64) -> SceneResult<()> {
 }
 
 /// A lattice or bar array is held as itself, whatever its size: rendered, one of more than
-/// [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) primitives is built from one block of them
+/// [`INSTANCE_OVER`](crate::geometry::INSTANCE_OVER) primitives is built from one block of them
 /// (`Blocks`), costing the block's primitives and one placement per block; a smaller one is
 /// listed primitive by primitive, counting against the scene's limit as any object does.
 fn implicit_budget(t: &Table, total: &mut u64, shape: &Implicit) -> SceneResult<()> {
-    if shape.len() <= crate::render::INSTANCE_OVER {
+    if shape.len() <= crate::geometry::INSTANCE_OVER {
         return budget(t, "counts", total, shape.len());
     }
     let what = format!(
@@ -107,7 +107,7 @@ fn implicit_budget(t: &Table, total: &mut u64, shape: &Implicit) -> SceneResult<
     Ok(())
 }
 
-/// A mesh file of at most [`INSTANCE_OVER`](crate::render::INSTANCE_OVER) triangles is listed
+/// A mesh file of at most [`INSTANCE_OVER`](crate::geometry::INSTANCE_OVER) triangles is listed
 /// triangle by triangle, counting against the scene's limit as any object does; a bigger one is
 /// held as itself (shared vertices), its memory checked as such, corner data included.
 fn mesh_budget(t: &Table, total: &mut u64, mesh: &super::mesh_file::MeshData) -> SceneResult<()> {
@@ -115,7 +115,7 @@ fn mesh_budget(t: &Table, total: &mut u64, mesh: &super::mesh_file::MeshData) ->
     let n = mesh.triangles.len() as u64;
     let corners = u64::from(mesh.normals.is_some()) * BYTES_PER_CORNER_NORMALS
         + u64::from(mesh.uvs.is_some()) * BYTES_PER_CORNER_UVS;
-    if n <= crate::render::INSTANCE_OVER {
+    if n <= crate::geometry::INSTANCE_OVER {
         return budget(t, "file", total, n);
     }
     let need = n.saturating_mul(BYTES_PER_HELD_TRIANGLE + corners);

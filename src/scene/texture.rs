@@ -287,7 +287,7 @@ pub fn read_image(path: &std::path::Path) -> Result<(usize, usize, Vec<[f32; 3]>
             Ok((w, h, texels))
         }
         Some("exr") => {
-            let (w, h, ch) = crate::output::read_exr_channels(path).map_err(|e| e.to_string())?;
+            let (w, h, ch) = crate::exr_read::read_channels(path).map_err(|e| e.to_string())?;
             fits(w, h)?;
             let pick =
                 |names: [&str; 3]| names.iter().map(|n| ch.get(*n)).collect::<Option<Vec<_>>>();
