@@ -120,18 +120,19 @@ fn mutate(rng: &mut Rng, text: &str) -> String {
 
 /// Load, and where that succeeds, render small on every backend: never a panic, never a
 /// non-finite channel.
-fn check(text: &str, sets: &[(String, String)], what: &str) -> bool {
+/// The scene is read as the file `name` (whose folder its relative paths start from).
+fn check_as(name: &str, text: &str, sets: &[(String, String)], what: &str) -> bool {
     let mut all = vec![
         ("--width 8".to_string(), "image.width=8".to_string()),
         ("--height 6".to_string(), "image.height=6".to_string()),
     ];
     all.extend_from_slice(sets);
     let outcome = std::panic::catch_unwind(|| {
-        let Ok(s) = rest_embree::scene::load_str("fuzz.toml", text, &all) else {
+        let Ok(s) = rest_embree::scene::load_str(name, text, &all) else {
             return false;
         };
         // Large generated objects cost time, not coverage.
-        if s.primitive_count() > 20_000 || s.image.samples > 4 {
+        if s.primitive_count() > 20_000 || s.image.samples > 64 {
             return false;
         }
         for b in backends() {
@@ -149,18 +150,24 @@ fn check(text: &str, sets: &[(String, String)], what: &str) -> bool {
 #[test]
 fn ten_thousand_mutated_scenes_neither_panic_nor_give_nan() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut bases: Vec<String> = std::fs::read_dir(root.join("scenes"))
+    // Each scene read as itself, so the files it names beside it (maps, meshes) are found.
+    let mut bases: Vec<(String, String)> = std::fs::read_dir(root.join("scenes"))
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .map(|p| std::fs::read_to_string(p).unwrap())
+        .map(|p| {
+            (
+                p.display().to_string(),
+                std::fs::read_to_string(&p).unwrap(),
+            )
+        })
         .collect();
     bases.sort();
-    bases.push(common::cli::GOOD.to_string());
+    bases.push(("fuzz.toml".into(), common::cli::GOOD.to_string()));
     let mut rng = Rng(0x5eed_f00d);
     let (mut rendered, total) = (0, 10_000);
     for n in 0..total {
-        let base = &bases[n % bases.len()];
+        let (name, base) = &bases[n % bases.len()];
         let mut text = mutate(&mut rng, base);
         for _ in 0..rng.next_u64() % 3 {
             text = mutate(&mut rng, &text);
@@ -176,7 +183,7 @@ fn ten_thousand_mutated_scenes_neither_panic_nor_give_nan() {
         } else {
             vec![]
         };
-        if check(&text, &sets, &format!("mutation {n}")) {
+        if check_as(name, &text, &sets, &format!("mutation {n}")) {
             rendered += 1;
         }
     }

@@ -1,17 +1,17 @@
-//! A pure-Rust bounding volume hierarchy in f64, built with binned SAH: the reference backend;
-//! with its nodes in f32 (bvh32.rs), the benchmark's f32-against-f64 BVH.
+//! A pure-Rust bounding volume hierarchy in f64, built with binned SAH: the reference backend.
+//! Its nodes over the held primitives are a [`NodeSet`]: f64 here, f32 in bvh32.rs (the
+//! benchmark's f32-against-f64 BVH).
 
-use super::bvh32::Nodes32;
 use super::instanced_tree::InstancedTree;
 use super::mesh_tree::MeshTree;
 use super::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, BoxTree, Geometry, TreeNode};
 use std::sync::Arc;
 
-pub struct Bvh {
+pub struct Bvh<N = Nodes64> {
     geometry: Arc<Geometry>,
     /// Over the primitives held one by one.
-    nodes: Nodes,
+    nodes: N,
     indices: Vec<u32>,
     /// The objects held as themselves: lattices and bar arrays each in two levels, meshes
     /// each in a tree over its triangles.
@@ -40,10 +40,34 @@ impl Held {
     }
 }
 
-/// The tree's nodes in f64, or in f32 about the geometry's centre.
-enum Nodes {
-    F64(Vec<TreeNode>),
-    F32(Nodes32),
+/// How a BVH's nodes over its held primitives are kept and walked.
+pub(super) trait NodeSet: Send + Sync + Sized + 'static {
+    /// The nodes of the f64 tree `nodes` over geometry with bounds `all`.
+    fn from_tree(nodes: Vec<TreeNode>, all: &Aabb) -> Self;
+    /// The nearest hit (or any, for occlusion) among the held primitives.
+    fn traverse(&self, indices: &[u32], geometry: &Geometry, ray: &Ray, any: bool) -> Option<Hit>;
+}
+
+/// The tree's nodes in f64, as built.
+pub struct Nodes64(Vec<TreeNode>);
+
+impl NodeSet for Nodes64 {
+    fn from_tree(nodes: Vec<TreeNode>, _: &Aabb) -> Self {
+        Nodes64(nodes)
+    }
+
+    fn traverse(&self, indices: &[u32], geometry: &Geometry, ray: &Ray, any: bool) -> Option<Hit> {
+        let inv = ray.dir.recip();
+        nearest_first(
+            &self.0,
+            |n| (n.first, n.count),
+            |n, tmax| n.bounds.clip(ray.origin, inv, ray.tmin, tmax).map(|x| x.0),
+            indices,
+            geometry,
+            ray,
+            any,
+        )
+    }
 }
 
 pub struct BvhBackend;
@@ -53,30 +77,21 @@ impl Backend for BvhBackend {
         "bvh"
     }
     fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>> {
-        Ok(Box::new(Bvh::build(geometry)))
+        Ok(Box::new(Bvh::<Nodes64>::build(geometry)))
     }
 }
 
-impl Bvh {
-    pub fn build(geometry: Arc<Geometry>) -> Bvh {
+impl<N: NodeSet> Bvh<N> {
+    pub fn build(geometry: Arc<Geometry>) -> Bvh<N> {
         let boxes: Vec<Aabb> = geometry.prims.iter().map(|p| p.bounds()).collect();
         let BoxTree { nodes, indices } = BoxTree::build(&boxes);
         let instanced = geometry.implicit.iter().map(Held::build).collect();
         Bvh {
+            nodes: N::from_tree(nodes, &geometry.bounds()),
             geometry,
-            nodes: Nodes::F64(nodes),
             indices,
             instanced,
         }
-    }
-
-    /// The same tree with its nodes in f32 (see bvh32.rs).
-    pub fn with_f32_nodes(geometry: Arc<Geometry>) -> Bvh {
-        let mut bvh = Bvh::build(geometry);
-        if let Nodes::F64(nodes) = &bvh.nodes {
-            bvh.nodes = Nodes::F32(Nodes32::new(nodes, &bvh.geometry.bounds()));
-        }
-        bvh
     }
 
     fn traverse(&self, ray: &Ray, any: bool) -> Option<Hit> {
@@ -92,21 +107,7 @@ impl Bvh {
     }
 
     fn traverse_held(&self, ray: &Ray, any: bool) -> Option<Hit> {
-        match &self.nodes {
-            Nodes::F64(nodes) => {
-                let inv = ray.dir.recip();
-                nearest_first(
-                    nodes,
-                    |n| (n.first, n.count),
-                    |n, tmax| n.bounds.clip(ray.origin, inv, ray.tmin, tmax).map(|x| x.0),
-                    &self.indices,
-                    &self.geometry,
-                    ray,
-                    any,
-                )
-            }
-            Nodes::F32(nodes) => nodes.traverse(&self.indices, &self.geometry, ray, any),
-        }
+        self.nodes.traverse(&self.indices, &self.geometry, ray, any)
     }
 }
 
@@ -181,7 +182,7 @@ pub(super) fn nearest_first<N>(
     best
 }
 
-impl Accelerator for Bvh {
+impl<N: NodeSet> Accelerator for Bvh<N> {
     fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         for (r, h) in rays.iter().zip(hits.iter_mut()) {
             *h = self.traverse(r, false);

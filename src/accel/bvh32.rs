@@ -4,7 +4,7 @@
 //! them, so its hits are the f64 BVH's; what it changes is the memory a node takes (32 bytes
 //! instead of 56) and the width of its arithmetic.
 
-use super::bvh::{nearest_first, Bvh};
+use super::bvh::{nearest_first, Bvh, NodeSet};
 use super::{Accelerator, Backend, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, TreeNode};
 use glam::DVec3;
@@ -19,7 +19,7 @@ struct Node32 {
 }
 
 /// A tree's nodes in f32, relative to `center`.
-pub(super) struct Nodes32 {
+pub struct Nodes32 {
     nodes: Vec<Node32>,
     center: DVec3,
 }
@@ -31,7 +31,7 @@ impl Backend for Bvh32Backend {
         "bvh-f32"
     }
     fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>> {
-        Ok(Box::new(Bvh::with_f32_nodes(geometry)))
+        Ok(Box::new(Bvh::<Nodes32>::build(geometry)))
     }
 }
 
@@ -54,9 +54,9 @@ fn clip32(n: &Node32, o: [f32; 3], inv: [f32; 3], tmin: f32, tmax: f32) -> Optio
     (t0 <= t1).then_some(t0)
 }
 
-impl Nodes32 {
+impl NodeSet for Nodes32 {
     /// The f64 tree's nodes over geometry with these bounds, in f32.
-    pub(super) fn new(nodes: &[TreeNode], all: &Aabb) -> Nodes32 {
+    fn from_tree(nodes: Vec<TreeNode>, all: &Aabb) -> Nodes32 {
         let center = if all.is_empty() {
             DVec3::ZERO
         } else {
@@ -85,13 +85,7 @@ impl Nodes32 {
     }
 
     /// As the f64 BVH's walk, with the node tests in f32 (limits widened by rounding).
-    pub(super) fn traverse(
-        &self,
-        indices: &[u32],
-        geometry: &Geometry,
-        ray: &Ray,
-        any: bool,
-    ) -> Option<Hit> {
+    fn traverse(&self, indices: &[u32], geometry: &Geometry, ray: &Ray, any: bool) -> Option<Hit> {
         let o = ray.origin - self.center;
         let o32 = [o.x as f32, o.y as f32, o.z as f32];
         let inv = [

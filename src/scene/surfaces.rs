@@ -98,8 +98,8 @@ pub(super) fn sky(t: &Table) -> SceneResult<super::Sky> {
     }
     let rotation = super::transform::Transform::read_rotation(t)?.unwrap_or(glam::DMat3::IDENTITY);
     let intensity = t.f64_where("intensity", Some(1.0), |v| v >= 0.0, "0 or more")?;
-    let velocity =
-        super::load::velocity(t, "velocity_direction")?.unwrap_or(crate::spacetime::Velocity::ZERO);
+    let velocity = super::speed::velocity(t, "velocity_direction")?
+        .unwrap_or(crate::spacetime::Velocity::ZERO);
     t.finish(&[
         "map",
         "rotate",

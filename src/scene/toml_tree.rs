@@ -10,7 +10,7 @@
 //! tables and arrays are closed. A differential test (`src/tests/toml_tree.rs`) holds this to
 //! `toml_edit` on hostile input.
 
-use super::doc::{Form, Lines, Node, Origin, Val};
+use super::node::{Form, Lines, Node, Origin, Val};
 use toml_parser::decoder::{Encoding, ScalarKind};
 use toml_parser::lexer::{Token, TokenKind};
 use toml_parser::parser::{EventReceiver, RecursionGuard, ValidateWhitespace};

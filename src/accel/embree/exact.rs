@@ -9,6 +9,7 @@
 
 use super::fault::{self, Callback, Fault, Injection};
 use super::lane_cull::lanes_near;
+pub use super::lane_hits::Round;
 use super::lane_hits::{round_hits, Answers, LaneRays, MAX};
 use super::scale;
 use crate::accel::Ray;
@@ -31,14 +32,6 @@ pub trait Shape: Copy {
     fn hits(&self, _rays: &LaneRays, out: &mut Answers) {
         out.fill(f64::NAN)
     }
-}
-
-/// A capsule (or with a = b, a sphere).
-#[derive(Clone, Copy, Debug)]
-pub struct Round {
-    pub a: DVec3,
-    pub b: DVec3,
-    pub radius: f64,
 }
 
 impl Shape for Round {

@@ -10,9 +10,9 @@ use super::exact::{
     everything, guarded, lane_hits_within, outward, report_hit, ExactContext, Round, Shape,
 };
 use super::fault::Callback;
+use super::rtc::f3;
 use super::rtc::field::TFAR;
 use super::rtc::{CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
-use super::scene::f3;
 use crate::geometry::{Aabb, Blocks, Implicit, ImplicitRun, Member, Primitive};
 use embree_sys::*;
 use glam::DVec3;

@@ -11,7 +11,6 @@
 //! end, so its end ball decides; a ray along the axis) is left undecided, and the callback asks
 //! the scalar test.
 
-use super::exact::Round;
 #[cfg(target_arch = "x86_64")]
 use super::f64x4::F4;
 use crate::geometry::AxisRod;
@@ -19,6 +18,14 @@ use crate::geometry::AxisRod;
 use crate::geometry::{ball_crossings, cylinder_crossings, Real};
 use glam::DVec3;
 use std::mem::MaybeUninit;
+
+/// A capsule (or with a = b, a sphere).
+#[derive(Clone, Copy, Debug)]
+pub struct Round {
+    pub a: DVec3,
+    pub b: DVec3,
+    pub radius: f64,
+}
 
 /// The most lanes of a packet (Embree's widest, 16).
 pub(super) const MAX: usize = 16;

@@ -489,3 +489,8 @@ pub fn new_context() -> RTCIntersectContext {
     unsafe { rtcInitIntersectContext(&mut rtc) };
     rtc
 }
+
+/// A point or vector (already rebased near the origin) in the f32 Embree stores.
+pub(super) fn f3(p: glam::DVec3) -> [f32; 3] {
+    [p.x as f32, p.y as f32, p.z as f32]
+}

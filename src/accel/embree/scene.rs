@@ -5,7 +5,7 @@
 
 use super::exact::{self, Round, Shape, Shapes};
 use super::instanced_blocks::{self, BlockScene};
-use super::rtc::{CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
+use super::rtc::{f3, CommittedScene, Device, Geometry, SceneBuilder, UserFunctions};
 use crate::geometry::{
     Aabb, Blocks, Geometry as SceneGeometry, Implicit, ImplicitRun, IndexedMesh, Primitive,
 };
@@ -98,10 +98,6 @@ pub struct EmbreeScene {
     _cuboids: Option<Box<Shapes<Aabb>>>,
     /// The implicit objects' block scenes (and what their callbacks read), likewise.
     _blocks: Vec<BlockScene>,
-}
-
-pub(super) fn f3(p: DVec3) -> [f32; 3] {
-    [p.x as f32, p.y as f32, p.z as f32]
 }
 
 impl EmbreeScene {
