@@ -24,3 +24,10 @@ if ! command -v cargo >/dev/null 2>&1; then
   echo "setup: Rust is not installed. Install Rust 1.87 or newer (https://rustup.rs), then run this again." >&2
   exit 1
 fi
+
+# `make test` checks the formatting and the lints too: rustup's default profile has both tools;
+# a minimal one gets them here.
+if command -v rustup >/dev/null 2>&1; then
+  cargo fmt --version >/dev/null 2>&1 || rustup component add rustfmt
+  cargo clippy --version >/dev/null 2>&1 || rustup component add clippy
+fi

@@ -9,13 +9,14 @@
 //! [`geometry`] + [`accel`] (static rest-frame intersection; the [`accel::Backend`] trait is
 //! where a new acceleration structure plugs in) → [`mod@render`] (past light-cone rays,
 //! per-group boost and merge, shading) → [`output`] (EXR, PNG). [`spectrum`] is light as
-//! spectra; [`compare`] tells how two frames differ; [`cli`] is the command line and
-//! [`mod@bench`] its measurements. The renderer's internals are private to the crate, and tested
-//! inside it (src/tests/); docs/architecture.md walks through them.
+//! spectra; [`compare`] tells how two frames differ. The command line and the bench are the
+//! binary's, not the library's (`src/cli/`, `src/bench/`, reached through [`run_command_line`]).
+//! The renderer's internals are private to the crate, and tested inside it (src/tests/);
+//! docs/architecture.md walks through them.
 
 pub mod accel;
-pub mod bench;
-pub mod cli;
+mod bench;
+mod cli;
 pub mod compare;
 mod error;
 mod exr_read;
@@ -29,6 +30,13 @@ pub mod spacetime;
 pub mod spectrum;
 
 pub use error::{Cause, Error, Result};
+
+/// The `rest-embree` command: parse the process's arguments and run it (what `src/main.rs`
+/// calls; not part of the library's API).
+#[doc(hidden)]
+pub fn run_command_line() -> std::process::ExitCode {
+    cli::main()
+}
 pub use render::{render, RenderOptions};
 
 // The helpers shared with tests/ name the crate `rest_embree`, as the integration tests do.

@@ -1,3 +1,3 @@
 fn main() -> std::process::ExitCode {
-    rest_embree::cli::main()
+    rest_embree::run_command_line()
 }

@@ -66,6 +66,38 @@ pub(crate) enum Command {
         backend: String,
         threads: String,
     },
+    /// A profiling probe: nanoseconds per primary ray on the paper's lattice (src/bench/probe.rs,
+    /// `primary_ns`): MODE is layer, layer-unfused, bare, bvh or render; EMBREE the Embree
+    /// backend's name for the modes that use it (embree, embree-16, embree-8). Prints the
+    /// fastest pass of as many as fit in SECONDS, in ns per pixel.
+    #[command(hide = true)]
+    ProbePrimaryNs {
+        #[arg(default_value = "layer")]
+        mode: String,
+        #[arg(default_value_t = 0.0)]
+        beta: f64,
+        #[arg(default_value_t = 512)]
+        size: u32,
+        #[arg(default_value_t = 2.0)]
+        seconds: f64,
+        #[arg(default_value = "embree")]
+        embree: String,
+        #[arg(default_value_t = 1)]
+        threads: usize,
+    },
+    /// A profiling probe: what many velocity groups cost against one group of the same boxes
+    /// (src/bench/probe.rs, `group_visits`).
+    #[command(hide = true)]
+    ProbeGroupVisits {
+        #[arg(default_value_t = 10000)]
+        groups: usize,
+        #[arg(default_value = "embree")]
+        backend: String,
+        #[arg(default_value_t = 256)]
+        size: u32,
+        #[arg(default_value_t = 1)]
+        threads: usize,
+    },
 }
 
 #[derive(clap::Args, Debug)]
@@ -307,6 +339,32 @@ fn run(cli: Cli) -> ExitCode {
             }
             ExitCode::SUCCESS
         }
+        Command::ProbePrimaryNs {
+            mode,
+            beta,
+            size,
+            seconds,
+            embree,
+            threads,
+        } => match bench::probe::primary_ns(&mode, beta, size, seconds, &embree, threads) {
+            Ok(ns) => {
+                println!("{mode} beta={beta} {size}x{size}: {ns:.2} ns per pixel");
+                ExitCode::SUCCESS
+            }
+            Err(e) => report(Err(crate::Error::flag("probe-primary-ns", e.to_string()))),
+        },
+        Command::ProbeGroupVisits {
+            groups,
+            backend,
+            size,
+            threads,
+        } => match bench::probe::group_visits(groups, &backend, size, threads) {
+            Ok(text) => {
+                print!("{text}");
+                ExitCode::SUCCESS
+            }
+            Err(e) => report(Err(crate::Error::flag("probe-group-visits", e.to_string()))),
+        },
     }
 }
 
