@@ -95,14 +95,7 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
                     within,
                     first,
                 } => self.walk(&ray, receiver_s, within, first, &mut path, rng),
-                Leg::Slow {
-                    group,
-                    event,
-                    side,
-                    dir,
-                    material,
-                    outside,
-                } => self.walk_inside(group, event, side, dir, material, outside, &mut path, rng),
+                Leg::Slow(inside) => self.walk_inside(&inside, &mut path, rng),
             };
             let next = match reached {
                 Reached::Sky { dir, receiver_s } => {
@@ -194,18 +187,15 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
 
     /// Follow a ray inside a glass object (its group's frame, light at c/n, `Shader::inside_hit`)
     /// to its next surface, or to where it scatters in the object's medium.
-    #[allow(clippy::too_many_arguments)]
-    fn walk_inside(
-        &self,
-        group: usize,
-        event: Event,
-        side: DVec3,
-        dir: DVec3,
-        material: u32,
-        outside: Option<(usize, u32)>,
-        path: &mut Path<B>,
-        rng: &mut Rng,
-    ) -> Reached {
+    fn walk_inside(&self, leg: &Inside, path: &mut Path<B>, rng: &mut Rng) -> Reached {
+        let Inside {
+            group,
+            event,
+            side,
+            dir,
+            material,
+            outside,
+        } = *leg;
         let sh = self.shader;
         let ior = sh.scene.materials[material as usize].ior;
         let Some((h, at, d)) = sh.inside_hit(group, event, side, dir, ior) else {
@@ -346,7 +336,7 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         // Into a glass object: slower light, no change of frame, maybe a medium.
         if mat.transmit > 0.0 && wi.dot(lit.n) < 0.0 {
             path.came = pdf.map(|pdf| Came { pdf, from, s: 1.0 });
-            return Some(Leg::Slow {
+            return Some(Leg::Slow(Inside {
                 group: lit.group,
                 event: lit.event,
                 side,
@@ -356,7 +346,7 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
                     .part_of(hit.prim)
                     .material,
                 outside: within,
-            });
+            }));
         }
         let r = sh.spawn(lit.group, lit.event, side, wi);
         let s = sh.world.groups[lit.group].boost.null_dir(r.dir).1;
@@ -420,14 +410,14 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             s,
         });
         Some(match at.slow {
-            Some(outside) => Leg::Slow {
+            Some(outside) => Leg::Slow(Inside {
                 group: at.group,
                 event: at.event,
                 side: DVec3::ZERO,
                 dir: wi,
                 material: at.material,
                 outside,
-            },
+            }),
             None => {
                 let r = sh.spawn(at.group, at.event, DVec3::ZERO, wi);
                 Leg::Null {
@@ -660,16 +650,22 @@ enum Leg {
         /// Its first hit, where known (a camera ray's).
         first: Option<SurfaceHit>,
     },
-    Slow {
-        group: usize,
-        event: Event,
-        side: DVec3,
-        dir: DVec3,
-        /// The glass object's material (its `ior`, and its medium if it has one).
-        material: u32,
-        /// The medium outside the object, to go back into.
-        outside: Option<(usize, u32)>,
-    },
+    Slow(Inside),
+}
+
+/// A ray inside a glass object, in the object's frame.
+#[derive(Clone, Copy)]
+struct Inside {
+    group: usize,
+    /// Where it starts (on the surface, or at a point where it scattered).
+    event: Event,
+    /// Which way it starts off the surface (zero at a point in the medium).
+    side: DVec3,
+    dir: DVec3,
+    /// The glass object's material (its `ior`, and its medium if it has one).
+    material: u32,
+    /// The medium outside the object, to go back into.
+    outside: Option<(usize, u32)>,
 }
 
 /// What a leg reaches.
