@@ -211,8 +211,19 @@ fn scattering_without_absorption_keeps_a_uniform_glow() {
                 sum += f64::from(p.color[0]);
             }
             let mean = sum / f.pixels.len() as f64;
-            let what = if glass { "milky glass" } else { "fog ball" };
-            report("medium in equilibrium", backend, 1.0, mean, 0.01, "");
+            let what = if glass {
+                "milky glass ball"
+            } else {
+                "fog ball"
+            };
+            report(
+                &format!("path: {what} in a glowing enclosure"),
+                backend,
+                1.0,
+                mean,
+                0.01,
+                "",
+            );
             assert_rel(mean, 1.0, 0.01, &format!("{what} on {backend}"));
         }
     }

@@ -87,7 +87,8 @@ fn white_furnace_at_rest() {
             let (mean, n) = mean_of(&f, 1);
             assert_eq!(n, 24 * 24, "every pixel sees the wall");
             let want = furnace_answer(rho, 100.0);
-            report("furnace at rest", backend, want, mean, 0.01 * want, "");
+            let case = format!("path: white furnace, albedo {rho}");
+            report(&case, backend, want, mean, 0.01 * want, "");
             assert_rel(mean, want, 0.01, &format!("furnace ρ = {rho} on {backend}"));
         }
     }
@@ -214,7 +215,8 @@ fn glowing_sphere_lights_a_plane_as_its_solid_angle_says() {
             let f = render_with(&scene(&lamp_over_plane(r, d)), backend);
             let (got, _) = mean_of(&f, 1);
             let want = 0.5 * 10.0 * (r / d) * (r / d);
-            report("lamp over plane", backend, want, got, 0.01 * want, "");
+            let case = format!("path: glowing sphere over a plane, r/d = {}", r / d);
+            report(&case, backend, want, got, 0.01 * want, "");
             assert_rel(got, want, 0.01, &format!("r = {r}, d = {d} on {backend}"));
         }
     }
@@ -314,7 +316,7 @@ fn sliding_glowing_ceiling_lights_a_floor_by_d5() {
         .0;
         let want = sliding_ceiling_factor(0.6);
         report(
-            "sliding ceiling",
+            "path: ceiling sliding at 0.6c over a floor, light over rest",
             backend,
             want,
             moving / rest,
