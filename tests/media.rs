@@ -271,3 +271,132 @@ fn bad_media_are_named() {
         }
     }
 }
+
+/// A camera at the origin looking down −z at a glowing backdrop 29 away, through a fog
+/// absorbing `sigma` per unit length at rest in the frame of group `drift` (a small ball out of
+/// view), which moves at `beta` along z.
+fn fogged(integrator: &str, beta: f64, sigma: f64) -> String {
+    format!(
+        r#"
+[camera]
+position = [0, 0, 0]
+direction = [0, 0, -1]
+up = [0, 1, 0]
+fov_y = 0.5
+[image]
+width = 3
+height = 3
+background = 0
+transparent = false
+[render]
+integrator = "{integrator}"
+max_depth = 0
+ambient = 0
+[[material]]
+name = "glow"
+emission = 1
+[fog]
+sigma_a = {sigma}
+group = "drift"
+[[group]]
+name = "backdrop"
+[[group.object]]
+type = "box"
+min = [-200, -200, -30]
+max = [200, 200, -29]
+material = "glow"
+[[group]]
+name = "drift"
+velocity = [0, 0, {beta}]
+[[group.object]]
+type = "sphere"
+center = [0, 500, 0]
+radius = 1
+"#
+    )
+}
+
+#[test]
+fn a_fog_everywhere_attenuates_by_its_own_frames_way() {
+    for backend in backends() {
+        for integrator in ["whitted", "path"] {
+            for beta in [0.0, 0.6, -0.6] {
+                let clear = centre(&render_with(
+                    &scene(&fogged(integrator, beta, 0.0)),
+                    backend,
+                ));
+                let seen = centre(&render_with(
+                    &scene(&fogged(integrator, beta, 0.02)),
+                    backend,
+                )) / clear;
+                // Looking along −z, the fog's frame (moving at β along z) stretches the way
+                // by s = γ (1 − β) (§7.1).
+                let gamma = 1.0 / (1.0 - beta * beta).sqrt();
+                let want = (-0.02 * gamma * (1.0 - beta) * 29.0).exp();
+                let what = format!("{integrator}, fog at β = {beta} on {backend}");
+                assert_rel(seen, want, 1e-4, &what);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_scattering_fog_in_a_glowing_room_keeps_it_uniform() {
+    let text = enclosure(false).replace(
+        "[[group]]\nname = \"ball\"",
+        "[fog]\nsigma_s = 0.3\ng = 0.4\ngroup = \"room\"\n[[group]]\nname = \"ball\"",
+    );
+    assert!(text.contains("[fog]"));
+    for backend in backends() {
+        let f = render_with(&scene(&text), backend);
+        let mean =
+            f.pixels.iter().map(|p| f64::from(p.color[0])).sum::<f64>() / f.pixels.len() as f64;
+        report(
+            "path: fog ball in a fog, in a glowing enclosure",
+            backend,
+            1.0,
+            mean,
+            0.01,
+            "",
+        );
+        assert_rel(mean, 1.0, 0.01, &format!("fog everywhere on {backend}"));
+    }
+}
+
+#[test]
+fn a_bad_fog_is_named() {
+    let base = fogged("path", 0.0, 0.02);
+    for (from, to, needles) in [
+        (
+            "group = \"drift\"",
+            "group = \"drifter\"",
+            vec!["fog.group", "no group is named `drifter`"],
+        ),
+        (
+            "sigma_a = 0.02\n",
+            "sigma_a = 0.02\ncolor = 1\n",
+            vec!["color", "unknown"],
+        ),
+        ("sigma_a = 0.02\n", "", vec!["sigma_a", "missing"]),
+    ] {
+        assert!(base.contains(from));
+        let err = rest_embree::scene::load_str("bad.toml", &base.replace(from, to), &[])
+            .err()
+            .unwrap_or_else(|| panic!("{to} is refused"))
+            .to_string();
+        for n in needles {
+            assert!(err.contains(n), "`{n}` in: {err}");
+        }
+    }
+    let empty = base
+        .replace(
+            "[[group]]\nname = \"drift\"",
+            "[[group]]\nname = \"still\"\n[[group]]\nname = \"drift\"",
+        )
+        .replace("group = \"drift\"", "group = \"still\"");
+    let err = rest_embree::scene::load_str("bad.toml", &empty, &[])
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("holds no objects"), "{err}");
+}

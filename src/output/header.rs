@@ -193,12 +193,17 @@ pub fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> String {
         objects,
         film,
         sky,
+        fog,
         image: _,
     } = scene;
     let _ = write!(
         feed,
         "{camera:?}|{image:?}|{render:?}|{materials:?}|{lights:?}|{groups:?}|{objects:?}|{film:?}|{sky:?}|{backend}|{overrides:?}"
     );
+    // Only where there is one, so that the ids of renders without fog stay as they were.
+    if let Some(f) = fog {
+        let _ = write!(feed, "|{f:?}");
+    }
     format!("{:016x}", feed.0.finish())
 }
 

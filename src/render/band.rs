@@ -72,11 +72,7 @@ impl Band for DVec3 {
         self.element_sum() / 3.0
     }
     fn exp_neg(&self, d: f64) -> Self {
-        DVec3::new(
-            (-self.x * d).exp(),
-            (-self.y * d).exp(),
-            (-self.z * d).exp(),
-        )
+        DVec3::new(exp_neg(self.x, d), exp_neg(self.y, d), exp_neg(self.z, d))
     }
     fn to_rgb(&self) -> DVec3 {
         *self
@@ -127,7 +123,7 @@ impl Band for Sampled {
         self.0.iter().sum::<f64>() / self.0.len() as f64
     }
     fn exp_neg(&self, d: f64) -> Self {
-        Sampled(self.0.map(|v| (-v * d).exp()))
+        Sampled(self.0.map(|v| exp_neg(v, d)))
     }
     fn to_rgb(&self) -> DVec3 {
         camera::rgb(self)
@@ -150,6 +146,16 @@ impl Band for Sampled {
     ) {
         let glint = glint.map(|(s, h)| (&s.0, h));
         kernels::add_lit(&mut self.0, &light.0, &diffuse.0, ndl, glint, atten * k);
+    }
+}
+
+/// e^(−v d), with a medium that does not attenuate (v = 0) letting all through however far
+/// (0 · ∞ would be NaN).
+fn exp_neg(v: f64, d: f64) -> f64 {
+    if v == 0.0 {
+        1.0
+    } else {
+        (-v * d).exp()
     }
 }
 

@@ -77,6 +77,8 @@ pub struct Shader<'a, B> {
     pub(super) seen: Seen,
     /// Whether some material is only the boundary of a medium.
     invisible: bool,
+    /// The scene's fog: the world group whose frame it rests in, and its material.
+    pub(super) fog: Option<(usize, u32)>,
     band: PhantomData<B>,
 }
 
@@ -133,6 +135,15 @@ impl<'a, B: Band> Shader<'a, B> {
             cones: None,
             seen,
             invisible: scene.materials.iter().any(|m| m.is_invisible()),
+            fog: scene.fog.as_ref().map(|f| {
+                let key = scene.groups[f.group].velocity.identity_key();
+                let g = world
+                    .groups
+                    .iter()
+                    .position(|g| g.velocity.identity_key() == key)
+                    .expect("a fog's group holds objects, so the world has its frame");
+                (g, f.material)
+            }),
             band: PhantomData,
         }
     }
@@ -161,7 +172,8 @@ impl<'a, B: Band> Shader<'a, B> {
         budget: Budget,
         spread: Spread,
     ) -> (B, u64) {
-        match self.world.closest_hit(ray, 0.0) {
+        let hit = self.world.closest_hit(ray, 0.0);
+        let (mut light, spent) = match hit {
             Some(h) => {
                 let (shift_h, k) = self.arriving(receiver_s, h.s, shift);
                 let sr = spread.into_frame(h.s);
@@ -175,7 +187,30 @@ impl<'a, B: Band> Shader<'a, B> {
                 }
                 (light, 0)
             }
+        };
+        let way = hit.map_or(f64::INFINITY, |h| h.lambda);
+        if let Some(t) = self.fog_over(ray.dir, receiver_s, shift, way) {
+            light.mul_by(&t);
         }
+        (light, spent)
+    }
+
+    /// The share of light the scene's fog lets through over lookback `lambda` (world frame)
+    /// along world direction `dir`, seen by a receiver with lookback factor `receiver_s` and
+    /// wavelengths `shift` times the camera's (None: no fog).
+    pub(super) fn fog_over(
+        &self,
+        dir: DVec3,
+        receiver_s: f64,
+        shift: f64,
+        lambda: f64,
+    ) -> Option<B> {
+        let (g, m) = self.fog?;
+        let gs = self.world.groups[g].boost.null_dir(dir).1;
+        let shift_f = self
+            .arriving(receiver_s, self.lookback_factor(g, dir), shift)
+            .0;
+        self.attenuation(m, shift_f, gs * lambda)
     }
 
     /// The stars a ray leaving the scene after a bounce sees, as radiance in its receiver's
@@ -525,6 +560,8 @@ impl<'a, B: Band> Shader<'a, B> {
                 }
             }
         };
+        // Outside every object, a ray is in the fog (if the scene has one).
+        within = within.or(self.fog);
         let mut t0 = 0.0;
         loop {
             let Some(h) = self.world.closest_hit(ray, t0).filter(|h| h.lambda < tmax) else {
@@ -539,11 +576,15 @@ impl<'a, B: Band> Shader<'a, B> {
             let exiting = g.geometry.prim(h.prim).normal(h.point).dot(h.dir) > 0.0;
             // Leaving a medium not entered on the way: the ray started in it (media are
             // closed and not nested).
-            if exiting && within.is_none() {
+            if exiting && within != Some((h.group, material)) {
                 within = Some((h.group, material));
             }
             cross(within, t0, h.lambda);
-            within = (!exiting).then_some((h.group, material));
+            within = if exiting {
+                self.fog
+            } else {
+                Some((h.group, material))
+            };
             // Past the boundary, by its group's ε (rest frame) in world lookback.
             t0 = h.lambda + g.epsilon / h.s;
         }

@@ -266,7 +266,7 @@ fn shade_hits<B: Band>(
         .map(|(k, lit)| match lit {
             Ok((l, factor)) => {
                 let mine = k * lights..(k + 1) * lights;
-                let seen = shader
+                let mut seen = shader
                     .finish(
                         l,
                         &shadows[mine],
@@ -274,6 +274,18 @@ fn shade_hits<B: Band>(
                         budget,
                     )
                     .0;
+                // The way from the hit to the camera through the scene's fog.
+                if let Some(h) = primary.hit(k) {
+                    let ray = primary.ray(k);
+                    let camera_s = if follows {
+                        cam.lookback_factor(ray.dir)
+                    } else {
+                        1.0
+                    };
+                    if let Some(t) = shader.fog_over(ray.dir, camera_s, 1.0, h.lambda) {
+                        seen.mul_by(&t);
+                    }
+                }
                 // The camera leg's factor, on the RGB (linear, so as on every wavelength).
                 seen.to_rgb() * *factor
             }
@@ -295,11 +307,14 @@ fn missed<B: Band>(
     stars: Option<&StarPixels>,
     (x, y): (u32, u32),
 ) -> DVec3 {
-    let sky = shader.background_along(dir, camera_s, 1.0).to_rgb();
-    match stars {
-        Some(st) => sky + st.at(x, y),
-        None => sky,
+    let mut sky = shader.background_along(dir, camera_s, 1.0);
+    // Through a fog without end: only wavelengths it does not attenuate arrive.
+    let fog = shader.fog_over(dir, camera_s, 1.0, f64::INFINITY);
+    if let Some(t) = &fog {
+        sky.mul_by(t);
     }
+    let stars = stars.map(|st| st.at(x, y) * fog.as_ref().map_or(1.0, |t| t.mean_value()));
+    sky.to_rgb() + stars.unwrap_or(DVec3::ZERO)
 }
 
 /// The colours (linear sRGB) of primary hits by the path integrator: one path per hit, its

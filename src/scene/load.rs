@@ -289,13 +289,17 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     }
     let film = root.table("film")?.map(|t| film(&t, &camera)).transpose()?;
     let sky = root.table("sky")?.map(|t| sky(&t)).transpose()?;
+    let fog = match root.table("fog")? {
+        Some(t) => Some(fog(&t, &groups, &mut materials)?),
+        None => None,
+    };
     // A sky is meant to be seen: the image shows it unless the scene asks for transparency.
     let mut image = image;
     if sky.is_some() && image.transparent.is_none() {
         image.transparent = Some(false);
     }
     root.finish(&[
-        "camera", "image", "render", "material", "texture", "light", "group", "film", "sky",
+        "camera", "image", "render", "material", "texture", "light", "group", "film", "sky", "fog",
     ])?;
     Ok(Scene {
         camera,
@@ -307,6 +311,36 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         objects,
         film,
         sky,
+        fog,
+    })
+}
+
+/// `[fog]`: a medium (`sigma_a`, `sigma_s`, `g`, as a material's `medium`) filling all space
+/// outside objects, at rest in the frame of group `group` (which must hold objects: its frame
+/// is one the renderer builds).
+fn fog(t: &Table, groups: &[Group], materials: &mut Vec<Material>) -> SceneResult<Fog> {
+    let name = t.req_string("group")?;
+    let Some(group) = groups.iter().position(|g| g.name == name) else {
+        return Err(t.error("group", format!("no group is named `{name}`")));
+    };
+    if groups[group].geometry.is_empty() {
+        return Err(t.error(
+            "group",
+            format!(
+                "group `{name}` holds no objects; a fog rests in the frame of a group that does"
+            ),
+        ));
+    }
+    let medium = super::surfaces::medium(t, &["group"])?;
+    materials.push(Material {
+        name: "[fog]".into(),
+        color: Colour::grey(0.0, Role::Reflectance),
+        medium: Some(medium),
+        ..Material::default_white()
+    });
+    Ok(Fog {
+        group,
+        material: (materials.len() - 1) as u32,
     })
 }
 

@@ -22,7 +22,7 @@ mod transform;
 pub use crate::error::SceneError;
 pub use load::{load_file, load_file_as, load_str, FrameSize};
 pub use model::{
-    Camera, Film, FrameSpacing, Group, ImageSettings, Integrator, Light, Material, Medium,
+    Camera, Film, Fog, FrameSpacing, Group, ImageSettings, Integrator, Light, Material, Medium,
     ObjectInfo, Projection, RenderSettings, Scene, MAX_FRAMES, MAX_FRAME_PIXELS, MAX_RAYS,
 };
 pub use pass_set::{Pass, PassSet};

@@ -343,6 +343,19 @@ pub struct Scene {
     pub film: Option<Film>,
     /// The sky every ray that meets nothing sees, in place of the image's background.
     pub sky: Option<super::Sky>,
+    /// A fog filling all space outside objects (`[fog]`), at rest in a group's frame.
+    pub fog: Option<Fog>,
+}
+
+/// A homogeneous medium everywhere outside objects, at rest in a group's frame. Its medium is
+/// the invisible material `materials[material]` (one no object uses), so it is crossed and
+/// scattered in as a fog bank's is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fog {
+    /// The scene group whose rest frame it is at rest in.
+    pub group: usize,
+    /// Its material's index (a medium and no surface).
+    pub material: u32,
 }
 
 impl Scene {

@@ -260,7 +260,7 @@ fn colour_or_texture(
 
 /// `medium = { sigma_a, sigma_s, g }`: coefficients per unit length, any non-negative colour
 /// (RGB is read as a reflectance scaled by its largest component, so a grey is flat).
-fn medium(t: &Table) -> SceneResult<crate::scene::Medium> {
+pub(super) fn medium(t: &Table, also: &[&str]) -> SceneResult<crate::scene::Medium> {
     let coefficient = |key: &str| -> SceneResult<Colour> {
         let Some(c) = t.colour(key, Role::Emitter)? else {
             return Ok(Colour::grey(0.0, Role::Reflectance));
@@ -293,7 +293,9 @@ fn medium(t: &Table) -> SceneResult<crate::scene::Medium> {
             "between -1 and 1 (not either)",
         )?,
     };
-    t.finish(&["sigma_a", "sigma_s", "g"])?;
+    let mut known = vec!["sigma_a", "sigma_s", "g"];
+    known.extend_from_slice(also);
+    t.finish(&known)?;
     Ok(m)
 }
 
@@ -317,7 +319,7 @@ pub(super) fn material(t: &Table, textures: &[ReadTexture]) -> SceneResult<Mater
         color_texture,
         emission_texture,
         medium: match t.table("medium")? {
-            Some(m) => Some(medium(&m)?),
+            Some(m) => Some(medium(&m, &[])?),
             None => None,
         },
     };

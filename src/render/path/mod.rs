@@ -126,12 +126,14 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         &self,
         ray: &NullRay,
         receiver_s: f64,
-        mut within: Option<(usize, u32)>,
+        within: Option<(usize, u32)>,
         first: Option<SurfaceHit>,
         path: &mut Path<B>,
         rng: &mut Rng,
     ) -> Reached {
         let (sh, world) = (self.shader, self.shader.world);
+        // Outside every object, a ray is in the fog (if the scene has one).
+        let mut within = within.or(sh.fog);
         let mut t = 0.0;
         let mut known = first;
         loop {
@@ -180,7 +182,11 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             }
             let g = &world.groups[h.group];
             let exiting = g.geometry.prim(h.prim).normal(h.point).dot(h.dir) > 0.0;
-            within = (!exiting).then_some((h.group, part.material));
+            within = if exiting {
+                sh.fog
+            } else {
+                Some((h.group, part.material))
+            };
             t = h.lambda + g.epsilon / h.s;
         }
     }
