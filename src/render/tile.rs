@@ -401,31 +401,7 @@ pub fn render_tile<B: Band>(
     let n = scene.image.samples;
     let shader = Shader::<B>::new(scene, world, seen).with_star_cones(view.cones);
     let tracer = view.emitters.map(|e| PathTracer::new(&shader, e));
-    // Pixels left out by the cull see the background in every sample (nothing, in a
-    // transparent image): the same everywhere
-    // unless the camera moves through a background that is not black (then each pixel's, as
-    // seen along its centre ray).
-    let still = scene.camera.velocity.is_zero()
-        || !shader.follows_frames()
-        || scene.image.background.is_black();
-    let transparent = scene.image.is_transparent();
-    let mut sum = if transparent {
-        vec![DVec3::ZERO; coords.len()]
-    } else if still {
-        vec![n as f64 * shader.background(1.0, 1.0).to_rgb(); coords.len()]
-    } else {
-        coords
-            .iter()
-            .map(|&(x, y)| {
-                let (ox, oy) = offset;
-                let ray = cam.ray((x + ox) as f64 + 0.5, (y + oy) as f64 + 0.5);
-                n as f64
-                    * shader
-                        .background(cam.lookback_factor(ray.dir), 1.0)
-                        .to_rgb()
-            })
-            .collect()
-    };
+    let mut sum = background_sums(&shader, scene, cam, (&coords, offset), n);
     for &k in live {
         sum[k] = DVec3::ZERO;
     }
@@ -487,72 +463,156 @@ pub fn render_tile<B: Band>(
             }
         }
     }
-    let mut nonfinite = 0;
-    // Depth is measured in the camera's rest frame, from the imaging event.
-    let (to_camera, eye) = (
-        crate::spacetime::Boost::to_rest(&scene.camera.velocity),
-        scene.camera.imaging_event(),
-    );
-    let pixels = coords
-        .iter()
-        .enumerate()
-        .map(|(k, &(x, y))| {
-            let mut c = sum[k] / n as f64;
-            if !c.is_finite() {
-                nonfinite += 1;
-                c = DVec3::ZERO;
-            }
-            let mut value = PixelValue {
-                color: c.to_array().map(to_f32),
-                alpha: if transparent {
-                    covered[k] as f32 / n as f32
-                } else {
-                    1.0
-                },
-                ..Default::default()
-            };
-            if let Some((r, hit)) = aov[k] {
-                let g = &world.groups[hit.group];
-                let prim = g.geometry.prim(hit.prim);
-                let nrm = prim.normal(hit.point);
-                value.lookback = to_f32(hit.lambda);
-                value.doppler = to_f32(cam.lookback_factor(r.dir) / hit.s);
-                let part = g.geometry.part_of(hit.prim);
-                value.object_id = part.object + 1;
-                value.material_id = part.material + 1;
-                value.primitive_id = g.geometry.index_in_object(hit.prim) + 1;
-                value.normal = [nrm.x as f32, nrm.y as f32, nrm.z as f32];
-                let p = r.at(hit.lambda).x;
-                value.position = p.to_array().map(to_f32);
-                let q = hit.point;
-                value.rest_position = q.to_array().map(to_f32);
-                let seen_at = to_camera.event(r.at(hit.lambda) - eye).x;
-                let c = &scene.camera;
-                let on_axes = [c.right, c.up, c.forward].map(|a| to_f32(seen_at.dot(a)));
-                value.camera_position = on_axes;
-                value.depth = on_axes[2];
-            } else if aov_sample.is_some() {
-                value.depth = super::DEPTH_FAR;
-            }
-            let mattes = seen
-                .get_mut(k)
-                .map_or(Mattes::default(), |[objects, materials]| Mattes {
-                    object: ranked(objects, n),
-                    material: ranked(materials, n),
-                });
-            TilePixel {
-                x,
-                y,
-                value,
-                mattes,
-            }
-        })
-        .collect();
+    let gathered = Gathered {
+        sum,
+        covered,
+        aov,
+        seen,
+        passes: aov_sample.is_some(),
+    };
+    let (pixels, nonfinite) = gathered.pixels(&coords, n, scene, world, cam);
     TileResult {
         pixels,
         primary_rays: traced,
         nonfinite,
     }
+}
+
+/// What a tile's samples gathered, pixel by pixel (in `tile_pixels` order).
+struct Gathered {
+    /// The colours' sum over the samples.
+    sum: Vec<DVec3>,
+    /// How many samples met a surface.
+    covered: Vec<u32>,
+    /// The centre ray's hit, for the passes.
+    aov: Vec<Option<(NullRay, SurfaceHit)>>,
+    /// How many samples saw each object and each material (with the passes).
+    seen: Vec<[Counts; 2]>,
+    /// Whether the passes are rendered.
+    passes: bool,
+}
+
+impl Gathered {
+    /// The tile's pixels, and how many came out NaN or infinite (made black).
+    fn pixels(
+        mut self,
+        coords: &[(u32, u32)],
+        n: u32,
+        scene: &Scene,
+        world: &World,
+        cam: &CameraRays,
+    ) -> (Vec<TilePixel>, u64) {
+        let transparent = scene.image.is_transparent();
+        let mut nonfinite = 0;
+        // Depth is measured in the camera's rest frame, from the imaging event.
+        let (to_camera, eye) = (
+            crate::spacetime::Boost::to_rest(&scene.camera.velocity),
+            scene.camera.imaging_event(),
+        );
+        let pixels = coords
+            .iter()
+            .enumerate()
+            .map(|(k, &(x, y))| {
+                let mut c = self.sum[k] / n as f64;
+                if !c.is_finite() {
+                    nonfinite += 1;
+                    c = DVec3::ZERO;
+                }
+                let mut value = PixelValue {
+                    color: c.to_array().map(to_f32),
+                    alpha: if transparent {
+                        self.covered[k] as f32 / n as f32
+                    } else {
+                        1.0
+                    },
+                    ..Default::default()
+                };
+                if let Some((r, hit)) = &self.aov[k] {
+                    fill_passes(&mut value, r, hit, world, cam, (scene, &to_camera, eye));
+                } else if self.passes {
+                    value.depth = super::DEPTH_FAR;
+                }
+                let mattes =
+                    self.seen
+                        .get_mut(k)
+                        .map_or(Mattes::default(), |[objects, materials]| Mattes {
+                            object: ranked(objects, n),
+                            material: ranked(materials, n),
+                        });
+                TilePixel {
+                    x,
+                    y,
+                    value,
+                    mattes,
+                }
+            })
+            .collect();
+        (pixels, nonfinite)
+    }
+}
+
+/// Every pixel's colour summed over its `n` samples, before any sample is traced: the
+/// background in every sample, as the pixels the screen cull leaves out keep it (nothing, in a
+/// transparent image). The same everywhere unless the camera moves through a background that
+/// is not black (then each pixel's, as seen along its centre ray).
+fn background_sums<B: Band>(
+    shader: &Shader<B>,
+    scene: &Scene,
+    cam: &CameraRays,
+    (coords, (ox, oy)): (&[(u32, u32)], (u32, u32)),
+    n: u32,
+) -> Vec<DVec3> {
+    let still = scene.camera.velocity.is_zero()
+        || !shader.follows_frames()
+        || scene.image.background.is_black();
+    if scene.image.is_transparent() {
+        vec![DVec3::ZERO; coords.len()]
+    } else if still {
+        vec![n as f64 * shader.background(1.0, 1.0).to_rgb(); coords.len()]
+    } else {
+        coords
+            .iter()
+            .map(|&(x, y)| {
+                let ray = cam.ray((x + ox) as f64 + 0.5, (y + oy) as f64 + 0.5);
+                n as f64
+                    * shader
+                        .background(cam.lookback_factor(ray.dir), 1.0)
+                        .to_rgb()
+            })
+            .collect()
+    }
+}
+
+/// The passes of a pixel whose centre ray `r` met `hit`: lookback, Doppler factor, ids, normal,
+/// positions (world, rest frame, and the camera's frame: into it by `to_camera`, from the
+/// imaging event `eye`) and depth.
+fn fill_passes(
+    value: &mut PixelValue,
+    r: &NullRay,
+    hit: &SurfaceHit,
+    world: &World,
+    cam: &CameraRays,
+    (scene, to_camera, eye): (&Scene, &crate::spacetime::Boost, crate::spacetime::Event),
+) {
+    let g = &world.groups[hit.group];
+    let prim = g.geometry.prim(hit.prim);
+    let nrm = prim.normal(hit.point);
+    value.lookback = to_f32(hit.lambda);
+    value.doppler = to_f32(cam.lookback_factor(r.dir) / hit.s);
+    let part = g.geometry.part_of(hit.prim);
+    value.object_id = part.object + 1;
+    value.material_id = part.material + 1;
+    value.primitive_id = g.geometry.index_in_object(hit.prim) + 1;
+    value.normal = [nrm.x as f32, nrm.y as f32, nrm.z as f32];
+    let p = r.at(hit.lambda).x;
+    value.position = p.to_array().map(to_f32);
+    let q = hit.point;
+    value.rest_position = q.to_array().map(to_f32);
+    let seen_at = to_camera.event(r.at(hit.lambda) - eye).x;
+    let c = &scene.camera;
+    let on_axes = [c.right, c.up, c.forward].map(|a| to_f32(seen_at.dot(a)));
+    value.camera_position = on_axes;
+    value.depth = on_axes[2];
 }
 
 /// An f64 value as f32, saturating at f32's largest finite values (radiance under a strong
