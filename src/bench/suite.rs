@@ -142,16 +142,28 @@ const LATTICE_SETTINGS: [&str; 7] = [
 
 /// The fixed suite, each case built only when it runs (so a row's peak memory is its own).
 /// `quick` shrinks images and scenes for a fast look (CI-sized).
+/// An image of `w` × `w` pixels at one sample each.
+fn size(w: u32) -> Vec<String> {
+    vec![
+        format!("image.width={w}"),
+        format!("image.height={w}"),
+        "image.samples=1".into(),
+    ]
+}
+
 pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
     let px: u32 = if quick { 128 } else { 512 };
-    fn size(w: u32) -> Vec<String> {
-        vec![
-            format!("image.width={w}"),
-            format!("image.height={w}"),
-            "image.samples=1".into(),
-        ]
-    }
     let mut out = Vec::new();
+    lattice_cases(px, &mut out);
+    planet_cases(px, &mut out);
+    light_cases(px, &mut out);
+    large_cases(quick, px, &mut out);
+    group_cases(quick, px, &mut out);
+    out
+}
+
+/// The paper's lattice at four speeds, and what its shadow and secondary rays cost at 0.9c.
+fn lattice_cases(px: u32, out: &mut Vec<LazyCase>) {
     for b in ["0", "0.5", "0.9", "0.99"] {
         out.push(LazyCase::new(&format!("lattice beta={b}"), move || {
             let mut s = size(px);
@@ -184,6 +196,10 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
             &["embree", "bvh"],
         ))
     }));
+}
+
+/// Textures, a sky map and a star field on the planet, each beside the planet without it.
+fn planet_cases(px: u32, out: &mut Vec<LazyCase>) {
     // What an image texture costs (three colour lookups per hit on the map's basis), against
     // the same planet in one colour; what a sky map costs, and a star field (placing 40,000
     // stars in their pixels, once a frame, and a look up per ray that meets nothing), against
@@ -219,6 +235,10 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
                 .beside(beside, with(beside_set)?))
         }));
     }
+}
+
+/// Spectral light against RGB, and what the EXR passes cost.
+fn light_cases(px: u32, out: &mut Vec<LazyCase>) {
     // Light as a camera records it (Doppler shift and searchlight on every leg of a path)
     // against the RGB render of the same scene, measured side by side.
     out.push(LazyCase::new("lattice beta=0.9, spectral", move || {
@@ -246,6 +266,10 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
         )
         .with_spp(&[4]))
     }));
+}
+
+/// A large lattice and a large bar array, instanced and listed.
+fn large_cases(quick: bool, px: u32, out: &mut Vec<LazyCase>) {
     // A large lattice: 100^3 nodes (1M spheres, ~3M rods) at 1024^2.
     let n = if quick { 30 } else { 100 };
     let big_name = format!("lattice {n}^3 beta=0.9");
@@ -289,6 +313,10 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
         )
         .without_hi_reference())
     }));
+}
+
+/// Many velocity groups against one, and merging groups of one velocity.
+fn group_cases(quick: bool, px: u32, out: &mut Vec<LazyCase>) {
     // Many velocity groups, against one group holding the same boxes.
     let gpx = px / 2;
     let many = if quick {
@@ -350,7 +378,6 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
         )
         .without_hi_reference())
     }));
-    out
 }
 
 #[cfg(test)]
