@@ -523,3 +523,42 @@ fn time_and_noise_budgets_on_the_command_line() {
         "{err}"
     );
 }
+
+/// Stars seen in a perfect mirror: the path integrator carries the pixel's bundle through
+/// smooth bounces as Whitted's rays do, so with a mirror alone the two pictures are the same,
+/// the camera at rest and moving at 0.6c along the mirror.
+#[test]
+fn stars_in_a_mirror_as_whitted_sees_them() {
+    let text = |integrator: &str, velocity: &str| {
+        format!(
+            "[camera]\nposition = [0, 0, 0]\ndirection = [1, 0, 0]\nup = [0, 0, 1]\nfov_y = 70\nvelocity = {velocity}\n\
+             [image]\nwidth = 48\nheight = 48\n\
+             [render]\nintegrator = \"{integrator}\"\n\
+             [sky]\nstars = {{ count = 20000, seed = 5, magnitudes = [5, 5], irradiance = 0.1 }}\n\
+             [[material]]\nname = \"mirror\"\ncolor = 0\nreflect = 1.0\n\
+             [[group]]\nname = \"m\"\n[[group.object]]\ntype = \"box\"\nmin = [5, -100, -100]\nmax = [6, 100, 100]\nmaterial = \"mirror\"\n"
+        )
+    };
+    for velocity in ["[0, 0, 0]", "[0, 0.6, 0]"] {
+        for backend in backends() {
+            let w = render_with(&scene(&text("whitted", velocity)), backend);
+            let p = render_with(&scene(&text("path", velocity)), backend);
+            let (mut stars, mut total) = (0, 0.0);
+            for (a, b) in w.pixels.iter().zip(&p.pixels) {
+                for c in 0..3 {
+                    let (a, b) = (f64::from(a.color[c]), f64::from(b.color[c]));
+                    assert!(
+                        (a - b).abs() <= 1e-5 * a.abs().max(1e-6),
+                        "Whitted {a}, path {b} (camera at {velocity}, {backend})"
+                    );
+                    total += b;
+                }
+                stars += usize::from(a.color[1] > 0.0);
+            }
+            assert!(
+                stars > 50 && total > 0.0,
+                "stars are seen in the mirror ({stars})"
+            );
+        }
+    }
+}

@@ -217,7 +217,13 @@ impl<'a, B: Band> Shader<'a, B> {
     /// frame: those in the cone of the ray's bundle about it (in the sky's frame), each as its
     /// irradiance, carried into the receiver's frame as a point source's (docs/physics.md
     /// §5.5), over the bundle's solid angle there. None where there are none to find.
-    fn stars_along(&self, dir: DVec3, receiver_s: f64, shift: f64, spread: Spread) -> Option<B> {
+    pub(super) fn stars_along(
+        &self,
+        dir: DVec3,
+        receiver_s: f64,
+        shift: f64,
+        spread: Spread,
+    ) -> Option<B> {
         let (cones, sky) = (self.cones?, self.sky.as_ref()?);
         if spread.sr.is_nan() || spread.sr <= 0.0 {
             return None;

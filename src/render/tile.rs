@@ -7,7 +7,7 @@ use super::frame::{Mattes, PixelValue, MATTE_RANKS};
 use super::path::{sample_rng, Emitters, PathTracer};
 use super::sampler::sample_offset;
 use super::screen_cull::ScreenCull;
-use super::shade::Shader;
+use super::shade::{Shader, Spread};
 use super::star_pixels::{StarCones, StarPixels};
 use super::world::{PrimaryHits, SurfaceHit, World};
 use super::{Passes, TILE};
@@ -332,6 +332,7 @@ fn shade_paths<B: Band>(
     let follows = shader.follows_frames();
     let black_sky = shader.primary_misses_add_nothing();
     let seed = shader.scene.render.seed;
+    let spreads = shader.finds_star_cones();
     (0..primary.len())
         .map(|i| {
             let ray = primary.ray(i);
@@ -344,7 +345,17 @@ fn shade_paths<B: Band>(
             match primary.hit(i) {
                 Some(h) => {
                     let mut rng = sample_rng(seed, x, y, sample);
-                    tracer.camera_path(&ray, &h, camera_s, &mut rng).to_rgb()
+                    // The pixel's bundle, for stars seen after mirrors and glass.
+                    let spread = match spreads {
+                        true => Spread {
+                            sr: cam.pixel_solid_angle(x, y),
+                            s: cam.lookback_factor(ray.dir),
+                        },
+                        false => Spread::NONE,
+                    };
+                    tracer
+                        .camera_path(&ray, &h, camera_s, spread, &mut rng)
+                        .to_rgb()
                 }
                 None if black_sky => DVec3::ZERO,
                 None => missed(shader, camera_s, ray.dir, stars, (x, y)),

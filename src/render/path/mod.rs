@@ -16,7 +16,7 @@ pub(crate) use emitters::Emitters;
 
 use super::band::Band;
 use super::sampler::splitmix;
-use super::shade::{surface_colour, Shader};
+use super::shade::{surface_colour, Shader, Spread};
 use super::world::SurfaceHit;
 use crate::rng::Rng;
 use crate::spacetime::{Event, NullRay};
@@ -68,11 +68,14 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
     /// The light a camera ray brings to the camera (its lookback factor `camera_s` for the
     /// ray, as the switches have it), which first meets `first`: one path's estimate, at the
     /// camera's wavelengths.
+    /// `spread`: the bundle the ray stands for (its pixel's, where stars are to be found after
+    /// mirror and glass bounces).
     pub fn camera_path(
         &self,
         ray: &NullRay,
         first: &SurfaceHit,
         camera_s: f64,
+        spread: Spread,
         rng: &mut Rng,
     ) -> B {
         let mut out = B::splat(0.0);
@@ -80,6 +83,7 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             beta: B::splat(1.0),
             shift: 1.0,
             came: None,
+            spread,
         };
         let mut leg = Leg::Null {
             ray: *ray,
@@ -99,7 +103,12 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             };
             let next = match reached {
                 Reached::Sky { dir, receiver_s } => {
-                    let mut sky = self.shader.background_along(dir, receiver_s, path.shift);
+                    let sh = self.shader;
+                    let mut sky = sh.background_along(dir, receiver_s, path.shift);
+                    // Stars, along a path of mirrors and clear glass that keeps its bundle.
+                    if let Some(stars) = sh.stars_along(dir, receiver_s, path.shift, path.spread) {
+                        sky.add(&stars);
+                    }
                     sky.mul_by(&path.beta);
                     out.add(&sky);
                     None
@@ -339,9 +348,16 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         let side = if bs.wi.z > 0.0 { lit.nf } else { -lit.nf };
         let pdf = (!bs.delta).then_some(bs.pdf);
         let from = sh.pushed_off(lit.group, lit.event, side);
+        // A smooth bounce keeps the bundle's solid angle in the surface's frame (a flat
+        // surface), as Whitted's rays do; any other ends it.
+        let kept = match bs.delta && path.spread.sr > 0.0 {
+            true => path.spread.into_frame(hit.s),
+            false => 0.0,
+        };
         // Into a glass object: slower light, no change of frame, maybe a medium.
         if mat.transmit > 0.0 && wi.dot(lit.n) < 0.0 {
             path.came = pdf.map(|pdf| Came { pdf, from, s: 1.0 });
+            path.spread = Spread { sr: kept, s: 1.0 };
             return Some(Leg::Slow(Inside {
                 group: lit.group,
                 event: lit.event,
@@ -361,6 +377,7 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             from: r.origin,
             s,
         });
+        path.spread = Spread { sr: kept, s };
         Some(Leg::Null {
             ray: r,
             receiver_s: sh.lookback_factor(lit.group, r.dir),
@@ -403,6 +420,7 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         }
         let (wi, pdf) = phase.sample(wo, rng.f(), rng.f());
         self.roulette(depth, path, rng)?;
+        path.spread = Spread::NONE;
         let s = match at.slow {
             Some(_) => 1.0,
             None => {
@@ -641,6 +659,8 @@ struct Path<B> {
     beta: B,
     shift: f64,
     came: Option<Came>,
+    /// The bundle the path's leg stands for (none after a bounce that is not smooth).
+    spread: Spread,
 }
 
 /// A leg of a path: a null ray (through the media whose boundaries it crosses), or a ray
