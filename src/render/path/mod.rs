@@ -10,6 +10,7 @@
 
 mod bsdf;
 mod emitters;
+mod nee;
 mod phase;
 
 pub(crate) use emitters::Emitters;
@@ -22,7 +23,7 @@ use crate::rng::Rng;
 use crate::spacetime::{Event, NullRay};
 use bsdf::{Basis, Lobes};
 use glam::DVec3;
-use std::f64::consts::PI;
+use nee::Gather;
 
 /// The bounce from which Russian roulette may end a path.
 const ROULETTE_FROM: u32 = 3;
@@ -150,16 +151,15 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             if let Some((g, m)) = within {
                 // Free flight through the medium, in its frame.
                 let gs = world.groups[g].boost.null_dir(ray.dir).1;
-                let (shift_m, _) =
+                // The medium's wavelengths, and what its light gains on the way to the receiver.
+                let (shift_m, k) =
                     sh.arriving(receiver_s, sh.lookback_factor(g, ray.dir), path.shift);
                 let end = hit.map_or(f64::INFINITY, |h| h.lambda);
                 match self.fly(m, shift_m, gs * (end - t), path, rng) {
                     Some(ts) => {
                         let lambda = t + ts / gs;
-                        let (shift_g, k) =
-                            sh.arriving(receiver_s, sh.lookback_factor(g, ray.dir), path.shift);
                         path.beta = path.beta * k;
-                        path.shift = shift_g;
+                        path.shift = shift_m;
                         return Reached::Scatter(Scatter {
                             group: g,
                             material: m,
@@ -466,191 +466,6 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         }
         Some(())
     }
-
-    /// The weight of an emitter a BSDF draw met (power heuristic against next-event
-    /// estimation's density for the same point, in the receiver's frame).
-    fn mis_met(&self, came: &Came, hit: &SurfaceHit) -> f64 {
-        let p_pick = self.emitters.prob_of(hit.group, hit.prim);
-        if p_pick == 0.0 {
-            return 1.0;
-        }
-        let g = &self.shader.world.groups[hit.group];
-        let x = g.boost.event(came.from).x;
-        let pdf_e = emitters::pdf_point(&g.geometry.prim(hit.prim), x, hit.point);
-        let d = came.s / hit.s;
-        power(came.pdf, p_pick * pdf_e * d * d)
-    }
-
-    /// Whether the way from `here` back along a shadow ray (`ray`, to lookback `tmax`) is clear,
-    /// and what share of the light crosses it: media attenuate it (where the scene has any
-    /// whose surface is invisible), any other surface stops it (None).
-    fn reaches(
-        &self,
-        here: &Gather,
-        ray: &NullRay,
-        tmax: f64,
-        light: Option<usize>,
-    ) -> Option<Option<B>> {
-        let sh = self.shader;
-        if sh.has_invisible() {
-            let s = sh.world.groups[here.group].boost.null_dir(ray.dir).1;
-            return sh
-                .transmittance(ray, tmax, here.within, here.shift, s)
-                .map(Some);
-        }
-        let blocked = match light {
-            None => sh.world.occluded(ray, 0.0, tmax),
-            Some(l) => sh.world.shadowed(l, ray, tmax),
-        };
-        (!blocked).then_some(None)
-    }
-
-    /// `beta` times the light `here` gathers from every point light and one glowing primitive
-    /// (next-event estimation), to `out`. `scatter(wi)`: for light arriving from rest-frame
-    /// direction `wi`, the factor on its radiance (BSDF times cosine, or the phase function)
-    /// and the density with which the vertex's own draw would have chosen `wi`.
-    fn gather(
-        &self,
-        here: &Gather,
-        scatter: &dyn Fn(DVec3) -> (B, f64),
-        beta: &B,
-        rng: &mut Rng,
-        out: &mut B,
-    ) {
-        self.point_lights(here, scatter, beta, out);
-        self.emitter_light(here, scatter, beta, rng, out);
-    }
-
-    /// The start of a shadow ray toward rest-frame direction `toward`: ε off the surface on
-    /// that side (a point in a medium starts where it is).
-    fn shadow_start(&self, here: &Gather, toward: DVec3) -> Event {
-        match here.nf {
-            Some(nf) => {
-                let side = if toward.dot(nf) > 0.0 { nf } else { -nf };
-                self.shader.pushed_off(here.group, here.event, side)
-            }
-            None => here.event,
-        }
-    }
-
-    fn point_lights(
-        &self,
-        here: &Gather,
-        scatter: &dyn Fn(DVec3) -> (B, f64),
-        beta: &B,
-        out: &mut B,
-    ) {
-        let sh = self.shader;
-        let g = &sh.world.groups[here.group];
-        for (i, l) in sh.lights.iter().enumerate() {
-            let Some(first) = l.toward(here.event, g) else {
-                continue;
-            };
-            let from = self.shadow_start(here, first.to_light);
-            let Some(to) = l.toward(from, g) else {
-                continue;
-            };
-            let (f, _) = scatter(to.to_light);
-            if f.max_value() <= 0.0 {
-                continue;
-            }
-            let ray = NullRay::new(from, to.dir_w);
-            let Some(through) = self.reaches(here, &ray, to.dist * to.k * (1.0 - 1e-9), Some(i))
-            else {
-                continue;
-            };
-            let atten = if l.light.inverse_square {
-                1.0 / (to.dist * to.dist)
-            } else {
-                1.0
-            };
-            let (light_shift, k) = sh.seen.irradiance(to.k * to.s_surface, here.shift);
-            // A point light's `intensity` is Whitted's: a white Lambert surface facing it at
-            // distance 1 shows that radiance, so its irradiance there is π times it.
-            let mut c = B::of(&l.light.radiance, B::at(light_shift));
-            c.mul_by(&f);
-            c.mul_by(beta);
-            if let Some(t) = &through {
-                c.mul_by(t);
-            }
-            out.add(&(c * (PI * atten * k)));
-        }
-    }
-
-    /// `beta` times the light of one glowing primitive, drawn on its area in its rest frame,
-    /// weighed against the vertex's own draws, to `out`.
-    fn emitter_light(
-        &self,
-        here: &Gather,
-        scatter: &dyn Fn(DVec3) -> (B, f64),
-        beta: &B,
-        rng: &mut Rng,
-        out: &mut B,
-    ) {
-        let sh = self.shader;
-        let world = sh.world;
-        let Some((eg, prim, p_pick)) = self.emitters.pick(rng.f()) else {
-            return;
-        };
-        let u = [rng.f(), rng.f(), rng.f()];
-        let ge = &world.groups[eg];
-        let prim_e = ge.geometry.prim(prim);
-        // The vertex in the emitter's frame, where the emitter is static: the event on its
-        // surface on the vertex's past light cone is `dist` before, at the drawn point.
-        let x = ge.boost.event(here.event).x;
-        let Some(pt) = emitters::sample_point(&prim_e, x, u) else {
-            return;
-        };
-        // The shadow ray starts ε off the surface, on the side the light comes from; the
-        // distance and the density are taken from there (as a BSDF draw's are, `mis_met`).
-        let toward_w = ge.boost.inverse().view_dir(pt.point - x).0;
-        let toward = world.groups[here.group].boost.view_dir(toward_w).0;
-        let from = self.shadow_start(here, toward);
-        let x = ge.boost.event(from).x;
-        let delta = pt.point - x;
-        let dist = delta.length();
-        if dist == 0.0 || !dist.is_finite() {
-            return;
-        }
-        let look_e = delta / dist;
-        // ν_world / ν_emitter, then ν_vertex / ν_world, along the ray.
-        let (dir_w, k_world) = ge.boost.inverse().view_dir(look_e);
-        let (look, s_vertex) = world.groups[here.group].boost.view_dir(dir_w);
-        let d = k_world * s_vertex;
-        let (f, pdf_own) = scatter(look);
-        if f.max_value() <= 0.0 {
-            return;
-        }
-        let ray = NullRay::new(from, dir_w);
-        let tmax = dist * k_world * (1.0 - 1e-6);
-        let Some(through) = self.reaches(here, &ray, tmax, None) else {
-            return;
-        };
-        let pdf_e = emitters::pdf_point(&prim_e, x, pt.point);
-        let p_light = p_pick * pdf_e * d * d;
-        let (shift_e, k) = sh.seen.radiance(d, here.shift);
-        let on = SurfaceHit {
-            group: eg,
-            prim,
-            lambda: 0.0,
-            point: pt.point,
-            dir: look_e,
-            s: 1.0,
-        };
-        let elit = sh.lit_at(&on, here.event, shift_e);
-        let Some(e) = &elit.mat.emission else {
-            return;
-        };
-        let at = B::at(shift_e);
-        let mut c = surface_colour::<B>(e, elit.mat.emission_texture.as_deref(), &elit, at);
-        c.mul_by(&f);
-        c.mul_by(beta);
-        if let Some(t) = &through {
-            c.mul_by(t);
-        }
-        let w = power(p_light, pdf_own);
-        out.add(&(c * (k * w / p_light)));
-    }
 }
 
 /// A path's state between vertices: its throughput, the wavelengths of the frame it is in,
@@ -720,26 +535,4 @@ struct Scatter {
     look: DVec3,
     /// Inside a glass object: Some(the medium outside it).
     slow: Option<Option<(usize, u32)>>,
-}
-
-/// Where next-event estimation gathers light.
-struct Gather {
-    group: usize,
-    event: Event,
-    /// The frame's wavelengths over the camera's.
-    shift: f64,
-    /// A surface's normal toward the side the path came from (None: a point in a medium).
-    nf: Option<DVec3>,
-    /// The medium the point is in.
-    within: Option<(usize, u32)>,
-}
-
-/// The power heuristic's weight for a strategy of density `a` against one of density `b`.
-fn power(a: f64, b: f64) -> f64 {
-    let (a2, b2) = (a * a, b * b);
-    if a2 + b2 > 0.0 {
-        a2 / (a2 + b2)
-    } else {
-        0.0
-    }
 }
