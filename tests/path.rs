@@ -1,6 +1,7 @@
 //! The path integrator (`[render] integrator = "path"`) against answers known in closed form:
 //! a white furnace (a diffuse sphere around a glowing ball) at rest and riding along with the
-//! camera at 0.6c, a diffuse plane under a uniform sky, a glowing sphere over a plane (direct
+//! camera at 0.6c and seen from outside through an opening as it moves (its glow times D⁵), a
+//! diffuse plane under a uniform sky, a glowing sphere over a plane (direct
 //! light only, small and large), a glowing ceiling sliding at 0.6c over a floor at rest (the
 //! floor's light the integral of D⁵ cos θ over the ceiling's directions), Whitted's picture with
 //! point lights and no bounce, the same bytes on any number of threads, and bad input.
@@ -116,6 +117,120 @@ fn white_furnace_riding_along_at_0_6c_is_the_one_at_rest() {
                 a,
                 0.005,
                 &format!("channel {c} moving against at rest, {backend}"),
+            );
+        }
+    }
+}
+
+/// A closed diffuse sphere (radius 10, albedo 0.8, flat spectra) with a round opening of
+/// half-angle 12° about its −z pole, written as 48 × 96 flat triangles, around a glowing ball
+/// off the axis; the furnace moving along −z at `beta` toward a camera at rest on the axis
+/// outside, which looks in through the opening at the far wall about the +z pole.
+fn open_furnace(beta: f64) -> String {
+    let (rings, segments) = (48, 96);
+    let hole = 12f64.to_radians();
+    let mut vertices = Vec::new();
+    for i in 0..=rings {
+        // From the +z pole (θ = 0) to the opening's rim (θ = π − hole).
+        let theta = (std::f64::consts::PI - hole) * i as f64 / rings as f64;
+        for j in 0..segments {
+            let phi = 2.0 * std::f64::consts::PI * j as f64 / segments as f64;
+            let (x, y, z) = (
+                10.0 * theta.sin() * phi.cos(),
+                10.0 * theta.sin() * phi.sin(),
+                10.0 * theta.cos(),
+            );
+            vertices.push(format!("[{x}, {y}, {z}]"));
+        }
+    }
+    let mut indices = Vec::new();
+    for i in 0..rings {
+        for j in 0..segments {
+            let a = i * segments + j;
+            let b = i * segments + (j + 1) % segments;
+            let (c, d) = (a + segments, b + segments);
+            indices.push(format!("[{a}, {b}, {d}]"));
+            indices.push(format!("[{a}, {d}, {c}]"));
+        }
+    }
+    let flat = |v: f64| format!("{{ wavelengths = [100, 3000], values = [{v}, {v}] }}");
+    format!(
+        r#"
+[camera]
+position = [0, 0, -40]
+direction = [0, 0, 1]
+up = [0, 1, 0]
+fov_y = 2
+[image]
+width = 12
+height = 12
+samples = 512
+background = 0
+transparent = false
+[render]
+integrator = "path"
+max_depth = 64
+[[material]]
+name = "wall"
+color = {wall}
+[[material]]
+name = "lamp"
+emission = {lamp}
+[[group]]
+name = "furnace"
+velocity = [0, 0, {v}]
+[[group.object]]
+type = "mesh"
+vertices = [{vertices}]
+indices = [{indices}]
+material = "wall"
+[[group.object]]
+type = "sphere"
+center = [0, 6, 0]
+radius = 1
+material = "lamp"
+"#,
+        wall = flat(0.8),
+        lamp = flat(100.0),
+        v = -beta,
+        vertices = vertices.join(", "),
+        indices = indices.join(", "),
+    )
+}
+
+/// The same furnace seen from outside through its opening, moving toward the camera: what
+/// the camera records of the glow inside (light that has bounced any number of times between
+/// walls at rest in the furnace's frame) is the glow at rest times D⁵, D = √((1 + β)/(1 − β))
+/// along the axis (flat spectra: the shift changes nothing else; docs/physics.md §5.2, §10.1).
+#[test]
+fn moving_furnace_seen_through_an_opening_glows_by_d5() {
+    for backend in backends() {
+        let rest = render_with(&scene(&open_furnace(0.0)), backend);
+        let (at_rest, n) = mean_of(&rest, 1);
+        assert_eq!(
+            n,
+            12 * 12,
+            "every pixel sees the far wall through the opening"
+        );
+        assert!(at_rest > 0.1, "the wall glows ({at_rest})");
+        for beta in [0.3, -0.3] {
+            let moving = render_with(&scene(&open_furnace(beta)), backend);
+            let (glow, n) = mean_of(&moving, 1);
+            assert_eq!(n, 12 * 12, "β = {beta}: still through the opening");
+            let want = ((1.0 + beta) / (1.0 - beta)).sqrt().powi(5);
+            report(
+                &format!("path: furnace seen through its opening at {beta}c, glow over rest"),
+                backend,
+                want,
+                glow / at_rest,
+                0.02 * want,
+                "",
+            );
+            assert_rel(
+                glow / at_rest,
+                want,
+                0.02,
+                &format!("β = {beta} on {backend}"),
             );
         }
     }
