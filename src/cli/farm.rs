@@ -135,190 +135,268 @@ fn script(name: &str, logs: &Path, array: Option<u64>, body: &str) -> String {
 }
 
 fn slurm(args: &SlurmArgs) -> crate::Result<()> {
-    let exe = std::env::current_exe().map_err(|e| Error::flag("farm", e))?;
-    let scene_path = std::fs::canonicalize(&args.scene)
-        .map_err(|e| Error::flag(&args.scene.display().to_string(), e))?;
-    let overrides: Vec<(String, String)> = args
-        .set
-        .iter()
-        .map(|s| (format!("--set {s}"), s.clone()))
-        .collect();
-    // Everything a task would refuse is refused here, before anything is submitted.
-    // A tiled image may be larger than one frame; each tile's frame is checked below.
-    let frame = match args.tiles {
-        Some(_) => scene::FrameSize::InTiles,
-        None => scene::FrameSize::Checked,
+    let (scene, plan) = Plan::new(args)?;
+    let jobs = match (&scene.film, args.tiles) {
+        (Some(f), None) => plan.film_jobs(f, args)?,
+        (_, grid) => plan.image_jobs(&scene, grid, args)?,
     };
-    let scene = scene::load_file_as(&scene_path, &overrides, frame)?;
-    let format = output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
-    if let Some(b) = &args.backend {
-        crate::accel::backend_by_name(b).map_err(|e| e.on_flag("--backend"))?;
+    if args.dry_run {
+        print_jobs(&jobs, args);
+        Ok(())
+    } else {
+        submit(&jobs, &plan.logs, args)
     }
-    let output = absolute(&args.output)?;
-    if let Some(c) = output
-        .to_string_lossy()
-        .chars()
-        .find(|c| c.is_whitespace() || c.is_control())
-    {
-        let what = match c {
-            ' ' => "a space".to_string(),
-            '\n' => "a line break".to_string(),
-            '\t' => "a tab".to_string(),
-            c => format!("the character {c:?}"),
+}
+
+/// What every job script of one submission shares: the output, where the scripts and logs go,
+/// the jobs' name, the lines each task's script starts with and the flags each task's render
+/// is given.
+struct Plan {
+    exe: String,
+    output: PathBuf,
+    dir: PathBuf,
+    stem: String,
+    logs: PathBuf,
+    name: String,
+    common: String,
+    flags: String,
+}
+
+impl Plan {
+    /// The scene as every task will read it (everything a task would refuse is refused here,
+    /// before anything is submitted), and the plan of its jobs.
+    fn new(args: &SlurmArgs) -> crate::Result<(scene::Scene, Plan)> {
+        let exe = std::env::current_exe().map_err(|e| Error::flag("farm", e))?;
+        let scene_path = std::fs::canonicalize(&args.scene)
+            .map_err(|e| Error::flag(&args.scene.display().to_string(), e))?;
+        let overrides: Vec<(String, String)> = args
+            .set
+            .iter()
+            .map(|s| (format!("--set {s}"), s.clone()))
+            .collect();
+        // A tiled image may be larger than one frame; each tile's frame is checked below.
+        let frame = match args.tiles {
+            Some(_) => scene::FrameSize::InTiles,
+            None => scene::FrameSize::Checked,
         };
-        return Err(Error::flag(
-            "-o",
-            format!(
-                "{:?} has {what}, which the job script's #SBATCH --output line cannot hold: choose a path without spaces or control characters",
-                output.display()
-            ),
-        ));
+        let scene = scene::load_file_as(&scene_path, &overrides, frame)?;
+        output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
+        if let Some(b) = &args.backend {
+            crate::accel::backend_by_name(b).map_err(|e| e.on_flag("--backend"))?;
+        }
+        let output = script_safe_output(&args.output)?;
+        let dir = output.parent().map(Path::to_path_buf).unwrap_or_default();
+        let stem = output_stem(&output);
+        let logs = dir.join("rest-embree-farm");
+        let name = format!("rest-embree-{}", job_name(&stem));
+        let exe = quote(&exe.display().to_string());
+        let common = format!(
+            "exe={exe}\nscene={}\n",
+            quote(&scene_path.display().to_string())
+        );
+        let mut flags = String::from(" -q");
+        if let Some(b) = &args.backend {
+            let _ = write!(flags, " --backend {}", quote(b));
+        }
+        for s in &args.set {
+            let _ = write!(flags, " --set {}", quote(s));
+        }
+        flags.push_str(" ${SLURM_CPUS_PER_TASK:+--threads $SLURM_CPUS_PER_TASK}");
+        let plan = Plan {
+            exe,
+            output,
+            dir,
+            stem,
+            logs,
+            name,
+            common,
+            flags,
+        };
+        Ok((scene, plan))
     }
-    let dir = output.parent().map(Path::to_path_buf).unwrap_or_default();
+
+    /// The output's path, quoted for bash.
+    fn quoted_output(&self) -> String {
+        quote(&self.output.display().to_string())
+    }
+
+    /// A film: one job array, each task a run of consecutive frames (one frame each, unless
+    /// the film has more frames than an array takes tasks).
+    fn film_jobs(&self, f: &crate::scene::Film, args: &SlurmArgs) -> crate::Result<Vec<Job>> {
+        film::FramePattern::parse(&args.output).map_err(|m| Error::flag("-o", m))?;
+        let (first, last) = film::frame_range(f, args.frames)?;
+        let frames = last - first + 1;
+        let per = frames.div_ceil(MAX_TASKS);
+        let tasks = frames.div_ceil(per);
+        let body = format!(
+            "{}out={}\nfirst=$(( {first} + SLURM_ARRAY_TASK_ID * {per} ))\nlast=$(( first + {per} - 1 ))\nif (( last > {last} )); then last={last}; fi\nexec \"$exe\" render \"$scene\" -o \"$out\" --frames \"$first..$last\" --resume{}\n",
+            self.common,
+            self.quoted_output(),
+            self.flags
+        );
+        Ok(vec![Job {
+            file: self.logs.join(format!("{}-frames.sbatch", self.stem)),
+            text: script(&self.name, &self.logs, Some(tasks), &body),
+            tasks,
+        }])
+    }
+
+    /// A still: one task, or (with `--tiles`) a job array of one task per tile and a job that
+    /// assembles the tiles once it has finished.
+    fn image_jobs(
+        &self,
+        scene: &scene::Scene,
+        grid: Option<(u32, u32)>,
+        args: &SlurmArgs,
+    ) -> crate::Result<Vec<Job>> {
+        if args.frames.is_some() {
+            return Err(Error::flag(
+                "--frames",
+                "the scene is not a film: add a [film] table",
+            ));
+        }
+        let Some((columns, rows)) = grid else {
+            let body = format!(
+                "{}out={}\nexec \"$exe\" render \"$scene\" -o \"$out\"{}\n",
+                self.common,
+                self.quoted_output(),
+                self.flags
+            );
+            return Ok(vec![Job {
+                file: self.logs.join(format!("{}-render.sbatch", self.stem)),
+                text: script(&self.name, &self.logs, Some(1), &body),
+                tasks: 1,
+            }]);
+        };
+        let format = output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
+        let shown = format!("--tiles {columns}x{rows}");
+        tiles::tile_crop(scene, format, (columns, rows), 0, &shown)?;
+        let tasks = u64::from(columns) * u64::from(rows);
+        check_array_size(tasks, (columns, rows))?;
+        // The tile's name quoted as a whole (a `$(...)` in the output's name is text), then the
+        // task's number.
+        let tile = |i: &str| self.dir.join(format!("{}.tile-{i}.exr", self.stem));
+        let prefix = self.dir.join(format!("{}.tile-", self.stem));
+        let prefix = quote(&prefix.display().to_string());
+        let body = format!(
+            "{}tile={prefix}\nexec \"$exe\" render \"$scene\" -o \"${{tile}}${{SLURM_ARRAY_TASK_ID}}.exr\" --tiles {columns}x{rows} --tile \"$SLURM_ARRAY_TASK_ID\"{}\n",
+            self.common, self.flags
+        );
+        let render = Job {
+            file: self.logs.join(format!("{}-tiles.sbatch", self.stem)),
+            text: script(&self.name, &self.logs, Some(tasks), &body),
+            tasks,
+        };
+        let all: Vec<String> = (0..tasks)
+            .map(|i| quote(&tile(&i.to_string()).display().to_string()))
+            .collect();
+        let body = format!(
+            "exe={}\n\"$exe\" assemble -o {} {}\nrm -f {}\n",
+            self.exe,
+            self.quoted_output(),
+            all.join(" "),
+            all.join(" ")
+        );
+        let assemble = Job {
+            file: self.logs.join(format!("{}-assemble.sbatch", self.stem)),
+            text: script(&format!("{}-assemble", self.name), &self.logs, None, &body),
+            tasks: 1,
+        };
+        Ok(vec![render, assemble])
+    }
+}
+
+/// `output` made absolute, refused where it holds what an `#SBATCH --output` line cannot.
+fn script_safe_output(output: &Path) -> crate::Result<PathBuf> {
+    let output = absolute(output)?;
+    let text = output.to_string_lossy();
+    let Some(c) = text.chars().find(|c| c.is_whitespace() || c.is_control()) else {
+        return Ok(output);
+    };
+    let what = match c {
+        ' ' => "a space".to_string(),
+        '\n' => "a line break".to_string(),
+        '\t' => "a tab".to_string(),
+        c => format!("the character {c:?}"),
+    };
+    Err(Error::flag(
+        "-o",
+        format!(
+            "{:?} has {what}, which the job script's #SBATCH --output line cannot hold: choose a path without spaces or control characters",
+            output.display()
+        ),
+    ))
+}
+
+/// The name the jobs and their scripts take from the output: its stem without a frame
+/// pattern's `#` and the separators around it (`frames` where nothing is left).
+fn output_stem(output: &Path) -> String {
     let stem = output
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("render")
         .replace('#', "");
-    let stem = stem.trim_matches(['-', '_', '.']).to_string();
-    let stem = if stem.is_empty() {
-        "frames".to_string()
-    } else {
-        stem
-    };
-    let logs = dir.join("rest-embree-farm");
-    let name = format!("rest-embree-{}", job_name(&stem));
-
-    let mut common = format!(
-        "exe={}\nscene={}\n",
-        quote(&exe.display().to_string()),
-        quote(&scene_path.display().to_string())
-    );
-    let mut flags = String::from(" -q");
-    if let Some(b) = &args.backend {
-        let _ = write!(flags, " --backend {}", quote(b));
+    let stem = stem.trim_matches(['-', '_', '.']);
+    match stem.is_empty() {
+        true => "frames".to_string(),
+        false => stem.to_string(),
     }
-    for s in &args.set {
-        let _ = write!(flags, " --set {}", quote(s));
-    }
-    flags.push_str(" ${SLURM_CPUS_PER_TASK:+--threads $SLURM_CPUS_PER_TASK}");
+}
 
-    let mut jobs = Vec::new();
-    match (&scene.film, args.tiles) {
-        (Some(f), None) => {
-            film::FramePattern::parse(&args.output).map_err(|m| Error::flag("-o", m))?;
-            let (first, last) = film::frame_range(f, args.frames)?;
-            let frames = last - first + 1;
-            let per = frames.div_ceil(MAX_TASKS);
-            let tasks = frames.div_ceil(per);
-            let _ = write!(
-                common,
-                "out={}\nfirst=$(( {first} + SLURM_ARRAY_TASK_ID * {per} ))\nlast=$(( first + {per} - 1 ))\nif (( last > {last} )); then last={last}; fi\n",
-                quote(&output.display().to_string())
-            );
-            let body = format!("{common}exec \"$exe\" render \"$scene\" -o \"$out\" --frames \"$first..$last\" --resume{flags}\n");
-            jobs.push(Job {
-                file: logs.join(format!("{stem}-frames.sbatch")),
-                text: script(&name, &logs, Some(tasks), &body),
-                tasks,
-            });
-        }
-        (_, grid) => {
-            let (columns, rows) = grid.unwrap_or((1, 1));
-            if grid.is_some() {
-                let shown = format!("--tiles {columns}x{rows}");
-                tiles::tile_crop(&scene, format, (columns, rows), 0, &shown)?;
-            }
-            if args.frames.is_some() {
-                return Err(Error::flag(
-                    "--frames",
-                    "the scene is not a film: add a [film] table",
-                ));
-            }
-            let tasks = u64::from(columns) * u64::from(rows);
-            // One task a tile, in one job array: no more than the cluster takes.
-            let (max, read) = max_array_size();
-            if tasks > max {
-                let side = (max as f64).sqrt().floor() as u64;
-                return Err(Error::flag(
-                    "--tiles",
-                    format!(
-                        "{columns}x{rows} is {tasks} tiles, one task each, and the cluster's job arrays take at most {max} tasks (MaxArraySize {max}{}): choose fewer tiles, e.g. --tiles {side}x{side}",
-                        if read {
-                            ", from scontrol show config"
-                        } else {
-                            ": SLURM's default, as scontrol could not say"
-                        }
-                    ),
-                ));
-            }
-            let tile = |i: &str| dir.join(format!("{stem}.tile-{i}.exr"));
-            if grid.is_none() {
-                let _ = writeln!(common, "out={}", quote(&output.display().to_string()));
-                jobs.push(Job {
-                    file: logs.join(format!("{stem}-render.sbatch")),
-                    text: script(
-                        &name,
-                        &logs,
-                        Some(1),
-                        &format!("{common}exec \"$exe\" render \"$scene\" -o \"$out\"{flags}\n"),
-                    ),
-                    tasks: 1,
-                });
-            } else {
-                // The tile's name quoted as a whole (a `$(...)` in the output's name is text),
-                // then the task's number.
-                let prefix = quote(&dir.join(format!("{stem}.tile-")).display().to_string());
-                let body = format!(
-                    "{common}tile={prefix}\nexec \"$exe\" render \"$scene\" -o \"${{tile}}${{SLURM_ARRAY_TASK_ID}}.exr\" --tiles {columns}x{rows} --tile \"$SLURM_ARRAY_TASK_ID\"{flags}\n"
-                );
-                jobs.push(Job {
-                    file: logs.join(format!("{stem}-tiles.sbatch")),
-                    text: script(&name, &logs, Some(tasks), &body),
-                    tasks,
-                });
-                let all: Vec<String> = (0..tasks)
-                    .map(|i| quote(&tile(&i.to_string()).display().to_string()))
-                    .collect();
-                let body = format!(
-                    "exe={}\n\"$exe\" assemble -o {} {}\nrm -f {}\n",
-                    quote(&exe.display().to_string()),
-                    quote(&output.display().to_string()),
-                    all.join(" "),
-                    all.join(" ")
-                );
-                jobs.push(Job {
-                    file: logs.join(format!("{stem}-assemble.sbatch")),
-                    text: script(&format!("{name}-assemble"), &logs, None, &body),
-                    tasks: 1,
-                });
-            }
-        }
-    }
-
-    let sbatch = |job: &Job, after: Option<&str>| {
-        let mut cmd = vec!["sbatch".to_string(), "--parsable".to_string()];
-        if let Some(id) = after {
-            cmd.push(format!("--dependency=afterok:{id}"));
-        }
-        cmd.extend(args.sbatch_args.iter().cloned());
-        cmd.push(job.file.display().to_string());
-        cmd
-    };
-    if args.dry_run {
-        for (i, job) in jobs.iter().enumerate() {
-            println!(
-                "# {} ({} task{})",
-                job.file.display(),
-                job.tasks,
-                if job.tasks == 1 { "" } else { "s" }
-            );
-            println!("{}", job.text);
-            let after = (i > 0).then_some("JOBID");
-            println!("# submitted with: {}\n", sbatch(job, after).join(" "));
-        }
+/// Refuse a job array of more tasks than the cluster's arrays take.
+fn check_array_size(tasks: u64, (columns, rows): (u32, u32)) -> crate::Result<()> {
+    let (max, read) = max_array_size();
+    if tasks <= max {
         return Ok(());
     }
+    let side = (max as f64).sqrt().floor() as u64;
+    Err(Error::flag(
+        "--tiles",
+        format!(
+            "{columns}x{rows} is {tasks} tiles, one task each, and the cluster's job arrays take at most {max} tasks (MaxArraySize {max}{}): choose fewer tiles, e.g. --tiles {side}x{side}",
+            if read {
+                ", from scontrol show config"
+            } else {
+                ": SLURM's default, as scontrol could not say"
+            }
+        ),
+    ))
+}
+
+/// The sbatch command that submits `job` (after job `after`, where given).
+fn sbatch_command(job: &Job, after: Option<&str>, args: &SlurmArgs) -> Vec<String> {
+    let mut cmd = vec!["sbatch".to_string(), "--parsable".to_string()];
+    if let Some(id) = after {
+        cmd.push(format!("--dependency=afterok:{id}"));
+    }
+    cmd.extend(args.sbatch_args.iter().cloned());
+    cmd.push(job.file.display().to_string());
+    cmd
+}
+
+fn plural(n: u64) -> &'static str {
+    if n == 1 {
+        ""
+    } else {
+        "s"
+    }
+}
+
+/// `--dry-run`: each job's script and the command that would submit it.
+fn print_jobs(jobs: &[Job], args: &SlurmArgs) {
+    for (i, job) in jobs.iter().enumerate() {
+        let (file, tasks) = (job.file.display(), job.tasks);
+        println!("# {file} ({tasks} task{})", plural(tasks));
+        println!("{}", job.text);
+        let after = (i > 0).then_some("JOBID");
+        let cmd = sbatch_command(job, after, args).join(" ");
+        println!("# submitted with: {cmd}\n");
+    }
+}
+
+/// Write the job scripts into `logs` and submit them with sbatch, each job after the one
+/// before; print each job's id.
+fn submit(jobs: &[Job], logs: &Path, args: &SlurmArgs) -> crate::Result<()> {
     let found = std::env::var_os("PATH")
         .map(|p| std::env::split_paths(&p).any(|d| d.join("sbatch").is_file()))
         .unwrap_or(false);
@@ -328,13 +406,13 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
             "sbatch is not on PATH: run this where SLURM's commands are (a login node), or add --dry-run to see the job scripts",
         ));
     }
-    std::fs::create_dir_all(&logs)
+    std::fs::create_dir_all(logs)
         .map_err(|e| Error::flag("-o", format!("cannot make {}: {e}", logs.display())))?;
     let mut previous: Option<String> = None;
-    for job in &jobs {
+    for job in jobs {
         std::fs::write(&job.file, &job.text)
             .map_err(|e| Error::flag("-o", format!("cannot write {}: {e}", job.file.display())))?;
-        let cmd = sbatch(job, previous.as_deref());
+        let cmd = sbatch_command(job, previous.as_deref(), args);
         let out = std::process::Command::new(&cmd[0])
             .args(&cmd[1..])
             .output()
@@ -356,11 +434,10 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
             .unwrap_or_default()
             .to_string();
         println!("{id}");
+        let (tasks, file) = (job.tasks, job.file.display());
         eprintln!(
-            "farm: submitted job {id} ({} task{}): {}",
-            job.tasks,
-            if job.tasks == 1 { "" } else { "s" },
-            job.file.display()
+            "farm: submitted job {id} ({tasks} task{}): {file}",
+            plural(tasks)
         );
         previous = Some(id);
     }

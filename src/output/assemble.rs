@@ -17,7 +17,7 @@ use exr::block::reader::ChunksReader;
 use exr::block::{BlockIndex, UncompressedBlock};
 use exr::meta::attribute::{ChannelList, SampleType};
 use exr::meta::header::Header;
-use exr::meta::BlockDescription;
+use exr::meta::{BlockDescription, Headers};
 use exr::prelude::*;
 use std::fs::File;
 use std::io::BufReader;
@@ -465,8 +465,49 @@ pub fn assemble(tiles: &[PathBuf], output: &Path) -> crate::Result<()> {
     if let Some(why) = crate::memory::too_much(need, &what) {
         return Err(crate::Error::flag("assemble", why));
     }
+    let out_headers = image_headers(first, (w, h));
+    let layout = Layout::new(sizes, w);
+    // A tile is opened when the band reaches its first row and closed after its last, so
+    // that only a row of tiles is open at a time.
+    let mut sources: Vec<Source> = headers
+        .into_iter()
+        .map(|tile| Source {
+            offsets: layout.offsets(tile.size.0),
+            tile,
+            lines: None,
+        })
+        .collect();
+    sources.sort_by_key(|s| (s.tile.origin.1, s.tile.origin.0));
+    let mut failed: Option<crate::Error> = None;
+    let written = super::file::write_whole(output, |tmp| {
+        super::exr_out::write_blocks(tmp, out_headers, |put| {
+            let mut y0 = 0;
+            while y0 < h {
+                let rows = band_rows.min(h - y0);
+                let mut band = Band {
+                    bytes: vec![0; rows * layout.line_bytes],
+                    line_bytes: layout.line_bytes,
+                };
+                if let Err(e) = layout.fill(&mut band, y0, &mut sources) {
+                    failed = Some(e);
+                    return Err(cause(std::io::Error::other("a tile failed")));
+                }
+                put(&band, rows)?;
+                y0 += rows;
+            }
+            Ok::<(), Cause>(())
+        })
+    });
+    match (failed, written) {
+        (Some(e), _) => Err(e),
+        (None, w) => w,
+    }
+}
 
-    // The whole image's header: the first tile's, over the display window.
+/// The whole image's headers: the first tile's, over the display window (`size`), in scan
+/// lines.
+fn image_headers(first: &Header, size: (usize, usize)) -> Headers {
+    let display = first.shared_attributes.display_window;
     let mut attributes = first.own_attributes.clone();
     attributes.layer_position = Vec2(display.position.0, display.position.1);
     let template = AnyChannels {
@@ -491,14 +532,36 @@ pub fn assemble(tiles: &[PathBuf], output: &Path) -> crate::Result<()> {
         blocks: Blocks::ScanLines,
         line_order: LineOrder::Increasing,
     };
-    let layer = Layer::new((w, h), attributes, encoding, template);
+    let layer = Layer::new(size, attributes, encoding, template);
     let mut image = Image::from_layer(layer);
     image.attributes = first.shared_attributes.clone();
-    let out_headers = image.write().infer_meta_data();
+    image.write().infer_meta_data()
+}
 
-    // Each tile's lines, and where each channel's samples start in its lines and the image's.
-    let offsets = |width: usize| -> Vec<usize> {
-        sizes
+/// How the image's lines are laid out: each channel's samples together (`sizes`: each
+/// channel's bytes a sample), channel after channel, over the image's width.
+struct Layout {
+    sizes: Vec<usize>,
+    /// Where each channel's samples start in an image line.
+    image_offsets: Vec<usize>,
+    line_bytes: usize,
+}
+
+impl Layout {
+    fn new(sizes: Vec<usize>, width: usize) -> Layout {
+        let line_bytes = width * sizes.iter().sum::<usize>();
+        let mut layout = Layout {
+            sizes,
+            image_offsets: Vec::new(),
+            line_bytes,
+        };
+        layout.image_offsets = layout.offsets(width);
+        layout
+    }
+
+    /// Where each channel's samples start in a line `width` wide.
+    fn offsets(&self, width: usize) -> Vec<usize> {
+        self.sizes
             .iter()
             .scan(0, |at, s| {
                 let here = *at;
@@ -506,75 +569,43 @@ pub fn assemble(tiles: &[PathBuf], output: &Path) -> crate::Result<()> {
                 Some(here)
             })
             .collect()
-    };
-    let image_offsets = offsets(w);
-    let line_bytes = w * pixel_bytes;
-    // A tile is opened when the band reaches its first row and closed after its last, so
-    // that only a row of tiles is open at a time.
-    let mut sources: Vec<Source> = headers
-        .into_iter()
-        .map(|tile| Source {
-            offsets: offsets(tile.size.0),
-            tile,
-            lines: None,
-        })
-        .collect();
-    sources.sort_by_key(|s| (s.tile.origin.1, s.tile.origin.0));
-    let mut failed: Option<crate::Error> = None;
-    let written = super::file::write_whole(output, |tmp| {
-        super::exr_out::write_blocks(tmp, out_headers, |put| {
-            let mut y0 = 0;
-            while y0 < h {
-                let rows = band_rows.min(h - y0);
-                let mut band = Band {
-                    bytes: vec![0; rows * line_bytes],
-                    line_bytes,
-                };
-                for source in sources.iter_mut() {
-                    let (ox, oy) = source.tile.origin;
-                    let (tw, th) = source.tile.size;
-                    let (from, to) = (y0.max(oy), (y0 + rows).min(oy + th));
-                    if from >= to {
-                        continue;
-                    }
-                    let lines = match &mut source.lines {
-                        Some(l) => l,
-                        None => match TileLines::open(&source.tile, tw * pixel_bytes) {
-                            Ok(l) => source.lines.insert(l),
-                            Err(e) => {
-                                failed = Some(e);
-                                return Err(cause(std::io::Error::other("a tile failed")));
-                            }
-                        },
-                    };
-                    for y in from..to {
-                        let line = match lines.line(y - oy) {
-                            Ok(l) => l,
-                            Err(e) => {
-                                failed = Some(e);
-                                return Err(cause(std::io::Error::other("a tile failed")));
-                            }
-                        };
-                        let row = &mut band.bytes[(y - y0) * line_bytes..][..line_bytes];
-                        for ((&size, &src), &dst) in
-                            sizes.iter().zip(&source.offsets).zip(&image_offsets)
-                        {
-                            let n = tw * size;
-                            row[dst + ox * size..][..n].copy_from_slice(&line[src..src + n]);
-                        }
-                    }
-                    if to == oy + th {
-                        source.lines = None;
-                    }
-                }
-                put(&band, rows)?;
-                y0 += rows;
+    }
+
+    /// The band of image rows from `y0`: each tile's part of them, copied channel by channel
+    /// into place; a tile is opened at its first row and closed after its last.
+    fn fill(&self, band: &mut Band, y0: usize, sources: &mut [Source]) -> crate::Result<()> {
+        let rows = band.bytes.len() / self.line_bytes.max(1);
+        let pixel_bytes: usize = self.sizes.iter().sum();
+        for source in sources.iter_mut() {
+            let (ox, oy) = source.tile.origin;
+            let (tw, th) = source.tile.size;
+            let (from, to) = (y0.max(oy), (y0 + rows).min(oy + th));
+            if from >= to {
+                continue;
             }
-            Ok::<(), Cause>(())
-        })
-    });
-    match (failed, written) {
-        (Some(e), _) => Err(e),
-        (None, w) => w,
+            let lines = match &mut source.lines {
+                Some(l) => l,
+                None => source
+                    .lines
+                    .insert(TileLines::open(&source.tile, tw * pixel_bytes)?),
+            };
+            for y in from..to {
+                let line = lines.line(y - oy)?;
+                let row = &mut band.bytes[(y - y0) * self.line_bytes..][..self.line_bytes];
+                for ((&size, &src), &dst) in self
+                    .sizes
+                    .iter()
+                    .zip(&source.offsets)
+                    .zip(&self.image_offsets)
+                {
+                    let n = tw * size;
+                    row[dst + ox * size..][..n].copy_from_slice(&line[src..src + n]);
+                }
+            }
+            if to == oy + th {
+                source.lines = None;
+            }
+        }
+        Ok(())
     }
 }
