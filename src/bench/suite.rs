@@ -386,7 +386,7 @@ mod tests {
     use crate::bench::parse_setting;
 
     /// The suite's settings parse, and a setting with a word the bench does not know is an
-    /// error (it had been measured as plain `embree` under its own label).
+    /// error (else it would be measured as plain `embree` under its own label).
     #[test]
     fn settings_are_checked() {
         for s in LATTICE_SETTINGS.iter().chain(&[

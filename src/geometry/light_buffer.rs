@@ -101,7 +101,7 @@ fn footprints(b: &Aabb, o: DVec3) -> [Option<[f64; 4]>; 6] {
             continue;
         }
         // The corners' depths below the face take two values, so two divisions serve all
-        // eight corners (each corner's u = p[b1] · (1 / depth) as before, bit for bit).
+        // eight corners (each corner's u is p[b1] · (1 / depth), the same to the bit).
         let (d0, d1) = (sign * lo[a], sign * hi[a]);
         if d0 <= 0.0 || d1 <= 0.0 {
             // The box crosses the face's plane: its directions may reach any of the face.

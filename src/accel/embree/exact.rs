@@ -2,10 +2,10 @@
 //! finds the candidates, and the exact f64 tests of the f64 BVH decide the hit, on the caller's
 //! f64 ray (passed in the intersect context) rather than Embree's f32 copy, so these hits need
 //! no refinement. A packet's lanes that may meet the primitive (`lane_cull`) are tested together,
-//! four per AVX2 vector where the shape allows (`lane_hits`). Embree's own round curves and sphere points are built for hair and particles
-//! (oriented boxes, swept spheres) and were its slow path on the paper's lattice: bare Embree
-//! traced it 1.6-2.0x as fast as the f64 BVH with them, 4-5x with this. Boxes as twelve f32
-//! triangles each, refined in f64 after, were slower than one exact slab test.
+//! four per AVX2 vector where the shape allows (`lane_hits`). Not Embree's own round curves and
+//! sphere points: they are built for hair and particles (oriented boxes, swept spheres) and are
+//! its slow path on a lattice of rods and spheres. Not boxes as twelve f32 triangles refined in
+//! f64: one exact slab test costs less.
 
 use super::fault::{self, Callback, Fault, Injection};
 use super::lane_cull::lanes_near;
