@@ -13,22 +13,22 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Bytes per primitive: the scene's copy, the accelerator and its build.
-pub const BYTES_PER_PRIMITIVE: u64 = 320;
+pub(crate) const BYTES_PER_PRIMITIVE: u64 = 320;
 /// Bytes per block of an instanced lattice: an Embree instance (or the f64 BVH's leaf) and its
 /// share of the tree over the blocks.
-pub const BYTES_PER_BLOCK: u64 = 1024;
+pub(crate) const BYTES_PER_BLOCK: u64 = 1024;
 /// Bytes of memory per byte of a scene file's text while it is read: the text itself and the
 /// tokens of its longest expression (the tree's values are `BYTES_PER_SCENE_VALUE`).
-pub const BYTES_PER_SCENE_BYTE: u64 = 8;
+pub(crate) const BYTES_PER_SCENE_BYTE: u64 = 8;
 /// Bytes of memory per value of a scene file's tree at most: its node and its share of the
 /// growth of the array or table it is in. Measured (peak resident memory over the file's
 /// values): 10 million numbers in one array 85 bytes each, 5 million one-number arrays 150
 /// bytes per value, a table of a million keys 150.
-pub const BYTES_PER_SCENE_VALUE: u64 = 192;
+pub(crate) const BYTES_PER_SCENE_VALUE: u64 = 192;
 
 /// What reading `text` as a scene costs at most: its bytes, and a value for each `,`, `[`, `{`
 /// and `=` (every value of TOML follows one; comments and strings only make it more).
-pub fn scene_bytes(text: &[u8]) -> u64 {
+pub(crate) fn scene_bytes(text: &[u8]) -> u64 {
     let values = text
         .iter()
         .filter(|b| matches!(b, b',' | b'[' | b'{' | b'='))
@@ -38,38 +38,38 @@ pub fn scene_bytes(text: &[u8]) -> u64 {
         .saturating_add(values.saturating_mul(BYTES_PER_SCENE_VALUE))
 }
 /// Bytes per pixel of a PNG render's strip: the frame's rows, and their 8-bit encoding.
-pub const BYTES_PER_PIXEL_PNG: u64 = 96;
+pub(crate) const BYTES_PER_PIXEL_PNG: u64 = 96;
 /// Pixels a render to a file holds at a time, at least (whole pairs of rows of tiles, four
 /// rows per thread or more): a PNG or EXR is written strip by strip as it is rendered, an EXR
 /// strip's blocks compressed in parallel.
-pub const STRIP_PIXELS: u64 = 1 << 18;
+pub(crate) const STRIP_PIXELS: u64 = 1 << 18;
 /// Bytes per pixel of an EXR render's strip: the frame (92), its mattes (96), and the
 /// encoder's 46 channels of 4 bytes. The encoder holds no copy of the strip's channels any
 /// more, but each thread's block in flight and the two buffers it keeps for its ZIP (a block
 /// is 32 rows or fewer, a strip at least 64 rows per thread): less than that copy, so the
 /// figure stays an upper bound.
-pub const BYTES_PER_PIXEL_EXR: u64 = 380;
+pub(crate) const BYTES_PER_PIXEL_EXR: u64 = 380;
 
 /// What a triangle of a mesh held as itself costs rendered, its corner data aside: its share of
 /// the shared vertices and of its indices, and of Embree's triangle geometry and tree (the
 /// bench's 10-million-triangle PLY peaks at 135 bytes a triangle, reading included).
-pub const BYTES_PER_HELD_TRIANGLE: u64 = 160;
+pub(crate) const BYTES_PER_HELD_TRIANGLE: u64 = 160;
 
 /// A mesh triangle's corner normals: three, in f64.
-pub const BYTES_PER_CORNER_NORMALS: u64 = 72;
+pub(crate) const BYTES_PER_CORNER_NORMALS: u64 = 72;
 /// A mesh triangle's corner texture coordinates: three pairs, in f64.
-pub const BYTES_PER_CORNER_UVS: u64 = 48;
+pub(crate) const BYTES_PER_CORNER_UVS: u64 = 48;
 
 /// What a star of `[sky] stars` costs: itself (40 bytes), its entry in the grid that rays after
 /// a bounce search (88: direction, spectrum, RGB), and in a frame its place in a pixel (about
 /// 80).
-pub const BYTES_PER_STAR: u64 = 210;
+pub(crate) const BYTES_PER_STAR: u64 = 210;
 
 /// The memory an object held as itself (a lattice, a bar array) costs rendered: its
 /// primitives', listed, or when it is instanced (more than
 /// [`INSTANCE_OVER`](crate::geometry::INSTANCE_OVER) of them) one block's and a placement per
 /// block; a mesh's, its vertices and indices.
-pub fn implicit_bytes(shape: &crate::geometry::Implicit) -> u64 {
+pub(crate) fn implicit_bytes(shape: &crate::geometry::Implicit) -> u64 {
     if shape.len() <= crate::geometry::INSTANCE_OVER {
         return shape.len().saturating_mul(BYTES_PER_PRIMITIVE);
     }
@@ -84,7 +84,7 @@ pub fn implicit_bytes(shape: &crate::geometry::Implicit) -> u64 {
 static LIMIT: AtomicU64 = AtomicU64::new(0);
 
 /// Limit what a render may use to `bytes` (None: the machine's available memory).
-pub fn set_limit(bytes: Option<u64>) {
+pub(crate) fn set_limit(bytes: Option<u64>) {
     LIMIT.store(bytes.unwrap_or(0), Ordering::Relaxed);
 }
 
@@ -106,7 +106,7 @@ fn available() -> Option<u64> {
 }
 
 /// Why `need` bytes (for `what`) will not fit, or None when they do or nothing can be known.
-pub fn too_much(need: u64, what: &str) -> Option<String> {
+pub(crate) fn too_much(need: u64, what: &str) -> Option<String> {
     exceeds(need, what, limit())
 }
 
@@ -122,7 +122,7 @@ fn exceeds(need: u64, what: &str, limit: Option<(u64, &str)>) -> Option<String> 
 }
 
 /// A size for people: GiB, MiB, KiB or bytes (never "0 MiB" for a size that is not 0).
-pub fn human(bytes: u64) -> String {
+pub(crate) fn human(bytes: u64) -> String {
     let b = bytes as f64;
     if b >= f64::from(1u32 << 30) {
         format!("{:.1} GiB", b / f64::from(1u32 << 30))
@@ -136,7 +136,7 @@ pub fn human(bytes: u64) -> String {
 }
 
 /// A size as people write it: `8G`, `512M`, `64k` or bytes.
-pub fn parse_size(text: &str) -> Result<u64, String> {
+pub(crate) fn parse_size(text: &str) -> Result<u64, String> {
     let t = text.trim();
     let (number, unit) = t
         .find(|c: char| c.is_ascii_alphabetic())

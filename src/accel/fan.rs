@@ -26,7 +26,7 @@ pub struct Fan<'a> {
 }
 
 /// `FanHits::prim` of a lane without a hit.
-pub const NO_HIT: u32 = u32::MAX;
+pub(crate) const NO_HIT: u32 = u32::MAX;
 
 /// What a fan's rays are and found, by lane, in columns: the world-frame unit looking
 /// direction, the rest-frame direction (unnormalised, of length `s`, the lookback factor) and

@@ -23,7 +23,8 @@ pub(crate) use bvh32::Bvh32Backend;
 pub(crate) use embree::{BareRay, EmbreeAccel, EmbreeBackend};
 #[cfg(all(feature = "embree", test))]
 pub(crate) use embree::{Callback, Isa};
-pub use fan::{Fan, FanHits, NO_HIT};
+pub(crate) use fan::NO_HIT;
+pub use fan::{Fan, FanHits};
 
 use crate::geometry::{Aabb, BoxTree, Geometry, LightBuffer};
 use glam::DVec3;
@@ -255,7 +256,7 @@ pub fn backend_names() -> Vec<&'static str> {
 
 /// Every name `--backend` accepts in this build: the backends (`backend_names`), then the
 /// variants kept for comparisons.
-pub fn all_backend_names() -> Vec<&'static str> {
+pub(crate) fn all_backend_names() -> Vec<&'static str> {
     let mut names = backend_names();
     #[cfg(feature = "embree")]
     names.extend(EMBREE_WIDTHS);
@@ -266,7 +267,7 @@ pub fn all_backend_names() -> Vec<&'static str> {
 /// What `rest-embree backends` prints: every name `--backend` takes and what it is; for
 /// Embree, what this CPU and `REST_EMBREE_ISA` make of it (an error if that names an
 /// instruction set Embree or the CPU does not have).
-pub fn backend_report() -> crate::Result<Vec<String>> {
+pub(crate) fn backend_report() -> crate::Result<Vec<String>> {
     let mut lines = Vec::new();
     #[cfg(feature = "embree")]
     {
@@ -298,7 +299,7 @@ pub fn backend_report() -> crate::Result<Vec<String>> {
 
 /// What Embree runs here (version, instruction set, packet widths), as `backends` says it;
 /// None in a build without Embree. For the bench's record of the machine.
-pub fn embree_summary() -> crate::Result<Option<String>> {
+pub(crate) fn embree_summary() -> crate::Result<Option<String>> {
     #[cfg(feature = "embree")]
     return EmbreeBackend::new()
         .configured_by_env()?
@@ -329,7 +330,8 @@ pub(crate) fn embree_backend(name: &str) -> Option<EmbreeBackend> {
 }
 
 /// The Embree backends of fixed packet width, for comparisons (`--backend` takes them too).
-pub const EMBREE_WIDTHS: [&str; 4] = ["embree-16", "embree-8", "embree-4", "embree-single"];
+#[cfg(feature = "embree")]
+pub(crate) const EMBREE_WIDTHS: [&str; 4] = ["embree-16", "embree-8", "embree-4", "embree-single"];
 
 /// The backend of that name, or an error that lists the choices.
 pub fn backend_by_name(name: &str) -> crate::Result<Box<dyn Backend>> {

@@ -57,7 +57,7 @@ const TRAVERSAL_COST: f64 = 1.0;
 const INTERSECT_COST: f64 = 1.5;
 
 /// Up to this many rays traverse a tree together in [`BoxTree::traverse_packet`].
-pub const PACKET: usize = 16;
+pub(crate) const PACKET: usize = 16;
 
 /// A node: an interior node has `count == 0` and children at `first` and `first + 1`; a leaf
 /// holds `indices[first .. first + count]`.
@@ -290,7 +290,7 @@ fn find_split(items: &mut [Item], bounds: &Aabb, cbounds: &Aabb) -> Option<usize
 /// `entry(i, tmax)` where a ray enters node i (None: it misses), and `visit(item, tmax)` returns
 /// the new tmax (the best hit so far); a tmax below tmin stops the walk. Both the box tree and
 /// the kinetic group tree walk this way, with different entry tests.
-pub fn walk(
+pub(crate) fn walk(
     indices: &[u32],
     node: impl Fn(u32) -> (u32, u32),
     mut entry: impl FnMut(u32, f64) -> Option<f64>,

@@ -14,7 +14,7 @@ use std::sync::Arc;
 /// (instanced, or as shared vertices) by default (`WorldOptions::instance_over`): about where
 /// holding them so starts to pay for itself; the bench measures both sides of it
 /// (docs/performance.md, the lattice and bar array rows, instanced and listed).
-pub const INSTANCE_OVER: u64 = 100_000;
+pub(crate) const INSTANCE_OVER: u64 = 100_000;
 
 /// An object held as itself.
 #[derive(Clone, Debug, PartialEq)]
@@ -38,9 +38,9 @@ pub struct Member {
 }
 
 /// A [`Member`]'s axis when it is a lattice's sphere.
-pub const SPHERE: u32 = 3;
+pub(crate) const SPHERE: u32 = 3;
 /// A [`Member`]'s axis when it is a bar.
-pub const BAR: u32 = 4;
+pub(crate) const BAR: u32 = 4;
 
 /// `n` as a number in the mixed radix `dims`, x fastest.
 pub(super) fn flatten(n: [u32; 3], dims: [u32; 3]) -> u64 {

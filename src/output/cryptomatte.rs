@@ -19,7 +19,7 @@ pub struct MatteNames {
 }
 
 /// MurmurHash3, 32 bits, seed 0, of `name`'s UTF-8 bytes.
-pub fn murmur3(name: &str) -> u32 {
+pub(crate) fn murmur3(name: &str) -> u32 {
     murmur3::murmur3_32(&mut std::io::Cursor::new(name.as_bytes()), 0).expect("reading memory")
 }
 
@@ -42,16 +42,16 @@ pub type Pick = fn(&Mattes) -> &Ranks;
 pub type Channels = Vec<(String, Vec<f32>)>;
 
 /// The Cryptomatte layers a render writes: its objects' mattes, then its materials'.
-pub const LAYERS: [&str; 2] = ["CryptoObject", "CryptoMaterial"];
+pub(crate) const LAYERS: [&str; 2] = ["CryptoObject", "CryptoMaterial"];
 
 /// The name of column `c` of `layer`: rank c / 2's id (c even) or share (c odd), as R, G, B
 /// or A of the layer's level c / 4 (`CryptoObject00.R`, …).
-pub fn channel_name(layer: &str, c: usize) -> String {
+pub(crate) fn channel_name(layer: &str, c: usize) -> String {
     format!("{layer}{:02}.{}", c / 4, ["R", "G", "B", "A"][c % 4])
 }
 
 /// The ids of `names` by index + 1, as a pixel's mattes number them: 0.0 (no object) first.
-pub fn id_table(names: &[String]) -> Vec<f32> {
+pub(crate) fn id_table(names: &[String]) -> Vec<f32> {
     std::iter::once(0.0)
         .chain(names.iter().map(|n| id(n)))
         .collect()

@@ -168,7 +168,7 @@ fn headers(
 /// bottom (every strip but the last a whole number of 32-row blocks): each strip's blocks are
 /// compressed in parallel and written as it comes, so the image is never held whole. `mattes`:
 /// whether the strips carry Cryptomatte mattes (and the file their layers).
-pub fn write_strips(
+pub(crate) fn write_strips(
     path: &Path,
     (width, height): (u32, u32),
     mattes: bool,

@@ -17,7 +17,7 @@ static PARTIAL: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// Remove the partial files this process is writing (for a signal handler: the process is
 /// about to end).
-pub fn remove_partial_files() {
+pub(crate) fn remove_partial_files() {
     let files = PARTIAL.lock().map(|f| f.clone()).unwrap_or_default();
     for f in files {
         let _ = std::fs::remove_file(f);

@@ -13,7 +13,7 @@ use crate::scene::{Camera, ImageSettings, Projection, Scene};
 
 /// OpenEXR's camera space: x right, y up, z along the view; a row vector times the matrix
 /// (row-major, as Imath's `M44f`).
-pub fn world_to_camera(cam: &Camera) -> [f64; 16] {
+pub(crate) fn world_to_camera(cam: &Camera) -> [f64; 16] {
     let (r, u, f, e) = (cam.right, cam.up, cam.forward, cam.position);
     [
         r.x,
@@ -39,7 +39,7 @@ pub fn world_to_camera(cam: &Camera) -> [f64; 16] {
 /// window, which is the full image (a crop is a data window inside it), (1, 1) at the bottom
 /// right, y down; a row vector `[x y z 1]` times the matrix, divided by its last component.
 /// None for projections no matrix gives (equirectangular).
-pub fn world_to_ndc(cam: &Camera, image: &ImageSettings) -> Option<[f64; 16]> {
+pub(crate) fn world_to_ndc(cam: &Camera, image: &ImageSettings) -> Option<[f64; 16]> {
     let (w, h) = (f64::from(image.width), f64::from(image.height));
     let (fw, fh) = (w, h);
     let (cx, cy) = (0.5, 0.5);
@@ -160,7 +160,7 @@ pub fn attributes(
 }
 
 /// The header attribute (and PNG text) holding `render_id`.
-pub const RENDER_ID: &str = "renderId";
+pub(crate) const RENDER_ID: &str = "renderId";
 
 /// What identifies a render's settings, as hex: a hash of the whole scene as loaded (every
 /// value, the view time and the image settings but the crop included, overrides applied), the
@@ -168,7 +168,7 @@ pub const RENDER_ID: &str = "renderId";
 /// `--resume` skips only a frame whose file says so. The hash is std's (SipHash with fixed
 /// keys), fed the scene's debug text as it is formatted, with no copy of it; another build of
 /// the compiler may hash differently, which costs a frame rendered again, nothing more.
-pub fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> String {
+pub(crate) fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> String {
     use std::fmt::Write as _;
     use std::hash::Hasher;
     struct Feed(std::hash::DefaultHasher);
@@ -209,7 +209,7 @@ pub fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> String {
 
 /// The names of the scene's objects and materials for the Cryptomatte manifests: an object's
 /// `name`, or where it has none its group, kind and place in the file.
-pub fn matte_names(scene: &Scene) -> MatteNames {
+pub(crate) fn matte_names(scene: &Scene) -> MatteNames {
     let objects = scene
         .objects
         .iter()

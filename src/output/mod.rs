@@ -56,7 +56,7 @@ pub fn write(frame: &Frame, path: &Path) -> crate::Result<()> {
 }
 
 /// As [`write()`], an EXR with `exr`'s compression, precision and header attributes.
-pub fn write_with(frame: &Frame, path: &Path, exr: &ExrOptions) -> crate::Result<()> {
+pub(crate) fn write_with(frame: &Frame, path: &Path, exr: &ExrOptions) -> crate::Result<()> {
     let format = Format::for_path(path)?;
     file::write_whole(path, |tmp| match format {
         Format::Exr => exr_out::write(frame, tmp, exr),
@@ -210,7 +210,7 @@ pub(crate) fn write_exr_in_strips(
 }
 
 /// Linear to sRGB-encoded, after clamping to [0, 1].
-pub fn srgb_encode(linear: f32) -> f32 {
+pub(crate) fn srgb_encode(linear: f32) -> f32 {
     let c = if linear.is_finite() {
         linear.clamp(0.0, 1.0)
     } else {

@@ -23,7 +23,7 @@ pub fn write(frame: &Frame, path: &Path) -> std::result::Result<(), Cause> {
 /// bottom: the rows are encoded as they come, so the image is never held whole.
 /// With `alpha`, RGBA: PNG's alpha is straight, so the premultiplied colour is divided by it.
 /// sRGB, with gAMA and cHRM for readers that ignore the sRGB chunk, and a Software chunk.
-pub fn write_strips(
+pub(crate) fn write_strips(
     path: &Path,
     width: u32,
     height: u32,

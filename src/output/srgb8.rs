@@ -55,7 +55,7 @@ fn start_codes() -> &'static [u8] {
 
 /// The 8-bit sRGB code of linear `c` (clamped to [0, 1]; NaN and infinities are 0, as
 /// `srgb_encode` has them).
-pub fn srgb8(c: f32) -> u8 {
+pub(crate) fn srgb8(c: f32) -> u8 {
     if !(c > 0.0 && c.is_finite()) {
         return 0;
     }

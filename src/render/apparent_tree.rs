@@ -31,13 +31,13 @@ fn x_app(g: f64, b: f64, x: f64, rho: f64) -> f64 {
 /// offset along v is x_app(X, ρ), increasing in the rest-frame offset X and decreasing in the
 /// distance ρ from the line of motion through the camera; so the apparent shape lies in the
 /// prism "the box's perpendicular section × [x_app(X_min, ρ_max), x_app(X_max, ρ_min)]".
-pub fn apparent_box(rest: &Aabb, v: &Velocity, event: Event) -> Aabb {
+pub(crate) fn apparent_box(rest: &Aabb, v: &Velocity, event: Event) -> Aabb {
     apparent_box_of(&world_box(rest, v, event.t), v, event.x)
 }
 
 /// As [`apparent_box`], for whatever moves at `v` and lies within `now` (world frame) at the
 /// time of the viewing event at `eye`: the bound holds point by point, so for any set in that box.
-pub fn apparent_box_of(now: &Aabb, v: &Velocity, eye: DVec3) -> Aabb {
+pub(crate) fn apparent_box_of(now: &Aabb, v: &Velocity, eye: DVec3) -> Aabb {
     if v.is_zero() {
         return *now;
     }
@@ -45,7 +45,7 @@ pub fn apparent_box_of(now: &Aabb, v: &Velocity, eye: DVec3) -> Aabb {
 }
 
 /// [`apparent_box_of`] for a motion given as its direction `u`, speed β > 0 and γ.
-pub fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec3) -> Aabb {
+pub(crate) fn apparent_box_along(now: &Aabb, u: DVec3, beta: f64, gamma: f64, eye: DVec3) -> Aabb {
     // The box about the eye: centre c and half-widths h.
     let c = now.centroid() - eye;
     let h = 0.5 * now.extent();

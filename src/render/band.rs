@@ -270,7 +270,7 @@ const MOSTLY_OUTSIDE: (f64, f64) = (380.0 / 580.0, 780.0 / 580.0);
 /// largest Doppler factor between the camera and a group or the background, from their
 /// relative rapidity, against [`MOSTLY_OUTSIDE`]. A bound: a group seen only sideways may
 /// never show it.
-pub fn extrapolation_warning(scene: &Scene) -> Option<String> {
+pub(crate) fn extrapolation_warning(scene: &Scene) -> Option<String> {
     use crate::spacetime::Velocity;
     if !scene.render.doppler {
         return None;

@@ -37,7 +37,7 @@ pub struct PixelValue {
 pub const DEPTH_FAR: f32 = f32::MAX;
 
 /// How many objects (and materials) a pixel's mattes keep, by coverage.
-pub const MATTE_RANKS: usize = 6;
+pub(crate) const MATTE_RANKS: usize = 6;
 
 /// What a pixel's samples saw, for anti-aliased mattes (Cryptomatte): the objects and the
 /// materials with the largest shares of the samples, largest first, as (index + 1, share);
@@ -129,7 +129,7 @@ pub fn pass(name: &str) -> Option<usize> {
 }
 
 /// Channel names written to EXR, in this order.
-pub const CHANNELS: [&str; 22] = [
+pub(crate) const CHANNELS: [&str; 22] = [
     "R",
     "G",
     "B",

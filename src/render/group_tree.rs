@@ -117,7 +117,7 @@ impl SlicedGroupTree {
 
 /// The world-frame box at world time `t` of rest-frame bounds moving at `v` (whose rest-frame
 /// origin passes the world origin at t = 0): the corners contracted along v, then carried.
-pub fn world_box(rest: &Aabb, v: &Velocity, t: f64) -> Aabb {
+pub(crate) fn world_box(rest: &Aabb, v: &Velocity, t: f64) -> Aabb {
     // Per group, not per corner: the speed is a tanh and γ a cosh of the rapidity. The
     // contraction 1/γ − 1 = −(γ − 1)/γ, exact at small speeds (docs/physics.md §8.1).
     let (dir, shift) = (v.direction(), v.beta_vec() * t);

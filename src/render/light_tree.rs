@@ -86,7 +86,7 @@ impl Motion {
 /// The box holding every point where a group (rest-frame bounds `rest`, velocity `v`) can meet
 /// light that left `light` at a time in [t_a, t_b] (what the tests check the light tree by).
 #[cfg(test)]
-pub fn reach_box(rest: &Aabb, v: &Velocity, light: DVec3, t_a: f64, t_b: f64) -> Aabb {
+pub(crate) fn reach_box(rest: &Aabb, v: &Velocity, light: DVec3, t_a: f64, t_b: f64) -> Aabb {
     Motion::new(rest, v).reach_box(light, t_a, t_b)
 }
 

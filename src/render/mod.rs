@@ -19,10 +19,12 @@ mod star_pixels;
 mod tile;
 mod world;
 
-pub use band::{extrapolation_warning, needs_spectra};
-pub use frame::{pass, Frame, Mattes, PixelValue, CHANNELS, DEPTH_FAR, MATTE_RANKS};
+pub(crate) use band::extrapolation_warning;
+pub use band::needs_spectra;
+pub use frame::{pass, Frame, Mattes, PixelValue, DEPTH_FAR};
+pub(crate) use frame::{CHANNELS, MATTE_RANKS};
 pub use progressive::{Converged, StopAt};
-pub use world::{WorldOptions, INSTANCE_OVER};
+pub use world::WorldOptions;
 
 pub(crate) use band::Seen;
 pub(crate) use camera::CameraRays;

@@ -10,7 +10,7 @@ use crate::scene::Scene;
 use std::time::{Duration, Instant};
 
 /// Samples per pixel in each round (fewer where the scene asks for fewer in all).
-pub const ROUND: u32 = 4;
+pub(crate) const ROUND: u32 = 4;
 
 /// When a progressive render stops (whichever comes first; `samples` always bounds it).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

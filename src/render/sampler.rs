@@ -16,7 +16,7 @@ fn unit(h: u64) -> f64 {
 /// sample `base` of the pixel (a progressive render's; 0 otherwise): the centre when n = 1 in
 /// the first round, else a jittered point in its cell of a k × ⌈n/k⌉ grid, k = ⌈√n⌉, the jitter
 /// a hash of the pixel and the sample's index in the whole render.
-pub fn sample_offset(x: u32, y: u32, s: u32, n: u32, base: u32) -> (f64, f64) {
+pub(crate) fn sample_offset(x: u32, y: u32, s: u32, n: u32, base: u32) -> (f64, f64) {
     if n <= 1 && base == 0 {
         return (0.5, 0.5);
     }

@@ -64,7 +64,7 @@ impl StarPixels {
 /// What the camera records (linear sRGB) of a star at `kelvin` whose light at rest has
 /// luminance `irradiance` (the Y of linear sRGB), seen from a frame whose wavelengths are
 /// `shift` times the star's (`spectral`), or its RGB at rest (not `spectral`).
-pub fn star_rgb(kelvin: f64, irradiance: f64, shift: f64, spectral: bool) -> DVec3 {
+pub(crate) fn star_rgb(kelvin: f64, irradiance: f64, shift: f64, spectral: bool) -> DVec3 {
     let (spectrum, rest) = star_spectrum(kelvin, irradiance);
     if spectral {
         camera::rgb(&Sampled::of(&spectrum, shift))
@@ -181,7 +181,7 @@ impl StarCones {
 
 /// The spectrum of a star at `kelvin` whose light at rest has luminance `irradiance`, and its
 /// RGB at rest.
-pub fn star_spectrum(kelvin: f64, irradiance: f64) -> (Spectrum, DVec3) {
+pub(crate) fn star_spectrum(kelvin: f64, irradiance: f64) -> (Spectrum, DVec3) {
     let unit = Spectrum::Blackbody { kelvin, scale: 1.0 };
     let rest = camera::rgb(&Sampled::of(&unit, 1.0));
     let scale = irradiance / luminance(rest);

@@ -27,7 +27,7 @@ fn blocks(x0: u32, y0: u32, w: u32, h: u32) -> impl Iterator<Item = (u32, u32, u
 }
 
 /// The pixels of the tile at (x0, y0), clipped to the image, in 4 × 4 blocks.
-pub fn tile_pixels(x0: u32, y0: u32, w: u32, h: u32) -> Vec<(u32, u32)> {
+pub(crate) fn tile_pixels(x0: u32, y0: u32, w: u32, h: u32) -> Vec<(u32, u32)> {
     let mut v = Vec::with_capacity((TILE * TILE) as usize);
     for (bx, by, bw, bh) in blocks(x0, y0, w, h) {
         for y in by..by + bh {
@@ -175,7 +175,7 @@ impl TileScratch {
 
 /// Trace (without shading) every sample's primary rays of one tile; returns the primary rays
 /// resolved (culled ones as background included) and the hits.
-pub fn trace_tile(
+pub(crate) fn trace_tile(
     scene: &Scene,
     world: &World,
     cam: &CameraRays,
@@ -395,7 +395,7 @@ pub struct TileResult {
 /// Render one tile, carrying light as `B` (RGB, or radiance at the camera's wavelengths) with
 /// changes of frame doing what `seen` says.
 #[allow(clippy::too_many_arguments)]
-pub fn render_tile<B: Band>(
+pub(crate) fn render_tile<B: Band>(
     seen: Seen,
     scene: &Scene,
     world: &World,

@@ -27,7 +27,7 @@ pub use primary_hits::PrimaryHits;
 use std::sync::{Arc, OnceLock};
 
 /// From this many groups on, rays find their groups through the group tree.
-pub const GROUP_TREE_MIN: usize = 8;
+pub(crate) const GROUP_TREE_MIN: usize = 8;
 
 /// Kinetic trees per world (reference times), when the group tree is in use.
 const TIME_SLICES: usize = 16;
@@ -39,7 +39,7 @@ const LIGHT_SLICES: usize = 128;
 /// structure (and a call into it) costs more than the primitives themselves.
 pub const DIRECT_MAX: usize = 4;
 
-pub use crate::geometry::INSTANCE_OVER;
+pub(crate) use crate::geometry::INSTANCE_OVER;
 
 /// The largest distance from `p` to a corner of `b`.
 fn corner_distance(b: &Aabb, p: DVec3) -> f64 {

@@ -17,28 +17,28 @@
 //! finite value in the image (a searchlight at γ = 1e8 multiplies radiance by up to 1e42).
 
 /// The largest magnitude of any number in a scene.
-pub const MAX_MAGNITUDE: f64 = 1e15;
+pub(crate) const MAX_MAGNITUDE: f64 = 1e15;
 /// The largest rapidity of any velocity (camera, light, group).
-pub const MAX_RAPIDITY: f64 = 20.0;
+pub(crate) const MAX_RAPIDITY: f64 = 20.0;
 /// The smallest vertical field of view, degrees.
-pub const MIN_FOV_DEG: f64 = 1e-6;
+pub(crate) const MIN_FOV_DEG: f64 = 1e-6;
 
 /// The message for a number beyond [`MAX_MAGNITUDE`].
-pub fn too_large(v: f64) -> String {
+pub(crate) fn too_large(v: f64) -> String {
     format!(
         "{v:?} is beyond the values rest-embree renders correctly: numbers up to {MAX_MAGNITUDE:e} in size (scale the scene's units instead; see \"Valid scenes\" in docs/scene-format.md)"
     )
 }
 
 /// The message for an object that reaches beyond [`MAX_MAGNITUDE`] from the origin.
-pub fn reaches_too_far(kind: &str, reach: f64) -> String {
+pub(crate) fn reaches_too_far(kind: &str, reach: f64) -> String {
     format!(
         "the {kind} reaches {reach:e} from the origin, beyond the {MAX_MAGNITUDE:e} rest-embree renders correctly (scale the scene's units instead; see \"Valid scenes\" in docs/scene-format.md)"
     )
 }
 
 /// The message for a velocity beyond [`MAX_RAPIDITY`], or None.
-pub fn too_fast(rapidity: f64) -> Option<String> {
+pub(crate) fn too_fast(rapidity: f64) -> Option<String> {
     (rapidity > MAX_RAPIDITY).then(|| {
         format!(
             "rapidity {rapidity:?} is beyond the speeds rest-embree renders correctly: rapidity up to {MAX_RAPIDITY:?} (1 - beta down to about 1e-17)"

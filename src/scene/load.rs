@@ -33,7 +33,7 @@ pub enum FrameSize {
 }
 
 /// As [`load_file`], the frame's size checked as `frame` says.
-pub fn load_file_as(
+pub(crate) fn load_file_as(
     path: &std::path::Path,
     overrides: &[(String, String)],
     frame: FrameSize,

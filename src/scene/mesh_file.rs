@@ -24,7 +24,7 @@ pub struct MeshData {
 }
 
 /// A triangle's material where the file gives it none.
-pub const NO_MATERIAL: u32 = u32::MAX;
+pub(crate) const NO_MATERIAL: u32 = u32::MAX;
 
 /// The name under which the names of an OBJ's `usemtl` statements are handed to tobj as a
 /// material library of their own (see `read_obj`).
@@ -54,11 +54,11 @@ impl MeshError {
 }
 
 /// The formats, by extension.
-pub const EXTENSIONS: [&str; 3] = ["obj", "ply", "stl"];
+pub(crate) const EXTENSIONS: [&str; 3] = ["obj", "ply", "stl"];
 
 /// Bytes of memory reading takes per byte of file, at most (text to positions, indices and the
 /// readers' own tables), for the check against the memory limit before reading.
-pub const BYTES_PER_FILE_BYTE: u64 = 24;
+pub(crate) const BYTES_PER_FILE_BYTE: u64 = 24;
 
 /// Read the mesh at `path`, by its extension.
 pub fn read(path: &Path) -> Result<MeshData, MeshError> {

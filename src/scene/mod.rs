@@ -20,10 +20,12 @@ pub(crate) mod toml_tree;
 mod transform;
 
 pub use crate::error::SceneError;
-pub use load::{load_file, load_file_as, load_str, FrameSize};
+pub(crate) use load::load_file_as;
+pub use load::{load_file, load_str, FrameSize};
+pub(crate) use model::MAX_FRAME_PIXELS;
 pub use model::{
     Camera, Film, Fog, FrameSpacing, Group, ImageSettings, Integrator, Light, Material, Medium,
-    ObjectInfo, Projection, RenderSettings, Scene, MAX_FRAMES, MAX_FRAME_PIXELS, MAX_RAYS,
+    ObjectInfo, Projection, RenderSettings, Scene,
 };
 pub use pass_set::{Pass, PassSet};
 pub use texture::{ImageTexture, Sample as TextureSample, Sky, Texture};

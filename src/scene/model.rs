@@ -80,7 +80,7 @@ pub enum FrameSpacing {
 }
 
 /// The most frames a film may have.
-pub const MAX_FRAMES: u64 = 1_000_000;
+pub(crate) const MAX_FRAMES: u64 = 1_000_000;
 
 impl Film {
     /// The number of frames: every k from 0 with `time(k) <= end` (a rounding error of a part
@@ -103,7 +103,7 @@ impl Film {
 }
 
 /// The most pixels one render's frame (the image, or its crop) may have.
-pub const MAX_FRAME_PIXELS: u64 = 1 << 28;
+pub(crate) const MAX_FRAME_PIXELS: u64 = 1 << 28;
 
 /// The image: its size, samples, background and crop.
 #[derive(Clone, Debug, PartialEq)]
@@ -181,7 +181,7 @@ pub enum Integrator {
 }
 
 /// The largest `max_rays` a scene may give.
-pub const MAX_RAYS: u32 = 65536;
+pub(crate) const MAX_RAYS: u32 = 65536;
 
 impl Default for RenderSettings {
     /// Five bounces (every ray of their tree: 62 at most), ambient 0.1, both effects on light.

@@ -10,7 +10,7 @@ use glam::DVec3;
 use std::collections::HashMap;
 
 /// The most primitives one scene may hold (a guard against typos like `counts = [1000000, ...]`).
-pub const MAX_PRIMITIVES: u64 = 200_000_000;
+pub(crate) const MAX_PRIMITIVES: u64 = 200_000_000;
 
 pub(super) const OBJECT_KEYS: &[&str] = &[
     "type",

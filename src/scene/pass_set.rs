@@ -70,7 +70,7 @@ impl Pass {
 }
 
 /// Names that stand for several passes.
-pub const SHORTHANDS: [(&str, &[Pass]); 4] = [
+pub(crate) const SHORTHANDS: [(&str, &[Pass]); 4] = [
     ("all", &Pass::ALL),
     ("none", &[]),
     (

@@ -11,7 +11,7 @@ use glam::DVec3;
 use std::sync::Arc;
 
 /// The most stars a field may have (about 40 bytes each, made when the scene is read).
-pub const MAX_STARS: u64 = 10_000_000;
+pub(crate) const MAX_STARS: u64 = 10_000_000;
 
 /// What `[sky] stars` asks for.
 #[derive(Clone, Debug, PartialEq)]

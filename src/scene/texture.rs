@@ -226,12 +226,12 @@ fn checker_cell(size: DVec3, p: DVec3) -> usize {
 }
 
 /// The most texels an image texture may have (a 16384 x 16384 image).
-pub const MAX_TEXELS: u64 = 1 << 28;
+pub(crate) const MAX_TEXELS: u64 = 1 << 28;
 
 /// An image file's linear RGB texels, row by row from the top: a PNG (8 or 16 bits, grey,
 /// RGB, with or without alpha, palette; sRGB-decoded; alpha ignored) or an EXR (its R, G, B
 /// channels, or Y as grey). Why not, in words.
-pub fn read_image(path: &std::path::Path) -> Result<(usize, usize, Vec<[f32; 3]>), String> {
+pub(crate) fn read_image(path: &std::path::Path) -> Result<(usize, usize, Vec<[f32; 3]>), String> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())

@@ -28,7 +28,7 @@ pub struct TomlError {
 }
 
 /// Parse a whole document. Values take the line of their key; elements of arrays their own.
-pub fn parse_document(text: &str, lines: &Lines) -> Result<Node, TomlError> {
+pub(crate) fn parse_document(text: &str, lines: &Lines) -> Result<Node, TomlError> {
     let mut b = Builder::new(text, Some(lines), Origin::line(1));
     let source = Source::new(text);
     let mut first: Option<ParseError> = None;
@@ -82,7 +82,7 @@ pub fn parse_document(text: &str, lines: &Lines) -> Result<Node, TomlError> {
 }
 
 /// Parse one value (a `--set` override); every node gets `origin`.
-pub fn parse_value(text: &str, origin: Origin) -> Result<Node, TomlError> {
+pub(crate) fn parse_value(text: &str, origin: Origin) -> Result<Node, TomlError> {
     let mut b = Builder::new(text, None, origin);
     let source = Source::new(text);
     let tokens = source.lex().into_vec();

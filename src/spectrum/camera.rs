@@ -14,7 +14,7 @@ use glam::{DMat3, DVec3};
 use std::sync::OnceLock;
 
 /// The band the camera sees, nm.
-pub const BAND: (f64, f64) = (380.0, 780.0);
+pub(crate) const BAND: (f64, f64) = (380.0, 780.0);
 
 /// XYZ to linear sRGB (IEC 61966-2-1's matrix, rows R, G, B).
 pub const XYZ_TO_SRGB: DMat3 = DMat3::from_cols_array(&[
@@ -22,11 +22,11 @@ pub const XYZ_TO_SRGB: DMat3 = DMat3::from_cols_array(&[
 ]);
 
 /// sRGB's chromaticities (red, green, blue, white) as the EXR header states them.
-pub const SRGB_CHROMATICITIES: [[f32; 2]; 4] =
+pub(crate) const SRGB_CHROMATICITIES: [[f32; 2]; 4] =
     [[0.64, 0.33], [0.30, 0.60], [0.15, 0.06], [0.3127, 0.3290]];
 
 /// The bins' width in ln λ.
-pub fn ln_step() -> f64 {
+pub(crate) fn ln_step() -> f64 {
     (BAND.1 / BAND.0).ln() / SAMPLES as f64
 }
 
@@ -145,7 +145,7 @@ pub(crate) fn illuminant(coeffs: &[f64; 3], scale: f64, shift: f64) -> [f64; SAM
 
 /// Half a camera bin's width in ln λ: bin i spans λ_i·e^{∓h}, in any frame (a shift multiplies
 /// both ends).
-pub fn bin_half_ln() -> f64 {
+pub(crate) fn bin_half_ln() -> f64 {
     (BAND.1 / BAND.0).ln() / (2 * SAMPLES) as f64
 }
 
@@ -162,7 +162,7 @@ pub fn white(nm: f64) -> f64 {
 }
 
 /// CIE XYZ of radiance sampled at the camera's wavelengths.
-pub fn xyz(s: &Sampled) -> DVec3 {
+pub(crate) fn xyz(s: &Sampled) -> DVec3 {
     let r = response();
     (0..SAMPLES).map(|i| r.xyz[i] * s.0[i]).sum()
 }
@@ -179,7 +179,7 @@ pub fn rgb_of(f: impl Fn(f64) -> f64) -> DVec3 {
 
 /// Linear sRGB of the radiance `f(nm)` by the 1 nm sum of the CIE table over 360-830 nm: the
 /// reference the camera's quadrature is measured against (docs/physics.md).
-pub fn reference_rgb_of(f: impl Fn(f64) -> f64) -> DVec3 {
+pub(crate) fn reference_rgb_of(f: impl Fn(f64) -> f64) -> DVec3 {
     let xyz: DVec3 = CMF_1931
         .iter()
         .enumerate()

@@ -3,9 +3,9 @@
 //! relative spectral power of CIE illuminant D65 (CIE 15, 5 nm steps from 300 nm).
 
 /// First wavelength of [`CMF_1931`], nm (1 nm apart).
-pub const CMF_START: f64 = 360.0;
+pub(crate) const CMF_START: f64 = 360.0;
 /// x̄, ȳ, z̄ at 471 wavelengths, 360-830 nm.
-pub const CMF_1931: [[f64; 3]; 471] = [
+pub(crate) const CMF_1931: [[f64; 3]; 471] = [
     [0.0001299, 3.917e-06, 0.0006061],
     [0.000145847, 4.393581e-06, 0.0006808792],
     [0.0001638021, 4.929604e-06, 0.0007651456],
@@ -480,9 +480,9 @@ pub const CMF_1931: [[f64; 3]; 471] = [
 ];
 
 /// First wavelength of [`D65`], nm (5 nm apart).
-pub const D65_START: f64 = 300.0;
+pub(crate) const D65_START: f64 = 300.0;
 /// Wavelength step of [`D65`], nm.
-pub const D65_STEP: f64 = 5.0;
+pub(crate) const D65_STEP: f64 = 5.0;
 /// D65's relative spectral power at 97 wavelengths, 300-780 nm.
 pub const D65: [f64; 97] = [
     0.0341, 1.6643, 3.2945, 11.7652, 20.236, 28.6447, 37.0535, 38.5011, 39.9488, 42.4302, 44.9117,

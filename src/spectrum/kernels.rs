@@ -10,7 +10,7 @@ type Lanes = [f64; SAMPLES];
 
 /// `out[i] = lo[i] + t (hi[i] − lo[i])`.
 #[multiversion(targets("x86_64+avx2"))]
-pub fn lerp(lo: &[f64], hi: &[f64], t: f64, out: &mut Lanes) {
+pub(crate) fn lerp(lo: &[f64], hi: &[f64], t: f64, out: &mut Lanes) {
     let (lo, hi) = (&lo[..SAMPLES], &hi[..SAMPLES]);
     for i in 0..SAMPLES {
         out[i] = lo[i] + t * (hi[i] - lo[i]);
@@ -19,7 +19,7 @@ pub fn lerp(lo: &[f64], hi: &[f64], t: f64, out: &mut Lanes) {
 
 /// The three dot products of `rows` with `v`, each in four partial sums.
 #[multiversion(targets("x86_64+avx2"))]
-pub fn dot3(rows: &[Lanes; 3], v: &Lanes) -> [f64; 3] {
+pub(crate) fn dot3(rows: &[Lanes; 3], v: &Lanes) -> [f64; 3] {
     let mut out = [0.0; 3];
     for (o, w) in out.iter_mut().zip(rows) {
         let mut acc = [0.0; 4];
@@ -35,7 +35,7 @@ pub fn dot3(rows: &[Lanes; 3], v: &Lanes) -> [f64; 3] {
 
 /// `a[i] *= b[i]`.
 #[multiversion(targets("x86_64+avx2"))]
-pub fn mul(a: &mut Lanes, b: &Lanes) {
+pub(crate) fn mul(a: &mut Lanes, b: &Lanes) {
     for i in 0..SAMPLES {
         a[i] *= b[i];
     }
@@ -43,7 +43,7 @@ pub fn mul(a: &mut Lanes, b: &Lanes) {
 
 /// `a[i] += b[i]`.
 #[multiversion(targets("x86_64+avx2"))]
-pub fn add(a: &mut Lanes, b: &Lanes) {
+pub(crate) fn add(a: &mut Lanes, b: &Lanes) {
     for i in 0..SAMPLES {
         a[i] += b[i];
     }
@@ -60,7 +60,7 @@ pub fn scale(a: &mut Lanes, k: f64) {
 /// `acc[i] += light[i] · (diffuse[i] · ndl + spec[i] · h) · a`, or without the specular part
 /// `acc[i] += light[i] · (diffuse[i] · (ndl · a))`: a light's term at a surface.
 #[multiversion(targets("x86_64+avx2"))]
-pub fn add_lit(
+pub(crate) fn add_lit(
     acc: &mut Lanes,
     light: &Lanes,
     diffuse: &Lanes,

@@ -4,7 +4,7 @@ use super::{camera, Spectrum};
 use std::ops::Mul;
 
 /// How many wavelengths the camera reads (see [`camera`]).
-pub const SAMPLES: usize = 64;
+pub(crate) const SAMPLES: usize = 64;
 
 /// Values at the camera's wavelengths: in a frame whose wavelengths are `shift` times the
 /// camera's, the i-th value belongs to wavelength `shift · camera::wavelengths()[i]`.

@@ -107,7 +107,7 @@ impl Injection {
 /// Run a callback's body: a panic is caught here and recorded in `fault`. Once the query has
 /// a fault the body is skipped: a bug that panics every time shows its message once a query.
 #[inline(always)]
-pub fn guarded(
+pub(crate) fn guarded(
     callback: Callback,
     fault: &Cell<Fault>,
     inject: Option<&Injection>,

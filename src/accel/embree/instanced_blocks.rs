@@ -114,7 +114,7 @@ pub struct BlockScene {
 
 /// Build `run`'s block scene and attach one instance of it per block to `builder`, as geomIDs
 /// `first_instance ..`; hits are reported with geomID `slot` and primID the object's number.
-pub fn attach(
+pub(crate) fn attach(
     device: &Arc<Device>,
     builder: &mut SceneBuilder,
     run: &ImplicitRun,

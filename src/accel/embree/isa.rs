@@ -10,7 +10,7 @@
 use crate::{Error, Result};
 
 /// The environment variable that picks Embree's instruction set.
-pub const ENV: &str = "REST_EMBREE_ISA";
+pub(crate) const ENV: &str = "REST_EMBREE_ISA";
 
 /// One of Embree 3's code paths, named as its `isa=` configuration names it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]

@@ -28,7 +28,8 @@ mod scene;
 
 pub use bare::BareRay;
 pub use fault::Callback;
-pub use isa::{Isa, ENV as ISA_ENV};
+pub use isa::Isa;
+pub(crate) use isa::ENV as ISA_ENV;
 
 use super::{Accelerator, Backend, BoxCuller, CullerFactory, Fan, FanHits, Faults, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, Real};
@@ -50,7 +51,7 @@ pub struct EmbreeBackend {
 }
 
 /// The environment variable of the fault-injection test hook (`EmbreeBackend::configured_by_env`).
-pub const FAULT_ENV: &str = "REST_EMBREE_FAULT";
+pub(crate) const FAULT_ENV: &str = "REST_EMBREE_FAULT";
 
 impl EmbreeBackend {
     pub fn new() -> Self {

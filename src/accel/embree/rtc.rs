@@ -483,7 +483,7 @@ impl CommittedScene {
 }
 
 /// An intersect context as `rtcInitIntersectContext` makes it.
-pub fn new_context() -> RTCIntersectContext {
+pub(crate) fn new_context() -> RTCIntersectContext {
     let mut rtc = RTCIntersectContext::default();
     // SAFETY: initialises the plain struct in place.
     unsafe { rtcInitIntersectContext(&mut rtc) };

@@ -40,7 +40,7 @@ impl Basis {
 
 /// Unpolarised Fresnel reflectance at a boundary met at `cos_i` (> 0) from the side of index
 /// n_i, with `eta` = n_t / n_i; 1 on total internal reflection.
-pub fn fresnel(cos_i: f64, eta: f64) -> f64 {
+pub(crate) fn fresnel(cos_i: f64, eta: f64) -> f64 {
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
     if sin2_t >= 1.0 {
         return 1.0;

@@ -11,7 +11,7 @@ use std::f64::consts::PI;
 
 /// Parts of more emitting primitives than this (a glowing lattice of 10⁹ nodes) are not
 /// listed: paths that meet them still see their light, by the BSDF's draws alone.
-pub const MAX_LISTED: u64 = 1 << 22;
+pub(crate) const MAX_LISTED: u64 = 1 << 22;
 
 /// Every listed emitting primitive and how it is chosen.
 #[derive(Default)]
@@ -137,7 +137,7 @@ fn cone(p: &Primitive, x: DVec3) -> Option<(DVec3, f64, f64)> {
 
 /// A point drawn on `p` as seen from `x` (both in its rest frame), given three uniform numbers:
 /// a sphere by the cone it fills, every other primitive uniformly by area.
-pub fn sample_point(p: &Primitive, x: DVec3, u: [f64; 3]) -> Option<EmitterPoint> {
+pub(crate) fn sample_point(p: &Primitive, x: DVec3, u: [f64; 3]) -> Option<EmitterPoint> {
     if let Some((center, radius, omc)) = cone(p, x) {
         let w = center - x;
         let dc = w.length();
@@ -200,7 +200,7 @@ pub fn sample_point(p: &Primitive, x: DVec3, u: [f64; 3]) -> Option<EmitterPoint
 
 /// The density per solid angle (emitter's frame) with which [`sample_point`] draws point `y`
 /// of `p` seen from `x`.
-pub fn pdf_point(p: &Primitive, x: DVec3, y: DVec3) -> f64 {
+pub(crate) fn pdf_point(p: &Primitive, x: DVec3, y: DVec3) -> f64 {
     if let Some((_, _, omc)) = cone(p, x) {
         return 1.0 / (2.0 * PI * omc);
     }
