@@ -281,21 +281,24 @@ impl LightTree {
     /// Many shadow rays toward this light (lookback from 0 to `tmax[i]`), in packets: the
     /// rays of one slice, read backwards, all start at the light. For each ray this tree
     /// serves, `served[i]` is set, and `blocked[i]` too when `test(group, i)` holds for a group
-    /// the ray may meet; the others are left alone.
+    /// the ray may meet; the others are left alone. `order`: a buffer for the rays by slice.
     pub fn occluded_many(
         &self,
         rays: &[NullRay],
         tmax: &[f64],
-        served: &mut [bool],
+        (served, order): (&mut [bool], &mut Vec<(usize, usize, f64)>),
         blocked: &mut [bool],
         mut test: impl FnMut(u32, usize) -> bool,
     ) {
-        let mut order: Vec<(usize, usize, f64)> = rays
-            .iter()
-            .zip(tmax)
-            .enumerate()
-            .filter_map(|(i, (r, &t))| self.serves(r, t).map(|(k, reach)| (k, i, reach)))
-            .collect();
+        order.clear();
+        // Room for every ray at once, so the buffer grows only with the batch.
+        order.reserve(rays.len());
+        order.extend(
+            rays.iter()
+                .zip(tmax)
+                .enumerate()
+                .filter_map(|(i, (r, &t))| self.serves(r, t).map(|(k, reach)| (k, i, reach))),
+        );
         order.sort_unstable_by_key(|&(k, i, _)| (k, i));
         for run in order.chunk_by(|a, b| a.0 == b.0) {
             // A slice that could not be built serves none of its rays.

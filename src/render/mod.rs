@@ -38,7 +38,9 @@ pub(crate) use {
     apparent_tree::apparent_box,
     group_tree::{world_box, GroupTree, SlicedGroupTree},
     light_tree::{reach_box, LightTree},
+    path::Emitters,
     shade::Shader,
+    tile::{render_tile, TileScratch, View},
 };
 
 use crate::accel::Backend;

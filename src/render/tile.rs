@@ -7,9 +7,9 @@ use super::frame::{Mattes, PixelValue, MATTE_RANKS};
 use super::path::{sample_rng, Emitters, PathTracer};
 use super::sampler::sample_offset;
 use super::screen_cull::ScreenCull;
-use super::shade::{Shader, Spread};
+use super::shade::{Lit, Shader, ShadowQuery, Spread};
 use super::star_pixels::{StarCones, StarPixels};
-use super::world::{PrimaryHits, SurfaceHit, World};
+use super::world::{PrimaryHits, ShadowBuffers, SurfaceHit, World};
 use super::{Passes, TILE};
 use crate::scene::Scene;
 use crate::spacetime::NullRay;
@@ -157,6 +157,7 @@ pub struct TileScratch {
     pixels: TilePixels,
     px: Vec<(f64, f64)>,
     primary: PrimaryHits,
+    round: RoundBuffers,
 }
 
 impl TileScratch {
@@ -167,9 +168,19 @@ impl TileScratch {
         cam: &CameraRays,
         cull: Option<&ScreenCull>,
         (x0, y0): (u32, u32),
-    ) -> (&TilePixels, &mut Vec<(f64, f64)>, &mut PrimaryHits) {
+    ) -> (
+        &TilePixels,
+        &mut Vec<(f64, f64)>,
+        &mut PrimaryHits,
+        &mut RoundBuffers,
+    ) {
         self.pixels.fill(scene, cam, cull, x0, y0);
-        (&self.pixels, &mut self.px, &mut self.primary)
+        (
+            &self.pixels,
+            &mut self.px,
+            &mut self.primary,
+            &mut self.round,
+        )
     }
 }
 
@@ -183,7 +194,7 @@ pub(crate) fn trace_tile(
     (x0, y0): (u32, u32),
     scratch: &mut TileScratch,
 ) -> (u64, u64) {
-    let (t, px, primary) = scratch.tile(scene, cam, cull, (x0, y0));
+    let (t, px, primary, _) = scratch.tile(scene, cam, cull, (x0, y0));
     let n = scene.image.samples;
     let mut found = 0;
     for s in 0..n {
@@ -194,16 +205,20 @@ pub(crate) fn trace_tile(
     (n as u64 * t.total as u64, found)
 }
 
-/// The colours (linear sRGB) of primary hits (background where none), with the shadow rays of
-/// all of them traced together, light by light, so they go to the backends in packets.
-fn shade_hits<B: Band>(
-    shader: &Shader<B>,
+/// The colours (linear sRGB) of primary hits (background where none), into `buf.colors`, with
+/// the shadow rays of all of them traced together, light by light, so they go to the backends
+/// in packets; `lits` and `buf` are refilled, not made.
+#[allow(clippy::too_many_arguments)]
+fn shade_hits<'a, B: Band>(
+    shader: &Shader<'a, B>,
     world: &World,
     cam: &CameraRays,
     primary: &PrimaryHits,
     (coords, (ox, oy)): (&[(u32, u32)], (u32, u32)),
     stars: Option<&StarPixels>,
-) -> Vec<DVec3> {
+    lits: &mut Vec<Prepared<'a>>,
+    buf: &mut RoundBuffers,
+) {
     // Stars seen after a bounce are found in the bundle of the pixel's solid angle.
     let spreads = shader.finds_star_cones();
     // One entry per light and hit (None where there is no shadow ray), hit-major.
@@ -211,43 +226,57 @@ fn shade_hits<B: Band>(
     let budget = shader.primary_budget();
     let follows = shader.follows_frames();
     let black_sky = shader.primary_misses_add_nothing();
-    let mut shadows = Vec::with_capacity(lights * primary.len());
+    let RoundBuffers {
+        shadows,
+        visible,
+        which,
+        shadow,
+        tmax,
+        blocked,
+        trees,
+        colors,
+    } = buf;
+    shadows.clear();
     // Each ray's hit prepared for shading with the factor its light gains on the way to the
     // camera, or the camera's lookback factor along a ray that meets nothing.
-    let lits: Vec<_> = (0..primary.len())
-        .map(|i| {
-            let ray = primary.ray(i);
-            let camera_s = if follows {
-                cam.lookback_factor(ray.dir)
-            } else {
-                1.0
-            };
-            match primary.hit(i) {
-                Some(h) => {
-                    let (shift, k) = shader.arriving(camera_s, h.s, 1.0);
-                    let lit = shader.prepare(&ray, &h, shift, &mut shadows);
-                    let lit = if spreads {
-                        let (x, y) = coords[i];
-                        let omega = cam.pixel_solid_angle(x + ox, y + oy);
-                        lit.with_spread(omega * (cam.lookback_factor(ray.dir) / h.s).powi(2))
-                    } else {
-                        lit
-                    };
-                    Ok((lit, k))
-                }
-                None => {
-                    shadows.extend((0..lights).map(|_| None));
-                    Err((camera_s, ray.dir))
-                }
+    lits.clear();
+    lits.extend((0..primary.len()).map(|i| {
+        let ray = primary.ray(i);
+        let camera_s = if follows {
+            cam.lookback_factor(ray.dir)
+        } else {
+            1.0
+        };
+        match primary.hit(i) {
+            Some(h) => {
+                let (shift, k) = shader.arriving(camera_s, h.s, 1.0);
+                let lit = shader.prepare(&ray, &h, shift, shadows);
+                let lit = if spreads {
+                    let (x, y) = coords[i];
+                    let omega = cam.pixel_solid_angle(x + ox, y + oy);
+                    lit.with_spread(omega * (cam.lookback_factor(ray.dir) / h.s).powi(2))
+                } else {
+                    lit
+                };
+                Ok((lit, k))
             }
-        })
-        .collect();
-    let mut visible = vec![false; shadows.len()];
-    let (mut which, mut shadow, mut tmax) = (Vec::new(), Vec::new(), Vec::new());
+            None => {
+                shadows.extend((0..lights).map(|_| None));
+                Err((camera_s, ray.dir))
+            }
+        }
+    }));
+    visible.clear();
+    visible.resize(shadows.len(), false);
     for light in 0..lights {
         which.clear();
         shadow.clear();
         tmax.clear();
+        // Room for a ray per hit from the first round on: no later round grows them.
+        which.reserve(lits.len());
+        shadow.reserve(lits.len());
+        tmax.reserve(lits.len());
+        blocked.reserve(lits.len());
         for (at, q) in shadows.iter().enumerate().skip(light).step_by(lights) {
             if let Some(q) = q {
                 which.push(at);
@@ -255,47 +284,69 @@ fn shade_hits<B: Band>(
                 tmax.push(q.tmax);
             }
         }
-        let mut blocked = vec![false; shadow.len()];
-        world.shadowed_many(light, &shadow, &tmax, &mut blocked);
-        for (&at, b) in which.iter().zip(blocked) {
+        blocked.clear();
+        blocked.resize(shadow.len(), false);
+        world.shadowed_many(light, (shadow, tmax), blocked, trees);
+        for (&at, &b) in which.iter().zip(blocked.iter()) {
             visible[at] = !b;
         }
     }
-    lits.iter()
-        .enumerate()
-        .map(|(k, lit)| match lit {
-            Ok((l, factor)) => {
-                let mine = k * lights..(k + 1) * lights;
-                let mut seen = shader
-                    .finish(
-                        l,
-                        &shadows[mine],
-                        |light, _| visible[k * lights + light],
-                        budget,
-                    )
-                    .0;
-                // The way from the hit to the camera through the scene's fog.
-                if let Some(h) = primary.hit(k) {
-                    let ray = primary.ray(k);
-                    let camera_s = if follows {
-                        cam.lookback_factor(ray.dir)
-                    } else {
-                        1.0
-                    };
-                    if let Some(t) = shader.fog_over(ray.dir, camera_s, 1.0, h.lambda) {
-                        seen.mul_by(&t);
-                    }
+    colors.clear();
+    colors.extend(lits.iter().enumerate().map(|(k, lit)| match lit {
+        Ok((l, factor)) => {
+            let mine = k * lights..(k + 1) * lights;
+            let mut seen = shader
+                .finish(
+                    l,
+                    &shadows[mine],
+                    |light, _| visible[k * lights + light],
+                    budget,
+                )
+                .0;
+            // The way from the hit to the camera through the scene's fog.
+            if let Some(h) = primary.hit(k) {
+                let ray = primary.ray(k);
+                let camera_s = if follows {
+                    cam.lookback_factor(ray.dir)
+                } else {
+                    1.0
+                };
+                if let Some(t) = shader.fog_over(ray.dir, camera_s, 1.0, h.lambda) {
+                    seen.mul_by(&t);
                 }
-                // The camera leg's factor, on the RGB (linear, so as on every wavelength).
-                seen.to_rgb() * *factor
             }
-            Err(_) if black_sky => DVec3::ZERO,
-            Err((camera_s, dir)) => {
-                let (x, y) = coords[k];
-                missed(shader, *camera_s, *dir, stars, (x + ox, y + oy))
-            }
-        })
-        .collect()
+            // The camera leg's factor, on the RGB (linear, so as on every wavelength).
+            seen.to_rgb() * *factor
+        }
+        Err(_) if black_sky => DVec3::ZERO,
+        Err((camera_s, dir)) => {
+            let (x, y) = coords[k];
+            missed(shader, *camera_s, *dir, stars, (x + ox, y + oy))
+        }
+    }));
+}
+
+/// A primary hit prepared for shading and the factor its light gains on the way to the camera,
+/// or, where the ray meets nothing, the camera's lookback factor and the ray's direction.
+type Prepared<'a> = Result<(Lit<'a>, f64), (f64, DVec3)>;
+
+/// The buffers of a round of samples of a tile (a sample of each pixel), kept by the worker
+/// and refilled round after round and tile after tile, so a sample allocates nothing.
+#[derive(Default)]
+struct RoundBuffers {
+    /// One entry per light and hit (None where there is no shadow ray), hit-major.
+    shadows: Vec<Option<ShadowQuery>>,
+    visible: Vec<bool>,
+    /// One light's shadow rays: where each sits in `shadows`, the rays, their lookback limits,
+    /// and whether each is blocked.
+    which: Vec<usize>,
+    shadow: Vec<NullRay>,
+    tmax: Vec<f64>,
+    blocked: Vec<bool>,
+    /// What the light trees work in.
+    trees: ShadowBuffers,
+    /// The colour (linear sRGB) of each hit.
+    colors: Vec<DVec3>,
 }
 
 /// What a primary ray that meets nothing sees (along `dir`, the camera's lookback factor
@@ -317,9 +368,10 @@ fn missed<B: Band>(
     sky.to_rgb() + stars.unwrap_or(DVec3::ZERO)
 }
 
-/// The colours (linear sRGB) of primary hits by the path integrator: one path per hit, its
-/// random numbers those of sample `sample` of its pixel; as [`shade_hits`] where a ray meets
-/// nothing.
+/// The colours (linear sRGB) of primary hits by the path integrator, into `colors`: one path
+/// per hit, its random numbers those of sample `sample` of its pixel; as [`shade_hits`] where
+/// a ray meets nothing.
+#[allow(clippy::too_many_arguments)]
 fn shade_paths<B: Band>(
     tracer: &PathTracer<B>,
     shader: &Shader<B>,
@@ -328,40 +380,40 @@ fn shade_paths<B: Band>(
     (coords, (ox, oy)): (&[(u32, u32)], (u32, u32)),
     stars: Option<&StarPixels>,
     sample: u32,
-) -> Vec<DVec3> {
+    colors: &mut Vec<DVec3>,
+) {
     let follows = shader.follows_frames();
     let black_sky = shader.primary_misses_add_nothing();
     let seed = shader.scene.render.seed;
     let spreads = shader.finds_star_cones();
-    (0..primary.len())
-        .map(|i| {
-            let ray = primary.ray(i);
-            let camera_s = if follows {
-                cam.lookback_factor(ray.dir)
-            } else {
-                1.0
-            };
-            let (x, y) = (coords[i].0 + ox, coords[i].1 + oy);
-            match primary.hit(i) {
-                Some(h) => {
-                    let mut rng = sample_rng(seed, x, y, sample);
-                    // The pixel's bundle, for stars seen after mirrors and glass.
-                    let spread = match spreads {
-                        true => Spread {
-                            sr: cam.pixel_solid_angle(x, y),
-                            s: cam.lookback_factor(ray.dir),
-                        },
-                        false => Spread::NONE,
-                    };
-                    tracer
-                        .camera_path(&ray, &h, camera_s, spread, &mut rng)
-                        .to_rgb()
-                }
-                None if black_sky => DVec3::ZERO,
-                None => missed(shader, camera_s, ray.dir, stars, (x, y)),
+    colors.clear();
+    colors.extend((0..primary.len()).map(|i| {
+        let ray = primary.ray(i);
+        let camera_s = if follows {
+            cam.lookback_factor(ray.dir)
+        } else {
+            1.0
+        };
+        let (x, y) = (coords[i].0 + ox, coords[i].1 + oy);
+        match primary.hit(i) {
+            Some(h) => {
+                let mut rng = sample_rng(seed, x, y, sample);
+                // The pixel's bundle, for stars seen after mirrors and glass.
+                let spread = match spreads {
+                    true => Spread {
+                        sr: cam.pixel_solid_angle(x, y),
+                        s: cam.lookback_factor(ray.dir),
+                    },
+                    false => Spread::NONE,
+                };
+                tracer
+                    .camera_path(&ray, &h, camera_s, spread, &mut rng)
+                    .to_rgb()
             }
-        })
-        .collect()
+            None if black_sky => DVec3::ZERO,
+            None => missed(shader, camera_s, ray.dir, stars, (x, y)),
+        }
+    }));
 }
 
 /// What one frame's camera sees, the same for every tile: its rays, the screen cull, and the
@@ -405,7 +457,7 @@ pub(crate) fn render_tile<B: Band>(
     scratch: &mut TileScratch,
 ) -> TileResult {
     let (cam, cull) = (view.cam, view.cull);
-    let (t, px, primary) = scratch.tile(scene, cam, cull, (x0, y0));
+    let (t, px, primary, round) = scratch.tile(scene, cam, cull, (x0, y0));
     let (offset, live, live_coords) = (t.offset, &t.live, &t.live_coords);
     let (w, h) = scene.image.frame_size();
     let coords = tile_pixels(x0, y0, w, h);
@@ -437,28 +489,27 @@ pub(crate) fn render_tile<B: Band>(
     } else {
         Vec::new()
     };
+    // Each hit prepared for shading; as a tile's rounds have one entry per pixel, it grows in
+    // the first alone.
+    let mut lits = Vec::new();
     for s in 0..n + u32::from(aov_pass) {
         let centre = s == n;
         let sample = if centre { None } else { Some((s, n)) };
         image_points(live_coords, offset, sample, view.sample_base, px);
         traced += coords.len() as u64;
         world.primary_hits(cam, px, primary);
-        let colors = if centre {
-            Vec::new()
+        if centre {
         } else if let Some(t) = &tracer {
             let at = (live_coords.as_slice(), offset);
             let index = view.sample_base + s;
-            shade_paths(t, &shader, cam, primary, at, view.stars, index)
+            let colors = &mut round.colors;
+            shade_paths(t, &shader, cam, primary, at, view.stars, index, colors);
         } else {
-            shade_hits(
-                &shader,
-                world,
-                cam,
-                primary,
-                (live_coords, offset),
-                view.stars,
-            )
-        };
+            let at = (live_coords.as_slice(), offset);
+            let stars = view.stars;
+            shade_hits(&shader, world, cam, primary, at, stars, &mut lits, round);
+        }
+        let colors = &round.colors;
         for (j, &k) in live.iter().enumerate() {
             if !centre {
                 covered[k] += u32::from(primary.is_hit(j));

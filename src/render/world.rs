@@ -611,14 +611,23 @@ impl World {
     }
 
     /// [`World::shadowed`] for many rays toward one light (lookback from 0 to `tmax[i]`): with
-    /// a light tree, in packets per slice of emission times.
-    pub fn shadowed_many(&self, light: usize, rays: &[NullRay], tmax: &[f64], out: &mut [bool]) {
+    /// a light tree, in packets per slice of emission times (`buffers` kept by the caller
+    /// from one call to the next).
+    pub fn shadowed_many(
+        &self,
+        light: usize,
+        (rays, tmax): (&[NullRay], &[f64]),
+        out: &mut [bool],
+        buffers: &mut ShadowBuffers,
+    ) {
         let Some(Some(lt)) = self.light_trees.get(light) else {
             return self.occluded_many(rays, tmax, out);
         };
-        let mut served = vec![false; rays.len()];
+        let ShadowBuffers { served, order } = buffers;
+        served.clear();
+        served.resize(rays.len(), false);
         out.iter_mut().for_each(|o| *o = false);
-        lt.occluded_many(rays, tmax, &mut served, out, |gi, i| {
+        lt.occluded_many(rays, tmax, (served, order), out, |gi, i| {
             self.group_blocks(gi as usize, &rays[i], 0.0, tmax[i])
         });
         for (i, o) in out.iter_mut().enumerate() {
@@ -647,4 +656,12 @@ impl World {
             None => (0..self.groups.len()).any(test),
         }
     }
+}
+
+/// What [`World::shadowed_many`] works in: which rays a light tree served, and the rays by
+/// slice of emission times.
+#[derive(Default)]
+pub(crate) struct ShadowBuffers {
+    served: Vec<bool>,
+    order: Vec<(usize, usize, f64)>,
 }

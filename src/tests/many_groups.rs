@@ -394,7 +394,9 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
             .collect();
         let (mut served, mut blocked) = (vec![false; rays.len()], vec![false; rays.len()]);
         let mut offered = vec![Vec::new(); rays.len()];
-        tree.occluded_many(&rays, &tmax, &mut served, &mut blocked, |g, i| {
+        let mut order = Vec::new();
+        let buffers = (served.as_mut_slice(), &mut order);
+        tree.occluded_many(&rays, &tmax, buffers, &mut blocked, |g, i| {
             offered[i].push(g as usize);
             false
         });
@@ -405,7 +407,8 @@ fn light_tree_visits_every_group_a_shadow_ray_meets() {
         // A test that holds blocks the ray, and stops offering it groups.
         let mut offers = vec![0; rays.len()];
         let (mut served2, mut blocked) = (vec![false; rays.len()], vec![false; rays.len()]);
-        tree.occluded_many(&rays, &tmax, &mut served2, &mut blocked, |_, i| {
+        let buffers = (served2.as_mut_slice(), &mut order);
+        tree.occluded_many(&rays, &tmax, buffers, &mut blocked, |_, i| {
             offers[i] += 1;
             true
         });

@@ -5,6 +5,7 @@
 #[path = "../../tests/common/basics.rs"]
 mod common;
 
+mod allocations;
 mod every_isa;
 mod fused_primary;
 mod instanced_lattice;
