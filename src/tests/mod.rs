@@ -6,6 +6,7 @@
 mod common;
 
 mod allocations;
+mod backend_names;
 mod every_isa;
 mod fused_primary;
 mod instanced_lattice;

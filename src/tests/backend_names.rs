@@ -1,0 +1,32 @@
+//! The names of the backends, in every list that holds them.
+
+/// Every name `--backend` takes is built by `backend_by_name`, offered by the error for an
+/// unknown one and described by `rest-embree backends`; the backends the tests and the bench
+/// run on are among them. A backend added to one list and not the others fails here.
+#[test]
+fn every_backend_name_is_listed_everywhere() {
+    use crate::accel::{all_backend_names, backend_by_name, backend_names, backend_report};
+    let all = all_backend_names();
+    let report = backend_report().unwrap().join("\n");
+    let unknown = backend_by_name("no-such-backend")
+        .err()
+        .unwrap()
+        .to_string();
+    for name in &all {
+        assert!(backend_by_name(name).is_ok(), "{name} is built");
+        assert!(
+            report.contains(name),
+            "`backends` describes {name}:\n{report}"
+        );
+        assert!(
+            unknown.contains(name),
+            "the error for an unknown backend offers {name}"
+        );
+    }
+    for name in backend_names() {
+        assert!(
+            all.contains(&name),
+            "{name} is among the names --backend takes"
+        );
+    }
+}
