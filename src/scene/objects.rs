@@ -234,208 +234,21 @@ pub(super) fn add_object(
     let kind = t.req_string("type")?;
     let mat = material_ref(t, "material", mats, 0)?;
     let transform = Transform::read(t)?;
-    // A sphere or rod stays one under a uniform scale only.
-    let uniform = |what: &str| match &transform {
-        Some(x) if !x.is_uniform() => Err(at_value(
-            t,
-            "scale",
-            format!(
-                "a {what} scaled unevenly is no longer a {what}: give one factor, or use a mesh"
-            ),
-        )),
-        _ => Ok(transform.map_or(1.0, |x| x.scale.x)),
+    let mut adding = Adding {
+        t,
+        id,
+        mat,
+        transform,
+        geo,
+        total,
     };
     // The shape before its transform, where it is a box, sphere or rod.
-    let mut original = None;
-    match kind {
-        "box" => {
-            let (min, max) = (t.req_vec3("min")?, t.req_vec3("max")?);
-            if min.cmpge(max).any() {
-                return Err(t.error("max", "every coordinate of max must exceed min"));
-            }
-            original = Some(Primitive::Cuboid { min, max });
-            match transform {
-                None => {
-                    budget(t, "type", total, 1)?;
-                    geo.push_part(id, mat, [Primitive::Cuboid { min, max }]);
-                }
-                // Turned by quarter turns: still a box, its corners moved.
-                Some(x) if x.axis_permutation().is_some() => {
-                    let exact = Transform {
-                        rotation: x.axis_permutation().expect("checked"),
-                        ..x
-                    };
-                    let (a, b) = (exact.point(min), exact.point(max));
-                    budget(t, "type", total, 1)?;
-                    geo.push_part(
-                        id,
-                        mat,
-                        [Primitive::Cuboid {
-                            min: a.min(b),
-                            max: a.max(b),
-                        }],
-                    );
-                }
-                // Turned otherwise: its twelve triangles.
-                Some(x) => {
-                    budget(t, "type", total, 12)?;
-                    geo.push_part(
-                        id,
-                        mat,
-                        box_triangles(min, max).map(|v| Primitive::Triangle {
-                            v: v.map(|p| x.point(p)),
-                        }),
-                    );
-                }
-            }
-        }
-        "sphere" => {
-            let center = t.req_vec3("center")?;
-            let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
-            let s = uniform("sphere")?;
-            original = Some(Primitive::Sphere { center, radius });
-            let center = transform.map_or(center, |x| x.point(center));
-            budget(t, "type", total, 1)?;
-            geo.push_part(
-                id,
-                mat,
-                [Primitive::Sphere {
-                    center,
-                    radius: radius * s,
-                }],
-            );
-        }
-        "rod" => {
-            let (a, b) = (t.req_vec3("from")?, t.req_vec3("to")?);
-            let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
-            let s = uniform("rod")?;
-            original = Some(Primitive::Capsule { a, b, radius });
-            let (a, b) = transform.map_or((a, b), |x| (x.point(a), x.point(b)));
-            budget(t, "type", total, 1)?;
-            geo.push_part(
-                id,
-                mat,
-                [Primitive::Capsule {
-                    a,
-                    b,
-                    radius: radius * s,
-                }],
-            );
-        }
-        "mesh" if t.has("file") => {
-            if let Some(k) = ["vertices", "indices"].into_iter().find(|k| t.has(k)) {
-                return Err(at_value(
-                    t,
-                    k,
-                    "a mesh is given by `file` or by `vertices` and `indices`, not both",
-                ));
-            }
-            let mut mesh = read_mesh_file(t)?;
-            mesh_budget(t, total, &mesh)?;
-            // The corner data, moved out of the mesh as read; normals turn with the mesh and
-            // take the inverse of its scale.
-            let normals = match transform {
-                Some(x) => mesh.normals.take().map(|n| {
-                    let turn = |n: DVec3| (x.rotation * (n / x.scale)).normalize_or_zero();
-                    n.into_iter().map(|c| c.map(turn)).collect()
-                }),
-                None => mesh.normals.take(),
-            };
-            let uvs = mesh.uvs.take();
-            let corners = (normals.is_some() || uvs.is_some())
-                .then_some(crate::geometry::Corners { normals, uvs });
-            // Runs of triangles of one material, each a part of the object.
-            let chosen = file_materials(t, &mesh.materials, mats, mat)?;
-            let material_of = |i: usize| match mesh.material_of.get(i) {
-                Some(&m) if m != super::mesh_file::NO_MATERIAL => chosen[m as usize],
-                _ => mat,
-            };
-            let n = mesh.triangles.len();
-            let mut bounds = Vec::new();
-            let mut start = 0;
-            while start < n {
-                let m = material_of(start);
-                let end = (start + 1..n).find(|&i| material_of(i) != m).unwrap_or(n);
-                bounds.push((start, end, m));
-                start = end;
-            }
-            // One material: the corner data as read, not a copy of it.
-            let runs: Vec<_> = match (bounds.as_slice(), corners) {
-                ([(_, _, m)], c) => vec![(n as u64, *m, c.map(std::sync::Arc::new))],
-                (_, c) => bounds
-                    .iter()
-                    .map(|&(start, end, m)| {
-                        let part = c.as_ref().map(|c| {
-                            std::sync::Arc::new(crate::geometry::Corners {
-                                normals: c.normals.as_ref().map(|v| v[start..end].to_vec()),
-                                uvs: c.uvs.as_ref().map(|v| v[start..end].to_vec()),
-                            })
-                        });
-                        ((end - start) as u64, m, part)
-                    })
-                    .collect(),
-            };
-            // Held as itself: its vertices once, placed, and its triangles' indices.
-            let positions = match transform {
-                Some(x) => mesh.positions.iter().map(|&p| x.point(p)).collect(),
-                None => mesh.positions,
-            };
-            let shape = Implicit::Mesh(std::sync::Arc::new(crate::geometry::IndexedMesh::new(
-                positions,
-                mesh.triangles,
-            )));
-            geo.push_implicit_with(id, &runs, shape)
-                .map_err(|why| at_value(t, "file", why))?;
-        }
-        "mesh" => {
-            let vn = t
-                .get("vertices")
-                .ok_or_else(|| t.error("vertices", "missing: give [[x, y, z], ...]"))?;
-            let verts = match &vn.val {
-                super::doc::Val::Array(items) => items
-                    .iter()
-                    .map(|e| {
-                        t.numbers_of(e, "vertices", Some(3))
-                            .map(|v| DVec3::new(v[0], v[1], v[2]))
-                    })
-                    .collect::<SceneResult<Vec<_>>>()?,
-                _ => return Err(t.error_at(vn, "vertices", "expected an array of [x, y, z]")),
-            };
-            let inn = t
-                .get("indices")
-                .ok_or_else(|| t.error("indices", "missing: give [[i, j, k], ...]"))?;
-            let tris = match &inn.val {
-                super::doc::Val::Array(items) => items
-                    .iter()
-                    .map(|e| {
-                        let v = t.numbers_of(e, "indices", Some(3))?;
-                        let mut idx = [0usize; 3];
-                        for (k, x) in v.iter().enumerate() {
-                            if x.fract() != 0.0 || *x < 0.0 || *x as usize >= verts.len() {
-                                return Err(t.error_at(
-                                    e,
-                                    "indices",
-                                    format!(
-                                        "index {x} is not a vertex (there are {})",
-                                        verts.len()
-                                    ),
-                                ));
-                            }
-                            idx[k] = *x as usize;
-                        }
-                        Ok(Primitive::Triangle {
-                            v: idx.map(|i| transform.map_or(verts[i], |x| x.point(verts[i]))),
-                        })
-                    })
-                    .collect::<SceneResult<Vec<_>>>()?,
-                _ => return Err(t.error_at(inn, "indices", "expected an array of [i, j, k]")),
-            };
-            if tris.is_empty() {
-                return Err(t.error_at(inn, "indices", "the mesh has no triangles"));
-            }
-            budget(t, "type", total, tris.len() as u64)?;
-            geo.push_part(id, mat, tris);
-        }
+    let original = match kind {
+        "box" => Some(adding.add_box()?),
+        "sphere" => Some(adding.add_sphere()?),
+        "rod" => Some(adding.add_rod()?),
+        "mesh" if t.has("file") => adding.add_mesh_file(mats).map(|_| None)?,
+        "mesh" => adding.add_inline_mesh().map(|_| None)?,
         "lattice" | "bar_array" if transform.is_some() => {
             let key = KEYS
                 .into_iter()
@@ -449,70 +262,8 @@ pub(super) fn add_object(
                 ),
             ));
         }
-        "lattice" => {
-            let counts = t
-                .uints("counts", 3, 1, 1_000_000)?
-                .ok_or_else(|| t.error("counts", "missing: give the node counts [nx, ny, nz]"))?;
-            let spacing = t.positive_scalar_or_array("spacing", 3, Some(1.0))?;
-            let l = Lattice {
-                counts: [counts[0] as u32, counts[1] as u32, counts[2] as u32],
-                spacing: DVec3::from_slice(&spacing),
-                origin: t.vec3("origin")?.unwrap_or(DVec3::ZERO),
-                rod_radius: t.f64_where("rod_radius", Some(0.05), |v| v >= 0.0, "0 or more")?,
-                sphere_radius: t.f64_where(
-                    "sphere_radius",
-                    Some(0.15),
-                    |v| v >= 0.0,
-                    "0 or more",
-                )?,
-            };
-            if l.rod_radius == 0.0 && l.sphere_radius == 0.0 {
-                return Err(t.error(
-                    "rod_radius",
-                    "rod_radius and sphere_radius are both 0: the lattice would be empty",
-                ));
-            }
-            let sm = material_ref(t, "sphere_material", mats, mat)?;
-            let rm = material_ref(t, "rod_material", mats, mat)?;
-            let runs = [(l.sphere_count(), sm), (l.rod_count(), rm)];
-            let shape = Implicit::Lattice(l);
-            implicit_budget(t, total, &shape)?;
-            geo.push_implicit(id, &runs, shape)
-                .map_err(|why| at_value(t, "counts", why))?;
-        }
-        "bar_array" => {
-            let counts = t
-                .uints("counts", 2, 1, 100_000)?
-                .ok_or_else(|| t.error("counts", "missing: give the bar counts [n1, n2]"))?;
-            let spacing = t.positive_scalar_or_array("spacing", 2, Some(2.0))?;
-            let bar_size = t.positive_scalar_or_array("bar_size", 2, Some(0.5))?;
-            let axis = match t.string("axis")?.unwrap_or("z") {
-                "x" => 0,
-                "y" => 1,
-                "z" => 2,
-                other => {
-                    let n = t.get("axis").expect("read above");
-                    return Err(t.error_at(
-                        n,
-                        "axis",
-                        format!("unknown axis `{other}` (x, y or z)"),
-                    ));
-                }
-            };
-            let b = BarArray {
-                counts: [counts[0] as u32, counts[1] as u32],
-                spacing: [spacing[0], spacing[1]],
-                bar_size: [bar_size[0], bar_size[1]],
-                length: t.f64_where("length", Some(2.0), |v| v > 0.0, "greater than 0")?,
-                axis,
-                center: t.vec3("center")?.unwrap_or(DVec3::ZERO),
-            };
-            let runs = [(b.len(), mat)];
-            let shape = Implicit::Bars(b);
-            implicit_budget(t, total, &shape)?;
-            geo.push_implicit(id, &runs, shape)
-                .map_err(|why| at_value(t, "counts", why))?;
-        }
+        "lattice" => adding.add_lattice(mats).map(|_| None)?,
+        "bar_array" => adding.add_bar_array().map(|_| None)?,
         other => {
             let n = t.get("type").expect("read above");
             return Err(t.error_at(
@@ -523,11 +274,11 @@ pub(super) fn add_object(
                 ),
             ));
         }
-    }
+    };
     // Textures turn and move with the object (a box turned by quarter turns as exactly as its
     // corners were).
     if let Some(x) = transform {
-        geo.set_placement(
+        adding.geo.set_placement(
             id,
             std::sync::Arc::new(crate::geometry::Placement {
                 scale: x.scale,
@@ -538,4 +289,309 @@ pub(super) fn add_object(
         );
     }
     Ok(kind.to_string())
+}
+
+/// The factor of a uniform scale (1 without a transform): a sphere or rod stays one under a
+/// uniform scale only.
+fn uniform_scale(t: &Table, transform: Option<Transform>, what: &str) -> SceneResult<f64> {
+    match transform {
+        Some(x) if !x.is_uniform() => Err(at_value(
+            t,
+            "scale",
+            format!(
+                "a {what} scaled unevenly is no longer a {what}: give one factor, or use a mesh"
+            ),
+        )),
+        _ => Ok(transform.map_or(1.0, |x| x.scale.x)),
+    }
+}
+
+/// An object being added: its table, id, material and transform, the group's geometry it goes
+/// into, and the scene's count of primitives so far.
+struct Adding<'t, 'a> {
+    t: &'t Table<'a>,
+    id: u32,
+    mat: u32,
+    transform: Option<Transform>,
+    geo: &'t mut Geometry,
+    total: &'t mut u64,
+}
+
+impl Adding<'_, '_> {
+    /// A box (`min`, `max`): itself, moved by quarter turns, or its twelve triangles turned any
+    /// other way; returns the box as given.
+    fn add_box(&mut self) -> SceneResult<Primitive> {
+        let (t, id, mat, transform) = (self.t, self.id, self.mat, self.transform);
+        let (geo, total) = (&mut *self.geo, &mut *self.total);
+        let (min, max) = (t.req_vec3("min")?, t.req_vec3("max")?);
+        if min.cmpge(max).any() {
+            return Err(t.error("max", "every coordinate of max must exceed min"));
+        }
+        match transform {
+            None => {
+                budget(t, "type", total, 1)?;
+                geo.push_part(id, mat, [Primitive::Cuboid { min, max }]);
+            }
+            // Turned by quarter turns: still a box, its corners moved.
+            Some(x) if x.axis_permutation().is_some() => {
+                let exact = Transform {
+                    rotation: x.axis_permutation().expect("checked"),
+                    ..x
+                };
+                let (a, b) = (exact.point(min), exact.point(max));
+                budget(t, "type", total, 1)?;
+                geo.push_part(
+                    id,
+                    mat,
+                    [Primitive::Cuboid {
+                        min: a.min(b),
+                        max: a.max(b),
+                    }],
+                );
+            }
+            // Turned otherwise: its twelve triangles.
+            Some(x) => {
+                budget(t, "type", total, 12)?;
+                geo.push_part(
+                    id,
+                    mat,
+                    box_triangles(min, max).map(|v| Primitive::Triangle {
+                        v: v.map(|p| x.point(p)),
+                    }),
+                );
+            }
+        }
+        Ok(Primitive::Cuboid { min, max })
+    }
+
+    /// A sphere (`center`, `radius`); returns it as given.
+    fn add_sphere(&mut self) -> SceneResult<Primitive> {
+        let (t, id, mat, transform) = (self.t, self.id, self.mat, self.transform);
+        let (geo, total) = (&mut *self.geo, &mut *self.total);
+        let center = t.req_vec3("center")?;
+        let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
+        let s = uniform_scale(t, transform, "sphere")?;
+        let given = Primitive::Sphere { center, radius };
+        let center = transform.map_or(center, |x| x.point(center));
+        budget(t, "type", total, 1)?;
+        geo.push_part(
+            id,
+            mat,
+            [Primitive::Sphere {
+                center,
+                radius: radius * s,
+            }],
+        );
+        Ok(given)
+    }
+
+    /// A rod (`from`, `to`, `radius`), a capsule; returns it as given.
+    fn add_rod(&mut self) -> SceneResult<Primitive> {
+        let (t, id, mat, transform) = (self.t, self.id, self.mat, self.transform);
+        let (geo, total) = (&mut *self.geo, &mut *self.total);
+        let (a, b) = (t.req_vec3("from")?, t.req_vec3("to")?);
+        let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
+        let s = uniform_scale(t, transform, "rod")?;
+        let given = Primitive::Capsule { a, b, radius };
+        let (a, b) = transform.map_or((a, b), |x| (x.point(a), x.point(b)));
+        budget(t, "type", total, 1)?;
+        geo.push_part(
+            id,
+            mat,
+            [Primitive::Capsule {
+                a,
+                b,
+                radius: radius * s,
+            }],
+        );
+        Ok(given)
+    }
+
+    /// A mesh read from `file`, held as itself: its vertices once and its triangles' indices,
+    /// in runs of one material each (`mats`: the scene's materials by name).
+    fn add_mesh_file(&mut self, mats: &HashMap<String, u32>) -> SceneResult<()> {
+        let (t, id, mat, transform) = (self.t, self.id, self.mat, self.transform);
+        let (geo, total) = (&mut *self.geo, &mut *self.total);
+        if let Some(k) = ["vertices", "indices"].into_iter().find(|k| t.has(k)) {
+            return Err(at_value(
+                t,
+                k,
+                "a mesh is given by `file` or by `vertices` and `indices`, not both",
+            ));
+        }
+        let mut mesh = read_mesh_file(t)?;
+        mesh_budget(t, total, &mesh)?;
+        // The corner data, moved out of the mesh as read; normals turn with the mesh and
+        // take the inverse of its scale.
+        let normals = match transform {
+            Some(x) => mesh.normals.take().map(|n| {
+                let turn = |n: DVec3| (x.rotation * (n / x.scale)).normalize_or_zero();
+                n.into_iter().map(|c| c.map(turn)).collect()
+            }),
+            None => mesh.normals.take(),
+        };
+        let uvs = mesh.uvs.take();
+        let corners = (normals.is_some() || uvs.is_some())
+            .then_some(crate::geometry::Corners { normals, uvs });
+        // Runs of triangles of one material, each a part of the object.
+        let chosen = file_materials(t, &mesh.materials, mats, mat)?;
+        let material_of = |i: usize| match mesh.material_of.get(i) {
+            Some(&m) if m != super::mesh_file::NO_MATERIAL => chosen[m as usize],
+            _ => mat,
+        };
+        let n = mesh.triangles.len();
+        let mut bounds = Vec::new();
+        let mut start = 0;
+        while start < n {
+            let m = material_of(start);
+            let end = (start + 1..n).find(|&i| material_of(i) != m).unwrap_or(n);
+            bounds.push((start, end, m));
+            start = end;
+        }
+        // One material: the corner data as read, not a copy of it.
+        let runs: Vec<_> = match (bounds.as_slice(), corners) {
+            ([(_, _, m)], c) => vec![(n as u64, *m, c.map(std::sync::Arc::new))],
+            (_, c) => bounds
+                .iter()
+                .map(|&(start, end, m)| {
+                    let part = c.as_ref().map(|c| {
+                        std::sync::Arc::new(crate::geometry::Corners {
+                            normals: c.normals.as_ref().map(|v| v[start..end].to_vec()),
+                            uvs: c.uvs.as_ref().map(|v| v[start..end].to_vec()),
+                        })
+                    });
+                    ((end - start) as u64, m, part)
+                })
+                .collect(),
+        };
+        // Held as itself: its vertices once, placed, and its triangles' indices.
+        let positions = match transform {
+            Some(x) => mesh.positions.iter().map(|&p| x.point(p)).collect(),
+            None => mesh.positions,
+        };
+        let shape = Implicit::Mesh(std::sync::Arc::new(crate::geometry::IndexedMesh::new(
+            positions,
+            mesh.triangles,
+        )));
+        geo.push_implicit_with(id, &runs, shape)
+            .map_err(|why| at_value(t, "file", why))?;
+        Ok(())
+    }
+
+    /// A mesh given inline (`vertices`, `indices`), one primitive per triangle.
+    fn add_inline_mesh(&mut self) -> SceneResult<()> {
+        let (t, id, mat, transform) = (self.t, self.id, self.mat, self.transform);
+        let (geo, total) = (&mut *self.geo, &mut *self.total);
+        let vn = t
+            .get("vertices")
+            .ok_or_else(|| t.error("vertices", "missing: give [[x, y, z], ...]"))?;
+        let verts = match &vn.val {
+            super::doc::Val::Array(items) => items
+                .iter()
+                .map(|e| {
+                    t.numbers_of(e, "vertices", Some(3))
+                        .map(|v| DVec3::new(v[0], v[1], v[2]))
+                })
+                .collect::<SceneResult<Vec<_>>>()?,
+            _ => return Err(t.error_at(vn, "vertices", "expected an array of [x, y, z]")),
+        };
+        let inn = t
+            .get("indices")
+            .ok_or_else(|| t.error("indices", "missing: give [[i, j, k], ...]"))?;
+        let tris = match &inn.val {
+            super::doc::Val::Array(items) => items
+                .iter()
+                .map(|e| {
+                    let v = t.numbers_of(e, "indices", Some(3))?;
+                    let mut idx = [0usize; 3];
+                    for (k, x) in v.iter().enumerate() {
+                        if x.fract() != 0.0 || *x < 0.0 || *x as usize >= verts.len() {
+                            return Err(t.error_at(
+                                e,
+                                "indices",
+                                format!("index {x} is not a vertex (there are {})", verts.len()),
+                            ));
+                        }
+                        idx[k] = *x as usize;
+                    }
+                    Ok(Primitive::Triangle {
+                        v: idx.map(|i| transform.map_or(verts[i], |x| x.point(verts[i]))),
+                    })
+                })
+                .collect::<SceneResult<Vec<_>>>()?,
+            _ => return Err(t.error_at(inn, "indices", "expected an array of [i, j, k]")),
+        };
+        if tris.is_empty() {
+            return Err(t.error_at(inn, "indices", "the mesh has no triangles"));
+        }
+        budget(t, "type", total, tris.len() as u64)?;
+        geo.push_part(id, mat, tris);
+        Ok(())
+    }
+
+    /// A lattice (`counts`, `spacing`, `origin`, its radii and materials), held as itself.
+    fn add_lattice(&mut self, mats: &HashMap<String, u32>) -> SceneResult<()> {
+        let (t, id, mat) = (self.t, self.id, self.mat);
+        let (geo, total) = (&mut *self.geo, &mut *self.total);
+        let counts = t
+            .uints("counts", 3, 1, 1_000_000)?
+            .ok_or_else(|| t.error("counts", "missing: give the node counts [nx, ny, nz]"))?;
+        let spacing = t.positive_scalar_or_array("spacing", 3, Some(1.0))?;
+        let l = Lattice {
+            counts: [counts[0] as u32, counts[1] as u32, counts[2] as u32],
+            spacing: DVec3::from_slice(&spacing),
+            origin: t.vec3("origin")?.unwrap_or(DVec3::ZERO),
+            rod_radius: t.f64_where("rod_radius", Some(0.05), |v| v >= 0.0, "0 or more")?,
+            sphere_radius: t.f64_where("sphere_radius", Some(0.15), |v| v >= 0.0, "0 or more")?,
+        };
+        if l.rod_radius == 0.0 && l.sphere_radius == 0.0 {
+            return Err(t.error(
+                "rod_radius",
+                "rod_radius and sphere_radius are both 0: the lattice would be empty",
+            ));
+        }
+        let sm = material_ref(t, "sphere_material", mats, mat)?;
+        let rm = material_ref(t, "rod_material", mats, mat)?;
+        let runs = [(l.sphere_count(), sm), (l.rod_count(), rm)];
+        let shape = Implicit::Lattice(l);
+        implicit_budget(t, total, &shape)?;
+        geo.push_implicit(id, &runs, shape)
+            .map_err(|why| at_value(t, "counts", why))?;
+        Ok(())
+    }
+
+    /// A bar array (`counts`, `spacing`, `bar_size`, `length`, `axis`, `center`), held as
+    /// itself.
+    fn add_bar_array(&mut self) -> SceneResult<()> {
+        let (t, id, mat) = (self.t, self.id, self.mat);
+        let (geo, total) = (&mut *self.geo, &mut *self.total);
+        let counts = t
+            .uints("counts", 2, 1, 100_000)?
+            .ok_or_else(|| t.error("counts", "missing: give the bar counts [n1, n2]"))?;
+        let spacing = t.positive_scalar_or_array("spacing", 2, Some(2.0))?;
+        let bar_size = t.positive_scalar_or_array("bar_size", 2, Some(0.5))?;
+        let axis = match t.string("axis")?.unwrap_or("z") {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            other => {
+                let n = t.get("axis").expect("read above");
+                return Err(t.error_at(n, "axis", format!("unknown axis `{other}` (x, y or z)")));
+            }
+        };
+        let b = BarArray {
+            counts: [counts[0] as u32, counts[1] as u32],
+            spacing: [spacing[0], spacing[1]],
+            bar_size: [bar_size[0], bar_size[1]],
+            length: t.f64_where("length", Some(2.0), |v| v > 0.0, "greater than 0")?,
+            axis,
+            center: t.vec3("center")?.unwrap_or(DVec3::ZERO),
+        };
+        let runs = [(b.len(), mat)];
+        let shape = Implicit::Bars(b);
+        implicit_budget(t, total, &shape)?;
+        geo.push_implicit(id, &runs, shape)
+            .map_err(|why| at_value(t, "counts", why))?;
+        Ok(())
+    }
 }
