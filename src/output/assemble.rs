@@ -50,6 +50,23 @@ struct TileHeader {
 
 impl TileHeader {
     fn read(path: &Path) -> crate::Result<TileHeader> {
+        let meta = Self::read_meta(path)?;
+        let n = meta.headers.len();
+        let Some(header) = meta.headers.into_iter().next().filter(|_| n == 1) else {
+            return Err(bad(
+                path,
+                format!(
+                    "it has {n} parts; assemble joins single-part EXRs as `render` writes them"
+                ),
+            ));
+        };
+        Self::joinable(path, &header)?;
+        Self::placed(path, header)
+    }
+
+    /// The file's headers: a regular file (a FIFO or a device would be read forever) whose
+    /// headers the EXR reader reads and a writer would write again.
+    fn read_meta(path: &Path) -> crate::Result<exr::meta::MetaData> {
         // Only a regular file: a FIFO or a device would be read forever.
         match std::fs::metadata(path) {
             Err(e) => return Err(bad(path, format!("cannot read it: {e}"))),
@@ -104,15 +121,12 @@ impl TileHeader {
                 }
             }
         }
-        let n = meta.headers.len();
-        let Some(header) = meta.headers.into_iter().next().filter(|_| n == 1) else {
-            return Err(bad(
-                path,
-                format!(
-                    "it has {n} parts; assemble joins single-part EXRs as `render` writes them"
-                ),
-            ));
-        };
+        Ok(meta)
+    }
+
+    /// Refuse what assemble cannot join bit for bit: deep data, tiled or mipmapped storage,
+    /// lossy compression, subsampled channels.
+    fn joinable(path: &Path, header: &Header) -> crate::Result<()> {
         if header.deep {
             return Err(bad(path, "it holds deep data; assemble joins flat images"));
         }
@@ -157,6 +171,11 @@ impl TileHeader {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    /// The tile's place in the full image (its display window), which must hold it.
+    fn placed(path: &Path, header: Header) -> crate::Result<TileHeader> {
         let display = header.shared_attributes.display_window;
         let (w, h) = (display.size.0, display.size.1);
         if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
