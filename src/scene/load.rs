@@ -176,105 +176,19 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         None => RenderSettings::default(),
     };
     let textures = textures(&root)?;
-    let mut materials = vec![Material::default_white()];
-    let mut material_ids: HashMap<String, u32> = HashMap::new();
-    for t in root.tables("material")? {
-        let m = material(&t, &textures)?;
-        if material_ids.contains_key(&m.name) {
-            return Err(t.error(
-                "name",
-                format!("a material named `{}` is defined twice", m.name),
-            ));
-        }
-        material_ids.insert(m.name.clone(), materials.len() as u32);
-        materials.push(m);
-    }
-    let group_tables = root.tables("group")?;
+    let (mut materials, material_ids) = materials(&root, &textures)?;
     let mut groups = Vec::new();
     let mut objects = Vec::new();
     let mut total: u64 = 0;
     let mut group_names = std::collections::HashSet::new();
-    for t in &group_tables {
-        let name = t.req_string("name")?.to_string();
-        if !group_names.insert(name.clone()) {
+    for t in &root.tables("group")? {
+        let name = t.req_string("name")?;
+        if !group_names.insert(name.to_string()) {
             return Err(t.error("name", format!("a group named `{name}` is defined twice")));
         }
-        let velocity = velocity(t, "direction")?.unwrap_or(Velocity::ZERO);
-        let mut geometry = Geometry::default();
-        for o in t.tables("object")? {
-            let id = objects.len() as u32;
-            let (first, implicit) = (geometry.prims.len(), geometry.implicit.len());
-            let kind = add_object(&o, id, &material_ids, &mut geometry, &mut total)?;
-            // An image needs a mapping: spheres, boxes and rods have one, a mesh its file's
-            // texture coordinates.
-            let imaged = |m: u32| {
-                let m = &materials[m as usize];
-                [&m.color_texture, &m.emission_texture]
-                    .into_iter()
-                    .flatten()
-                    .any(|t| matches!(**t, Texture::Image(_)))
-            };
-            // (A box turned into triangles keeps its box's mapping through its placement.)
-            let unmapped = geometry
-                .parts
-                .iter()
-                .filter(|p| p.object == id)
-                .any(|part| {
-                    let triangles = matches!(
-                        geometry.prim(part.start),
-                        crate::geometry::Primitive::Triangle { .. }
-                    );
-                    triangles
-                        && imaged(part.material)
-                        && part.corners.as_ref().is_none_or(|c| c.uvs.is_none())
-                        && part.placement.as_ref().is_none_or(|pl| pl.shape.is_none())
-                });
-            if unmapped {
-                return Err(o.error(
-                    "material",
-                    "its material's texture is an image, and the mesh has no texture coordinates (vt in OBJ, u and v in PLY) to map it; spheres, boxes and rods have their own",
-                ));
-            }
-            let held = geometry.prims[first..].iter().map(|p| p.bounds());
-            let implicit = geometry.implicit[implicit..]
-                .iter()
-                .map(|r| r.shape.bounds());
-            let reach = held
-                .chain(implicit)
-                .map(|b| b.min.abs().max(b.max.abs()).max_element())
-                .fold(0.0, f64::max);
-            if reach > super::envelope::MAX_MAGNITUDE {
-                return Err(o.error("type", super::envelope::reaches_too_far(&kind, reach)));
-            }
-            objects.push(ObjectInfo {
-                name: o.string("name")?.map(str::to_string),
-                kind,
-                group: groups.len(),
-            });
-            o.finish(OBJECT_KEYS)?;
-        }
-        if let Some(key) = OBJECT_KEYS.iter().find(|k| **k != "name" && t.has(k)) {
-            let n = t.get(key).expect("present");
-            return Err(t.error_at(
-                n,
-                key,
-                format!("`{key}` belongs to an object: address it as group.{name}.object.<object name or index>.{key}"),
-            ));
-        }
-        t.finish(&[
-            "name",
-            "velocity",
-            "direction",
-            "beta",
-            "rapidity",
-            "one_minus_beta",
-            "object",
-        ])?;
-        groups.push(Group {
-            name,
-            velocity,
-            geometry: Arc::new(geometry),
-        });
+        let (ids, index) = (&material_ids, groups.len());
+        let g = group(t, ids, &materials, &mut objects, index, &mut total)?;
+        groups.push(g);
     }
     // Without objects only a sky is worth rendering.
     if groups.iter().all(|g| g.geometry.is_empty()) && !root.has("sky") {
@@ -313,6 +227,131 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         sky,
         fog,
     })
+}
+
+/// The scene's materials (the default white first, as id 0) and their ids by name.
+fn materials(
+    root: &Table,
+    textures: &[super::surfaces::ReadTexture],
+) -> SceneResult<(Vec<Material>, HashMap<String, u32>)> {
+    let mut materials = vec![Material::default_white()];
+    let mut material_ids: HashMap<String, u32> = HashMap::new();
+    for t in root.tables("material")? {
+        let m = material(&t, textures)?;
+        if material_ids.contains_key(&m.name) {
+            return Err(t.error(
+                "name",
+                format!("a material named `{}` is defined twice", m.name),
+            ));
+        }
+        material_ids.insert(m.name.clone(), materials.len() as u32);
+        materials.push(m);
+    }
+    Ok((materials, material_ids))
+}
+
+/// A `[[group]]` (the `index`th) and its objects, appended to `objects`; `total` counts the
+/// scene's primitives.
+fn group(
+    t: &Table,
+    material_ids: &HashMap<String, u32>,
+    materials: &[Material],
+    objects: &mut Vec<ObjectInfo>,
+    index: usize,
+    total: &mut u64,
+) -> SceneResult<Group> {
+    let name = t.req_string("name")?.to_string();
+    let velocity = velocity(t, "direction")?.unwrap_or(Velocity::ZERO);
+    let mut geometry = Geometry::default();
+    for o in t.tables("object")? {
+        let id = objects.len() as u32;
+        let (first, implicit) = (geometry.prims.len(), geometry.implicit.len());
+        let kind = add_object(&o, id, material_ids, &mut geometry, total)?;
+        check_object(&o, id, &kind, &geometry, materials, (first, implicit))?;
+        objects.push(ObjectInfo {
+            name: o.string("name")?.map(str::to_string),
+            kind,
+            group: index,
+        });
+        o.finish(OBJECT_KEYS)?;
+    }
+    if let Some(key) = OBJECT_KEYS.iter().find(|k| **k != "name" && t.has(k)) {
+        let n = t.get(key).expect("present");
+        return Err(t.error_at(
+            n,
+            key,
+            format!("`{key}` belongs to an object: address it as group.{name}.object.<object name or index>.{key}"),
+        ));
+    }
+    t.finish(&[
+        "name",
+        "velocity",
+        "direction",
+        "beta",
+        "rapidity",
+        "one_minus_beta",
+        "object",
+    ])?;
+    Ok(Group {
+        name,
+        velocity,
+        geometry: Arc::new(geometry),
+    })
+}
+
+/// Refuse an object just added to `geometry` (its held primitives from `first`, its implicit
+/// ones from `implicit`) that an image texture cannot be mapped onto, or that reaches farther
+/// than coordinates may.
+fn check_object(
+    o: &Table,
+    id: u32,
+    kind: &str,
+    geometry: &Geometry,
+    materials: &[Material],
+    (first, implicit): (usize, usize),
+) -> SceneResult<()> {
+    // An image needs a mapping: spheres, boxes and rods have one, a mesh its file's
+    // texture coordinates.
+    let imaged = |m: u32| {
+        let m = &materials[m as usize];
+        [&m.color_texture, &m.emission_texture]
+            .into_iter()
+            .flatten()
+            .any(|t| matches!(**t, Texture::Image(_)))
+    };
+    // (A box turned into triangles keeps its box's mapping through its placement.)
+    let unmapped = geometry
+        .parts
+        .iter()
+        .filter(|p| p.object == id)
+        .any(|part| {
+            let triangles = matches!(
+                geometry.prim(part.start),
+                crate::geometry::Primitive::Triangle { .. }
+            );
+            triangles
+                && imaged(part.material)
+                && part.corners.as_ref().is_none_or(|c| c.uvs.is_none())
+                && part.placement.as_ref().is_none_or(|pl| pl.shape.is_none())
+        });
+    if unmapped {
+        return Err(o.error(
+            "material",
+            "its material's texture is an image, and the mesh has no texture coordinates (vt in OBJ, u and v in PLY) to map it; spheres, boxes and rods have their own",
+        ));
+    }
+    let held = geometry.prims[first..].iter().map(|p| p.bounds());
+    let implicit = geometry.implicit[implicit..]
+        .iter()
+        .map(|r| r.shape.bounds());
+    let reach = held
+        .chain(implicit)
+        .map(|b| b.min.abs().max(b.max.abs()).max_element())
+        .fold(0.0, f64::max);
+    if reach > super::envelope::MAX_MAGNITUDE {
+        return Err(o.error("type", super::envelope::reaches_too_far(&kind, reach)));
+    }
+    Ok(())
 }
 
 /// `[fog]`: a medium (`sigma_a`, `sigma_s`, `g`, as a material's `medium`) filling all space
