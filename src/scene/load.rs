@@ -349,7 +349,7 @@ fn check_object(
         .map(|b| b.min.abs().max(b.max.abs()).max_element())
         .fold(0.0, f64::max);
     if reach > super::envelope::MAX_MAGNITUDE {
-        return Err(o.error("type", super::envelope::reaches_too_far(&kind, reach)));
+        return Err(o.error("type", super::envelope::reaches_too_far(kind, reach)));
     }
     Ok(())
 }
