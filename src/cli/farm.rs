@@ -153,6 +153,8 @@ fn slurm(args: &SlurmArgs) -> crate::Result<()> {
 /// is given.
 struct Plan {
     exe: String,
+    /// The output's format, by its extension.
+    format: output::Format,
     output: PathBuf,
     dir: PathBuf,
     stem: String,
@@ -180,7 +182,7 @@ impl Plan {
             None => scene::FrameSize::Checked,
         };
         let scene = scene::load_file_as(&scene_path, &overrides, frame)?;
-        output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
+        let format = output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
         if let Some(b) = &args.backend {
             crate::accel::backend_by_name(b).map_err(|e| e.on_flag("--backend"))?;
         }
@@ -204,6 +206,7 @@ impl Plan {
         flags.push_str(" ${SLURM_CPUS_PER_TASK:+--threads $SLURM_CPUS_PER_TASK}");
         let plan = Plan {
             exe,
+            format,
             output,
             dir,
             stem,
@@ -268,9 +271,8 @@ impl Plan {
                 tasks: 1,
             }]);
         };
-        let format = output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
         let shown = format!("--tiles {columns}x{rows}");
-        tiles::tile_crop(scene, format, (columns, rows), 0, &shown)?;
+        tiles::tile_crop(scene, self.format, (columns, rows), 0, &shown)?;
         let tasks = u64::from(columns) * u64::from(rows);
         check_array_size(tasks, (columns, rows))?;
         // The tile's name quoted as a whole (a `$(...)` in the output's name is text), then the

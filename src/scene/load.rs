@@ -187,7 +187,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
             return Err(t.error("name", format!("a group named `{name}` is defined twice")));
         }
         let (ids, index) = (&material_ids, groups.len());
-        let g = group(t, ids, &materials, &mut objects, index, &mut total)?;
+        let g = group(t, name, ids, &materials, &mut objects, index, &mut total)?;
         groups.push(g);
     }
     // Without objects only a sky is worth rendering.
@@ -250,17 +250,18 @@ fn materials(
     Ok((materials, material_ids))
 }
 
-/// A `[[group]]` (the `index`th) and its objects, appended to `objects`; `total` counts the
+/// A `[[group]]` (the `index`th, named `name`) and its objects, appended to `objects`; `total` counts the
 /// scene's primitives.
 fn group(
     t: &Table,
+    name: &str,
     material_ids: &HashMap<String, u32>,
     materials: &[Material],
     objects: &mut Vec<ObjectInfo>,
     index: usize,
     total: &mut u64,
 ) -> SceneResult<Group> {
-    let name = t.req_string("name")?.to_string();
+    let name = name.to_string();
     let velocity = velocity(t, "direction")?.unwrap_or(Velocity::ZERO);
     let mut geometry = Geometry::default();
     for o in t.tables("object")? {
