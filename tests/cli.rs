@@ -479,3 +479,20 @@ fn the_same_render_writes_the_same_file() {
         assert!(bytes == first, "{ext}: the same render, a different file");
     }
 }
+
+/// A reader that has gone (`rest-embree backends | head -1`) ends the output quietly: no panic,
+/// no error, the command's status unchanged.
+#[test]
+fn output_to_a_closed_pipe_is_dropped_quietly() {
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .arg("backends")
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "status {:?}: {err}", out.status);
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.trim().is_empty(), "nothing on standard error: {err}");
+}

@@ -1,6 +1,7 @@
 //! `rest-embree bench`: the cases picked by `--case` (or a scene file), measured, reported as
 //! a table, a summary, CSV and a plot.
 
+use super::say;
 use super::*;
 
 /// The cases `--case` asks for: for each text, the case of that name, or where no case has it,
@@ -140,10 +141,10 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         Some(e) => format!(" Embree: {e}."),
         None => String::new(),
     };
-    println!(
+    say(format_args!(
         "threads: {}.{embree}\n\n{table}\n{summary}",
         rayon::current_num_threads()
-    );
+    ));
     let md = format!(
         "Measured with `rest-embree bench{}` on {} threads.{embree}\n\n{table}\n{summary}",
         if args.quick { " --quick" } else { "" },

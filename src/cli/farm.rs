@@ -3,6 +3,7 @@
 //! per tile of a still (`--tiles NxM`), joined by `rest-embree assemble` in a job that waits for
 //! the array. The cluster's own tools watch and stop it: `squeue`, `sacct`, `scancel`.
 
+use super::say;
 use super::{film, tiles};
 use crate::{output, scene, Error};
 use clap::Subcommand;
@@ -388,11 +389,11 @@ fn plural(n: u64) -> &'static str {
 fn print_jobs(jobs: &[Job], args: &SlurmArgs) {
     for (i, job) in jobs.iter().enumerate() {
         let (file, tasks) = (job.file.display(), job.tasks);
-        println!("# {file} ({tasks} task{})", plural(tasks));
-        println!("{}", job.text);
+        say(format_args!("# {file} ({tasks} task{})", plural(tasks)));
+        say(&job.text);
         let after = (i > 0).then_some("JOBID");
         let cmd = sbatch_command(job, after, args).join(" ");
-        println!("# submitted with: {cmd}\n");
+        say(format_args!("# submitted with: {cmd}\n"));
     }
 }
 
@@ -435,7 +436,7 @@ fn submit(jobs: &[Job], logs: &Path, args: &SlurmArgs) -> crate::Result<()> {
             .next()
             .unwrap_or_default()
             .to_string();
-        println!("{id}");
+        say(&id);
         let (tasks, file) = (job.tasks, job.file.display());
         eprintln!(
             "farm: submitted job {id} ({tasks} task{}): {file}",

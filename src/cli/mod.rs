@@ -308,7 +308,7 @@ fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Backends => report(accel::backend_report().map(|lines| {
             for line in lines {
-                println!("{line}");
+                say(line);
             }
         })),
         Command::Render(args) => report(run_render(&args)),
@@ -323,7 +323,7 @@ fn run(cli: Cli) -> ExitCode {
         }
         Command::Farm { scheduler } => report(farm::run(&scheduler)),
         Command::BenchSceneFile { kind, size } => {
-            println!("{}", bench::scene_file_here(&kind, size));
+            say(bench::scene_file_here(&kind, size));
             ExitCode::SUCCESS
         }
         Command::BenchLattice {
@@ -333,9 +333,9 @@ fn run(cli: Cli) -> ExitCode {
             threads,
         } => {
             let (line, wall) = bench_lattice::here(n, size, &backend, &threads);
-            println!("{line}");
+            say(line);
             if let Some(wall) = wall {
-                println!("{} {wall}", bench_lattice::WALL);
+                say(format_args!("{} {wall}", bench_lattice::WALL));
             }
             ExitCode::SUCCESS
         }
@@ -348,7 +348,9 @@ fn run(cli: Cli) -> ExitCode {
             threads,
         } => match bench::probe::primary_ns(&mode, beta, size, seconds, &embree, threads) {
             Ok(ns) => {
-                println!("{mode} beta={beta} {size}x{size}: {ns:.2} ns per pixel");
+                say(format_args!(
+                    "{mode} beta={beta} {size}x{size}: {ns:.2} ns per pixel"
+                ));
                 ExitCode::SUCCESS
             }
             Err(e) => report(Err(crate::Error::flag("probe-primary-ns", e.to_string()))),
@@ -365,6 +367,19 @@ fn run(cli: Cli) -> ExitCode {
             }
             Err(e) => report(Err(crate::Error::flag("probe-group-visits", e.to_string()))),
         },
+    }
+}
+
+/// Write a line to standard output. A reader that has gone (`rest-embree backends | head -1`)
+/// wants no more: the rest is dropped, quietly. Any other failure is said on standard error;
+/// neither panics, as `println!` would.
+pub(crate) fn say(line: impl std::fmt::Display) {
+    use std::io::Write;
+    match writeln!(std::io::stdout().lock(), "{line}") {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            eprintln!("error: cannot write to standard output: {e}");
+        }
+        _ => {}
     }
 }
 
