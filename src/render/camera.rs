@@ -15,6 +15,9 @@ pub struct CameraRays {
     focal: f64,
     /// Used for pinhole projections only (its focal length is 0 for the others).
     pinhole: Pinhole,
+    /// How far the camera moves, in the world frame, over the whole exposure:
+    /// `(γ s, γβ s)` for a shutter s of proper time.
+    exposure: Event,
 }
 
 impl CameraRays {
@@ -34,7 +37,21 @@ impl CameraRays {
             height: height as f64,
             focal,
             pinhole,
+            exposure: to_world.event(Event::new(camera.shutter, DVec3::ZERO)),
         }
+    }
+
+    /// Whether the shutter stays open for a while (samples then see from different events).
+    pub fn has_shutter(&self) -> bool {
+        self.camera.shutter > 0.0
+    }
+
+    /// [`CameraRays::ray`] from the event `f` of the exposure after the imaging event (`f`
+    /// from −½ to ½): the same direction, its origin moved along the camera's worldline.
+    pub fn ray_in_exposure(&self, px: f64, py: f64, f: f64) -> NullRay {
+        let r = self.ray(px, py);
+        let shift = Event::new(f * self.exposure.t, f * self.exposure.x);
+        NullRay::new(r.origin + shift, r.dir)
     }
 
     /// The pinhole camera's looking directions (None for other projections).

@@ -129,7 +129,7 @@ fn tiles(scene: &Scene) -> Vec<(u32, u32)> {
 /// measure of intersection throughput); returns (rays, hits).
 pub(crate) fn trace_primary(scene: &Scene, world: &World) -> (u64, u64) {
     let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
-    let cull = ScreenCull::new(world, &cam);
+    let cull = ScreenCull::new(world, &cam).filter(|_| !cam.has_shutter());
     tiles(scene)
         .par_iter()
         .map_init(tile::TileScratch::default, |scratch, &xy| {
@@ -248,8 +248,10 @@ impl<'a> Rows<'a> {
         progress: Option<&'a Progress>,
     ) -> Self {
         let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
-        // A sky is seen through every pixel: nothing to cull.
-        let cull = ScreenCull::new(world, &cam).filter(|_| scene.sky.is_none());
+        // A sky is seen through every pixel: nothing to cull. The cull's cones are seen from the
+        // imaging event, not from the other events of an open shutter.
+        let cull =
+            ScreenCull::new(world, &cam).filter(|_| scene.sky.is_none() && !cam.has_shutter());
         let spectral = needs_spectra(scene);
         let seen = if spectral {
             Seen::of(scene)

@@ -7,7 +7,7 @@ mod gathered;
 use super::band::{Band, Seen};
 use super::camera::CameraRays;
 use super::path::{sample_rng, Emitters, PathTracer};
-use super::sampler::sample_offset;
+use super::sampler::{sample_offset, shutter_offset};
 use super::screen_cull::ScreenCull;
 use super::shade::{Lit, Shader, ShadowQuery, Spread};
 use super::star_pixels::{StarCones, StarPixels};
@@ -42,18 +42,35 @@ pub(crate) fn tile_pixels(x0: u32, y0: u32, w: u32, h: u32) -> Vec<(u32, u32)> {
     v
 }
 
-/// The image points of `coords` (frame pixels; `offset` places the frame in the full image),
-/// in pixels from the image's top-left corner: sample `(s, n)` of each pixel in the round of
-/// samples that starts at `base` (`sample_offset`), or the pixel centre for None.
+/// A round's image points, in pixels from the image's top-left corner, and where the camera's
+/// shutter is open, each one's place in the exposure (−½ to ½; empty for an instant, and for
+/// the pixel centres, which see from the imaging event).
+#[derive(Default)]
+pub(crate) struct ImagePoints {
+    pub px: Vec<(f64, f64)>,
+    pub times: Vec<f64>,
+}
+
+/// The image points of `coords` (frame pixels; `offset` places the frame in the full image):
+/// sample `(s, n)` of each pixel in the round of samples that starts at `base`
+/// (`sample_offset`, and `shutter_offset` where `shutter`), or the pixel centre for None.
 fn image_points(
     coords: &[(u32, u32)],
     offset: (u32, u32),
-    sample: Option<(u32, u32)>,
-    base: u32,
-    px: &mut Vec<(f64, f64)>,
+    (sample, base, shutter): (Option<(u32, u32)>, u32, bool),
+    points: &mut ImagePoints,
 ) {
+    let ImagePoints { px, times } = points;
     px.clear();
+    times.clear();
     let (dx, dy) = (offset.0 as f64, offset.1 as f64);
+    if let (true, Some((s, n))) = (shutter, sample) {
+        times.extend(
+            coords
+                .iter()
+                .map(|&(fx, fy)| shutter_offset(fx + offset.0, fy + offset.1, s, n, base)),
+        );
+    }
     match sample {
         Some((s, n)) if n > 1 || base > 0 => px.extend(coords.iter().map(|&(fx, fy)| {
             let (x, y) = (fx + offset.0, fy + offset.1);
@@ -79,10 +96,10 @@ pub fn primary_rays(
     sample: Option<(u32, u32)>,
     rays: &mut Vec<NullRay>,
 ) {
-    let mut px = Vec::with_capacity(coords.len());
-    image_points(coords, offset, sample, 0, &mut px);
+    let mut points = ImagePoints::default();
+    image_points(coords, offset, (sample, 0, false), &mut points);
     rays.clear();
-    rays.extend(px.iter().map(|&(x, y)| cam.ray(x, y)));
+    rays.extend(points.px.iter().map(|&(x, y)| cam.ray(x, y)));
 }
 
 /// A tile's pixels that the screen cull keeps (frame coordinates, and their indices among
@@ -160,7 +177,7 @@ impl TilePixels {
 #[derive(Default)]
 pub struct TileScratch {
     pixels: TilePixels,
-    px: Vec<(f64, f64)>,
+    points: ImagePoints,
     primary: PrimaryHits,
     round: RoundBuffers,
 }
@@ -175,14 +192,14 @@ impl TileScratch {
         (x0, y0): (u32, u32),
     ) -> (
         &TilePixels,
-        &mut Vec<(f64, f64)>,
+        &mut ImagePoints,
         &mut PrimaryHits,
         &mut RoundBuffers,
     ) {
         self.pixels.fill(scene, cam, cull, x0, y0);
         (
             &self.pixels,
-            &mut self.px,
+            &mut self.points,
             &mut self.primary,
             &mut self.round,
         )
@@ -203,7 +220,12 @@ pub(crate) fn trace_tile(
     let n = scene.image.samples;
     let mut found = 0;
     for s in 0..n {
-        image_points(&t.live_coords, t.offset, Some((s, n)), 0, px);
+        image_points(
+            &t.live_coords,
+            t.offset,
+            (Some((s, n)), 0, cam.has_shutter()),
+            px,
+        );
         world.primary_hits(cam, px, primary);
         found += primary.hit_count() as u64;
     }
@@ -492,7 +514,8 @@ pub(crate) fn render_tile<B: Band>(
     for s in 0..n + u32::from(aov_pass) {
         let centre = s == n;
         let sample = if centre { None } else { Some((s, n)) };
-        image_points(live_coords, offset, sample, view.sample_base, px);
+        let which = (sample, view.sample_base, cam.has_shutter());
+        image_points(live_coords, offset, which, px);
         traced += coords.len() as u64;
         world.primary_hits(cam, px, primary);
         if centre {

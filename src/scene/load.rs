@@ -457,8 +457,15 @@ fn camera(t: &Table) -> SceneResult<Camera> {
     };
     let time = t.f64_or("time", 0.0)?;
     let velocity = velocity(t, "velocity_direction")?.unwrap_or(Velocity::ZERO);
+    let shutter = t.f64_where(
+        "shutter",
+        Some(0.0),
+        |s| s >= 0.0,
+        "0 (an instant) or more: the exposure in the camera's proper time",
+    )?;
     t.finish(&[
         "position",
+        "shutter",
         "look_at",
         "direction",
         "up",
@@ -480,6 +487,7 @@ fn camera(t: &Table) -> SceneResult<Camera> {
         up,
         projection,
         velocity,
+        shutter,
     })
 }
 

@@ -39,12 +39,22 @@ pub struct Camera {
     pub projection: Projection,
     /// The camera's velocity in the world frame.
     pub velocity: Velocity,
+    /// How long the exposure lasts in the camera's proper time, centred on the imaging event
+    /// (`[camera] shutter`); 0 is an instant. Each sample sees from its own event on the
+    /// camera's worldline within it.
+    pub shutter: f64,
 }
 
 impl Camera {
     /// The event of the exposure (world frame), where every primary ray starts.
     pub fn imaging_event(&self) -> Event {
         Event::new(self.time, self.position)
+    }
+
+    /// The event on the camera's worldline `tau` after the imaging event in its proper time
+    /// (before it for negative `tau`): the imaging event moved by `(γτ, γβτ)`.
+    pub fn event_after(&self, tau: f64) -> Event {
+        self.imaging_event() + Boost::from_rest(&self.velocity).event(Event::new(tau, DVec3::ZERO))
     }
 
     /// The same camera at world time `t` on its worldline: it moves with its velocity from

@@ -6,6 +6,7 @@
 use super::{SurfaceHit, World, WorldGroup};
 use crate::accel::{Accelerator, Fan, FanHits, NO_HIT};
 use crate::geometry::PACKET;
+use crate::render::tile::ImagePoints;
 use crate::render::CameraRays;
 use crate::spacetime::{Event, NullRay, Pinhole};
 use glam::DVec3;
@@ -35,17 +36,26 @@ impl World {
         self.fan_group(cam).is_some()
     }
 
-    /// The primary rays through the image points `px` (pixels from the top-left corner, a
-    /// tile's in packet order) and the visible hit of each, into `out`: `cam.ray` of each and
+    /// The primary rays through the image points `points` (pixels from the top-left corner,
+    /// a tile's in packet order) and the visible hit of each, into `out`: `cam.ray` of each and
     /// `closest_hits`, or, where the backend has a path for them, fans of PACKET rays made,
     /// boosted and traced by the backend, left in its columns, with the same rays and hits to
-    /// the bit.
-    pub fn primary_hits(&self, cam: &CameraRays, px: &[(f64, f64)], out: &mut PrimaryHits) {
+    /// the bit. Points with times in the exposure are seen from their events on the camera's
+    /// worldline (`CameraRays::ray_in_exposure`), one by one.
+    pub fn primary_hits(&self, cam: &CameraRays, points: &ImagePoints, out: &mut PrimaryHits) {
+        let px = points.px.as_slice();
         out.len = px.len();
-        let Some((g, accel, camera)) = self.fan_group(cam) else {
+        let fans = self.fan_group(cam).filter(|_| points.times.is_empty());
+        let Some((g, accel, camera)) = fans else {
             out.fan = None;
             out.hits.resize(px.len(), None);
             out.rays.clear();
+            if !points.times.is_empty() {
+                let shifted = px.iter().zip(&points.times);
+                let rays = shifted.map(|(&(x, y), &f)| cam.ray_in_exposure(x, y, f));
+                out.rays.extend(rays);
+                return self.closest_hits(&out.rays, 0.0, &mut out.hits);
+            }
             return self.one_by_one(cam, px, &mut out.rays, &mut out.hits);
         };
         out.fan = Some((cam.event(), g.event_rest));
