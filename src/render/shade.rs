@@ -349,16 +349,12 @@ impl<'a, B: Band> Shader<'a, B> {
                 to_light,
                 s_surface,
                 dist,
-            } = l.toward(from, g)?;
+                atten,
+            } = l.toward(from, event, g)?;
             let ndl = nf.dot(to_light);
             if ndl <= 0.0 {
                 return None;
             }
-            let atten = if l.light.inverse_square {
-                1.0 / (dist * dist)
-            } else {
-                1.0
-            };
             let highlight = glints.then(|| {
                 let r = reflect(-to_light, nf);
                 highlight(r.dot(-v).max(0.0), mat.shininess)

@@ -6,9 +6,10 @@ use super::objects::{add_object, OBJECT_KEYS};
 use super::reader::{SceneResult, Table};
 use super::speed::velocity;
 use super::surfaces::{material, sky, textures};
+use super::timing::{self, Timing, TIMING_KEYS};
 use super::{PassSet, SceneError, Texture};
 use crate::geometry::Geometry;
-use crate::spacetime::Velocity;
+use crate::spacetime::{Boost, Velocity};
 use crate::spectrum::{Colour, Role};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -155,7 +156,7 @@ fn superseded(table: &[&str], key: &str) -> &'static [&'static str] {
 
 fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     let root = Table::root(doc)?;
-    let camera = match root.table("camera")? {
+    let (camera, flash) = match root.table("camera")? {
         Some(t) => camera(&t)?,
         None => return Err(root.missing_table("camera", "the scene needs a [camera] table")),
     };
@@ -201,6 +202,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     for t in root.tables("light")? {
         lights.push(light(&t, &groups)?);
     }
+    lights.extend(flash);
     let film = root.table("film")?.map(|t| film(&t, &camera)).transpose()?;
     let sky = root.table("sky")?.map(|t| sky(&t)).transpose()?;
     let fog = match root.table("fog")? {
@@ -384,7 +386,8 @@ fn fog(t: &Table, groups: &[Group], materials: &mut Vec<Material>) -> SceneResul
     })
 }
 
-fn camera(t: &Table) -> SceneResult<Camera> {
+/// The camera, and the light riding with it where it has a `flash`.
+fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
     let position = t.req_vec3("position")?;
     let forward = match (t.vec3("look_at")?, t.vec3("direction")?) {
         (Some(_), Some(_)) => {
@@ -463,9 +466,11 @@ fn camera(t: &Table) -> SceneResult<Camera> {
         |s| s >= 0.0,
         "0 (an instant) or more: the exposure in the camera's proper time",
     )?;
+    let flash = t.table("flash")?.map(|f| flash(&f)).transpose()?;
     t.finish(&[
         "position",
         "shutter",
+        "flash",
         "look_at",
         "direction",
         "up",
@@ -479,7 +484,7 @@ fn camera(t: &Table) -> SceneResult<Camera> {
         "projection",
         "view_height",
     ])?;
-    Ok(Camera {
+    let camera = Camera {
         position,
         time,
         forward,
@@ -488,7 +493,49 @@ fn camera(t: &Table) -> SceneResult<Camera> {
         projection,
         velocity,
         shutter,
-    })
+    };
+    let flash = flash.map(|(radiance, inverse_square, timing)| Light {
+        // At rest in the camera's frame, where the camera's worldline is.
+        position: Boost::to_rest(&velocity).event(camera.imaging_event()).x,
+        radiance,
+        velocity,
+        inverse_square,
+        timing,
+    });
+    Ok((camera, flash))
+}
+
+/// What a light emits: its colour times its intensity, whether it falls off as 1/r², and how
+/// it varies in its proper time.
+type Emitting = (Colour, bool, Timing);
+
+/// A light's `intensity`, `color`, `falloff` and timing (`pulse`, `on` or `table`).
+fn emitting(t: &Table) -> SceneResult<Emitting> {
+    let intensity = t.f64_where("intensity", Some(1.0), |v| v >= 0.0, "0 or more")?;
+    let color = t
+        .colour("color", Role::Emitter)?
+        .unwrap_or_else(|| Colour::grey(1.0, Role::Emitter));
+    let inverse_square = match t.string("falloff")?.unwrap_or("none") {
+        "none" => false,
+        "inverse_square" => true,
+        other => {
+            let n = t.get("falloff").expect("read above");
+            return Err(t.error_at(
+                n,
+                "falloff",
+                format!("unknown falloff `{other}` (none, inverse_square)"),
+            ));
+        }
+    };
+    Ok((color.scaled(intensity), inverse_square, timing::read(t)?))
+}
+
+/// `[camera] flash`: a point light riding with the camera (the radar world).
+fn flash(t: &Table) -> SceneResult<Emitting> {
+    let e = emitting(t)?;
+    let keys = ["intensity", "color", "falloff"];
+    t.finish(&[&keys[..], &TIMING_KEYS[..]].concat())?;
+    Ok(e)
 }
 
 fn image(t: &Table, frame: FrameSize) -> SceneResult<ImageSettings> {
@@ -640,10 +687,7 @@ fn render_settings(t: &Table) -> SceneResult<RenderSettings> {
 
 fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
     let position = t.req_vec3("position")?;
-    let intensity = t.f64_where("intensity", Some(1.0), |v| v >= 0.0, "0 or more")?;
-    let color = t
-        .colour("color", Role::Emitter)?
-        .unwrap_or_else(|| Colour::grey(1.0, Role::Emitter));
+    let (radiance, inverse_square, timing) = emitting(t)?;
     let own = velocity(t, "velocity_direction")?;
     let velocity = match (t.string("group")?, own) {
         (Some(_), Some(_)) => {
@@ -663,20 +707,8 @@ fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
         },
         (None, v) => v.unwrap_or(Velocity::ZERO),
     };
-    let inverse_square = match t.string("falloff")?.unwrap_or("none") {
-        "none" => false,
-        "inverse_square" => true,
-        other => {
-            let n = t.get("falloff").expect("read above");
-            return Err(t.error_at(
-                n,
-                "falloff",
-                format!("unknown falloff `{other}` (none, inverse_square)"),
-            ));
-        }
-    };
     t.string("name")?;
-    t.finish(&[
+    let keys = [
         "position",
         "intensity",
         "color",
@@ -688,11 +720,13 @@ fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
         "rapidity",
         "one_minus_beta",
         "name",
-    ])?;
+    ];
+    t.finish(&[&keys[..], &TIMING_KEYS[..]].concat())?;
     Ok(Light {
         position,
-        radiance: color.scaled(intensity),
+        radiance,
         velocity,
         inverse_square,
+        timing,
     })
 }

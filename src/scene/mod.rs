@@ -16,6 +16,7 @@ mod speed;
 pub mod stars;
 mod surfaces;
 mod texture;
+mod timing;
 pub(crate) mod toml_tree;
 mod transform;
 
@@ -29,3 +30,4 @@ pub use model::{
 };
 pub use pass_set::{Pass, PassSet};
 pub use texture::{ImageTexture, Sample as TextureSample, Sky, Texture};
+pub use timing::Timing;

@@ -308,6 +308,9 @@ pub struct Light {
     pub velocity: Velocity,
     /// Whether its irradiance falls off as 1/r² (else it is constant, as in the paper).
     pub inverse_square: bool,
+    /// How its emission varies over its proper time: the time of the frame it rests in, whose
+    /// clock reads 0 where that frame's origin passes the world origin at world time 0.
+    pub timing: super::Timing,
 }
 
 /// Objects sharing one uniform velocity; geometry in their rest frame.
@@ -387,7 +390,9 @@ impl Scene {
         s.camera.position += shift.x;
         s.camera.time += shift.t;
         for l in &mut s.lights {
-            l.position += rest_shift(&l.velocity);
+            let own = Boost::to_rest(&l.velocity).event(shift);
+            l.position += own.x;
+            l.timing = l.timing.delayed(own.t);
         }
         for g in &mut s.groups {
             g.geometry = Arc::new(g.geometry.translated(rest_shift(&g.velocity)));

@@ -102,11 +102,11 @@ impl<B: Band> PathTracer<'_, '_, B> {
         let sh = self.shader;
         let g = &sh.world.groups[here.group];
         for (i, l) in sh.lights.iter().enumerate() {
-            let Some(first) = l.toward(here.event, g) else {
+            let Some(first) = l.toward(here.event, here.event, g) else {
                 continue;
             };
             let from = self.shadow_start(here, first.to_light);
-            let Some(to) = l.toward(from, g) else {
+            let Some(to) = l.toward(from, here.event, g) else {
                 continue;
             };
             let (f, _) = scatter(to.to_light);
@@ -118,11 +118,7 @@ impl<B: Band> PathTracer<'_, '_, B> {
             else {
                 continue;
             };
-            let atten = if l.light.inverse_square {
-                1.0 / (to.dist * to.dist)
-            } else {
-                1.0
-            };
+            let atten = to.atten;
             let (light_shift, k) = sh.seen.irradiance(to.k * to.s_surface, here.shift);
             // A point light's `intensity` is Whitted's: a white Lambert surface facing it at
             // distance 1 shows that radiance, so its irradiance there is π times it.

@@ -16,14 +16,37 @@ pub(in crate::render) struct LightRt<'a> {
 impl LightRt<'_> {
     /// Toward this light from world event `from`, seen in group `g`'s frame: the emission
     /// event on the light's worldline that lies on `from`'s past light cone, found in the
-    /// light's rest frame, where the light is static. None where `from` is at the light.
-    pub(in crate::render) fn toward(&self, from: Event, g: &WorldGroup) -> Option<ToLight> {
+    /// light's rest frame, where the light is static. `lit` is the event the light falls on
+    /// (a hit; `from` is a shadow ray's start, ε off it): the light shines with its timing at
+    /// the emission event on `lit`'s past light cone, its time in the light's frame being its
+    /// proper time. None where `from` is at the light, or where the light is off then.
+    pub(in crate::render) fn toward(
+        &self,
+        from: Event,
+        lit: Event,
+        g: &WorldGroup,
+    ) -> Option<ToLight> {
         let at_light = self.to_light.event(from);
         let delta = self.light.position - at_light.x;
         let dist = delta.length();
         if dist == 0.0 {
             return None;
         }
+        let strength = if self.light.timing.is_steady() {
+            1.0
+        } else {
+            let at = self.to_light.event(lit);
+            let emitted = at.t - (self.light.position - at.x).length();
+            self.light.timing.factor(emitted)
+        };
+        if strength <= 0.0 {
+            return None;
+        }
+        let atten = if self.light.inverse_square {
+            strength / (dist * dist)
+        } else {
+            strength
+        };
         let (dir_w, k) = self.from_light.view_dir(delta / dist);
         let (to_light, s_surface) = g.boost.view_dir(dir_w);
         Some(ToLight {
@@ -32,6 +55,7 @@ impl LightRt<'_> {
             to_light,
             s_surface,
             dist,
+            atten,
         })
     }
 }
@@ -48,4 +72,7 @@ pub(in crate::render) struct ToLight {
     pub s_surface: f64,
     /// The distance in the light's frame (its lookback time there).
     pub dist: f64,
+    /// What the light's intensity is multiplied by on the way: its timing's factor at the
+    /// emission event, over the distance squared where it falls off.
+    pub atten: f64,
 }
