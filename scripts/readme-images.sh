@@ -32,6 +32,9 @@ $r render scenes/rocket.toml -o "$o/rocket-0.9.png" "${sky[@]}" --samples 4
 glow=(--width 384 --height 216 --samples 256 --quiet)
 $r render scenes/glowing_pass.toml -o "$o/glow-0.png" "${glow[@]}" --set 'group.lamps.velocity=[0, 0, 0]'
 $r render scenes/glowing_pass.toml -o "$o/glow-0.7.png" "${glow[@]}"
+# The radar world: the bar array lit by a flash riding with the camera, left on and pulsed.
+$r render scenes/radar_bars.toml -o "$o/optical-bars.png" "${size[@]}" --set 'camera.flash.on=[[-100, 100]]'
+$r render scenes/radar_bars.toml -o "$o/radar-bars.png" "${size[@]}"
 # Six frames of the planet film, as one picture.
 film=$(mktemp -d)
 $r render scenes/planet_film.toml -o "$film/planet-####.png" --width 320 --height 180 --quiet --frames 12..46
