@@ -95,6 +95,9 @@ pub struct WorldGroup {
     pub epsilon: f64,
     /// The bounds as they move through the world frame: a test before the boost.
     moving: MovingBounds,
+    /// The world times of the emission events it is seen at (a worldline's segment); None:
+    /// always.
+    pub during: Option<(f64, f64)>,
 }
 
 impl WorldGroup {
@@ -244,6 +247,7 @@ impl World {
                 accel: g.accel.clone(),
                 epsilon: g.epsilon,
                 moving: MovingBounds::new(&g.bounds, &g.velocity, event.t),
+                during: g.during,
             })
             .collect();
         let (tree, primary_tree, light_trees) =
@@ -346,9 +350,21 @@ impl World {
 
     /// Boost into group g's rest frame; None when the ray misses the group's bounds in
     /// (tmin, tmax). The origin moves along the ray to where it enters the bounds, so the
-    /// backend never sees large coordinates (docs/physics.md §7.1).
+    /// backend never sees large coordinates (docs/physics.md §7.1). A group seen only at some
+    /// world times (a worldline's segment) is met only where the ray's emission time
+    /// `origin.t − λ` lies within them (docs/physics.md §12.4).
     #[inline(always)]
     fn rest_ray(&self, g: &WorldGroup, ray: &NullRay, tmin: f64, tmax: f64) -> Option<RestRay> {
+        let (tmin, tmax) = match g.during {
+            None => (tmin, tmax),
+            Some((from, to)) => {
+                let (lo, hi) = (tmin.max(ray.origin.t - to), tmax.min(ray.origin.t - from));
+                if lo >= hi {
+                    return None;
+                }
+                (lo, hi)
+            }
+        };
         // Every primary ray starts at the imaging event: its rest-frame origin is per group.
         let origin = if ray.origin == self.event {
             g.event_rest

@@ -7,6 +7,7 @@ use super::reader::{SceneResult, Table};
 use super::speed::velocity;
 use super::surfaces::{material, sky, textures};
 use super::timing::{self, Timing, TIMING_KEYS};
+use super::worldline;
 use super::{PassSet, SceneError, Texture};
 use crate::geometry::Geometry;
 use crate::spacetime::{Boost, Velocity};
@@ -189,7 +190,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         }
         let (ids, index) = (&material_ids, groups.len());
         let g = group(t, name, ids, &materials, &mut objects, index, &mut total)?;
-        groups.push(g);
+        groups.extend(g);
     }
     // Without objects only a sky is worth rendering.
     if groups.iter().all(|g| g.geometry.is_empty()) && !root.has("sky") {
@@ -252,8 +253,9 @@ fn materials(
     Ok((materials, material_ids))
 }
 
-/// A `[[group]]` (the `index`th, named `name`) and its objects, appended to `objects`; `total` counts the
-/// scene's primitives.
+/// A `[[group]]` (its first group the `index`th, named `name`) and its objects, appended to
+/// `objects`; `total` counts the scene's primitives. A group with a worldline of several
+/// segments is a group per segment.
 fn group(
     t: &Table,
     name: &str,
@@ -262,9 +264,12 @@ fn group(
     objects: &mut Vec<ObjectInfo>,
     index: usize,
     total: &mut u64,
-) -> SceneResult<Group> {
-    let name = name.to_string();
-    let velocity = velocity(t, "direction")?.unwrap_or(Velocity::ZERO);
+) -> SceneResult<Vec<Group>> {
+    let segments = worldline::read(t)?;
+    let velocity = match segments {
+        Some(_) => Velocity::ZERO,
+        None => velocity(t, "direction")?.unwrap_or(Velocity::ZERO),
+    };
     let mut geometry = Geometry::default();
     for o in t.tables("object")? {
         let id = objects.len() as u32;
@@ -294,11 +299,17 @@ fn group(
         "rapidity",
         "one_minus_beta",
         "object",
+        "worldline",
     ])?;
-    Ok(Group {
-        name,
-        velocity,
-        geometry: Arc::new(geometry),
+    let geometry = Arc::new(geometry);
+    Ok(match segments {
+        Some(s) => worldline::groups(name, geometry, &s),
+        None => vec![Group {
+            name: name.to_string(),
+            velocity,
+            geometry,
+            during: None,
+        }],
     })
 }
 
@@ -365,6 +376,12 @@ fn fog(t: &Table, groups: &[Group], materials: &mut Vec<Material>) -> SceneResul
     let Some(group) = groups.iter().position(|g| g.name == name) else {
         return Err(t.error("group", format!("no group is named `{name}`")));
     };
+    if groups[group].during.is_some() {
+        return Err(t.error(
+            "group",
+            format!("group `{name}` has a worldline of several segments: a fog resting in it is not built yet"),
+        ));
+    }
     if groups[group].geometry.is_empty() {
         return Err(t.error(
             "group",
@@ -694,6 +711,12 @@ fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
             return Err(t.error("group", "give either `group` or a velocity, not both"))
         }
         (Some(g), None) => match groups.iter().find(|x| x.name == g) {
+            Some(x) if x.during.is_some() => {
+                return Err(t.error(
+                    "group",
+                    format!("group `{g}` has a worldline of several segments: a light resting in it is not built yet (give the light its own velocity)"),
+                ))
+            }
             Some(x) => x.velocity,
             None => {
                 let names: Vec<&str> = groups.iter().map(|x| x.name.as_str()).collect();

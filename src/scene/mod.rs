@@ -19,6 +19,7 @@ mod texture;
 mod timing;
 pub(crate) mod toml_tree;
 mod transform;
+mod worldline;
 
 pub use crate::error::SceneError;
 pub(crate) use load::load_file_as;

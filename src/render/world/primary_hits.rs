@@ -20,6 +20,7 @@ impl World {
             return None;
         };
         if !self.options.fused_primary
+            || g.during.is_some()
             || self.clip_rays
             || self.primary_tree.is_some()
             || cam.event() != self.event

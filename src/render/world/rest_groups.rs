@@ -18,6 +18,8 @@ pub(super) struct RestGroup {
     pub geometry: Arc<Geometry>,
     pub accel: Option<Arc<dyn Accelerator>>,
     pub epsilon: f64,
+    /// The world times of the emission events it is seen at (a worldline's segment).
+    pub during: Option<(f64, f64)>,
 }
 
 /// The world's groups, built once: the part of a world that a film's frames share (the
@@ -34,26 +36,30 @@ impl RestGroups {
         backend: &dyn Backend,
         options: WorldOptions,
     ) -> crate::Result<RestGroups> {
-        // Which scene groups share a rest frame, in file order.
-        let mut sets: Vec<(Velocity, Vec<usize>)> = Vec::new();
-        let mut index: std::collections::HashMap<[u64; 4], usize> =
-            std::collections::HashMap::new();
+        // Which scene groups share a rest frame and the times they are seen at, in file order.
+        type Key = ([u64; 4], Option<(u64, u64)>);
+        type Set = (Velocity, Option<(f64, f64)>, Vec<usize>);
+        let mut sets: Vec<Set> = Vec::new();
+        let mut index: std::collections::HashMap<Key, usize> = std::collections::HashMap::new();
         for (i, g) in scene.groups.iter().enumerate() {
             if g.geometry.is_empty() {
                 continue;
             }
             let v = g.velocity;
-            let key = v.identity_key();
+            let key = (
+                v.identity_key(),
+                g.during.map(|(a, b)| (a.to_bits(), b.to_bits())),
+            );
             match index.get(&key).filter(|_| options.merge_equal_velocities) {
-                Some(&k) => sets[k].1.push(i),
+                Some(&k) => sets[k].2.push(i),
                 None => {
                     index.insert(key, sets.len());
-                    sets.push((v, vec![i]));
+                    sets.push((v, g.during, vec![i]));
                 }
             }
         }
         let mut groups = Vec::with_capacity(sets.len());
-        for (velocity, members) in sets {
+        for (velocity, during, members) in sets {
             let geos: Vec<&Arc<Geometry>> =
                 members.iter().map(|&i| &scene.groups[i].geometry).collect();
             let mut geometry = merge(&geos);
@@ -88,6 +94,7 @@ impl RestGroups {
                 // Relative to the group's size and place alone, so that a scene scaled as a
                 // whole renders the same (tests/envelope.rs).
                 epsilon: 1e-7 * bounds.diagonal() + 1e-12 * bounds.max_abs(),
+                during,
             });
         }
         Ok(RestGroups { groups, options })
