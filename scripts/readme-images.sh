@@ -42,4 +42,13 @@ frames=()
 for k in 12 18 24 30 36 46; do frames+=("$film/planet-$(printf %04d $k).png"); done
 oiiotool "${frames[@]}" --mosaic 3x2 -o "$o/planet-film.png"
 rm -rf "$film"
+# Six frames of the travelling twin's film, on its own clock (scenes/twin_film.toml).
+film=$(mktemp -d)
+frames=()
+for k in 14 22 40 56 76 96; do
+  $r render scenes/twin_film.toml -o "$film/twin-####.png" --width 320 --height 180 --quiet --frames "$k"
+  frames+=("$film/twin-$(printf %04d $k).png")
+done
+oiiotool "${frames[@]}" --mosaic 3x2 -o "$o/twin-film.png"
+rm -rf "$film"
 echo "wrote $(ls "$o" | wc -l) images to $o"

@@ -159,3 +159,162 @@ fn bad_worldlines_name_the_key() {
         assert!(e.contains(needle), "{motion}:\n{e}");
     }
 }
+
+/// The travelling twin: out at 0.8c (γ = 5/3) from x = 3 at world time 0, turning at world
+/// time 10, back at 0.8c; 12 years of its proper time to 20 of the world's.
+fn twin(lamp_pulse_at: f64, width: f64) -> String {
+    format!(
+        r#"
+[camera]
+position = [3, 0, 0]
+time = 0
+direction = [-1, 0, 0]
+fov_y = 20
+worldline = [{{ until = 10, velocity = [0.8, 0, 0] }}, {{ velocity = [-0.8, 0, 0] }}]
+[image]
+width = 33
+height = 33
+[render]
+ambient = 0
+[film]
+start = 0
+end = 12
+step = 0.5
+clock = "proper"
+[[light]]
+position = [2, 0, 0]
+pulse = {{ at = {lamp_pulse_at:?}, width = {width:?} }}
+[[group]]
+name = "home"
+[[group.object]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+"#
+    )
+}
+
+/// A film on the camera's clock steps its proper time: frame k is at τ = k/2, world time
+/// t = γτ out and 10 + γ(τ − 6) back, with the camera's velocity there; and each frame is, to
+/// the bit, the picture of a uniformly moving camera at that event with that velocity.
+#[test]
+fn a_film_on_the_travellers_clock_follows_its_worldline() {
+    let s = scene(&twin(0.0, 1.0));
+    let film = s.film.as_ref().unwrap();
+    assert_eq!(film.frame_count(), 25);
+    for k in [0u64, 5, 12, 13, 20, 24] {
+        let tau = 0.5 * k as f64;
+        let t = if tau <= 6.0 {
+            tau / 0.6
+        } else {
+            10.0 + (tau - 6.0) / 0.6
+        };
+        let x = if t <= 10.0 {
+            3.0 + 0.8 * t
+        } else {
+            11.0 - 0.8 * (t - 10.0)
+        };
+        let f = s.film_frame(k).unwrap();
+        assert!(
+            (f.camera.time - t).abs() < 1e-12,
+            "frame {k}: t = {}",
+            f.camera.time
+        );
+        assert!(
+            (f.camera.position.x - x).abs() < 1e-12,
+            "frame {k}: x = {}",
+            f.camera.position.x
+        );
+        let bx = f.camera.velocity.beta_vec().x;
+        assert!(
+            (bx - if t < 10.0 { 0.8 } else { -0.8 }).abs() < 1e-15,
+            "frame {k}: β = {bx}"
+        );
+        if k == 5 || k == 20 {
+            let mut uniform = f.clone();
+            uniform.camera.worldline = None;
+            for backend in backends() {
+                let a = render_with(&f, backend);
+                let b = render_with(&uniform, backend);
+                assert_eq!(
+                    bytes(&a),
+                    bytes(&b),
+                    "{backend}: frame {k} as a uniform camera"
+                );
+            }
+        }
+    }
+}
+
+/// Home's lamp (at x = 2, lighting the point x = 1 of home that the traveller's centre pixel
+/// sees) flashes a Gaussian pulse of width w. A flash at world time t_L reaches the traveller
+/// going out at world time 5(t_L + 3), proper time 3(t_L + 3); coming back at world time
+/// (19 + t_L)/1.8, proper time 6 + 0.6((19 + t_L)/1.8 − 10). Home's clock is seen running at
+/// 1/3 going out and 3 times coming back (the Doppler factor √((1 ∓ β)/(1 ± β))), so the pulse
+/// is seen 3w wide, then w/3 (docs/physics.md §12.5).
+#[test]
+fn the_traveller_sees_home_slow_then_fast() {
+    let w = 0.2;
+    for (t_lamp, tau_peak, seen_width) in [(-2.0, 3.0, 3.0 * w), (5.0, 8.0, w / 3.0)] {
+        let s = scene(&twin(t_lamp, w));
+        for backend in backends() {
+            let at = |tau: f64| {
+                let mut f = s.clone();
+                f.camera = s.camera.at_time(s.camera.world_time_at(tau));
+                render_with(&f, backend).get(16, 16).values()[0] as f64
+            };
+            let h = 0.5 * seen_width;
+            let (a, b, c) = (
+                at(tau_peak + 0.1 * h - h).ln(),
+                at(tau_peak + 0.1 * h).ln(),
+                at(tau_peak + 1.1 * h).ln(),
+            );
+            let peak = tau_peak + 0.1 * h + 0.5 * h * (a - c) / (a - 2.0 * b + c);
+            report(
+                &format!("twin: home's flash at {t_lamp} seen at proper time"),
+                backend,
+                tau_peak,
+                peak,
+                1e-6,
+                "time",
+            );
+            let half = at(tau_peak + h) / at(tau_peak);
+            report(
+                &format!("twin: home's flash at {t_lamp}, half maximum at half its seen width"),
+                backend,
+                0.5,
+                half,
+                1e-5,
+                "of peak",
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_camera_worldlines_and_clocks_are_refused() {
+    let good = twin(0.0, 1.0);
+    for (from, to, needle) in [
+        (
+            "clock = \"proper\"",
+            "clock = \"mine\"",
+            "test.toml:17: key `film.clock`: unknown clock `mine`",
+        ),
+        (
+            "fov_y = 20",
+            "fov_y = 20\nshutter = 0.1",
+            "camera.shutter`: a camera whose worldline changes velocity cannot have a shutter yet",
+        ),
+        (
+            "fov_y = 20",
+            "fov_y = 20\nvelocity = [0.1, 0, 0]",
+            "give the motion either as a velocity or as a worldline",
+        ),
+    ] {
+        let text = good.replace(from, to);
+        let e = rest_embree::scene::load_str("test.toml", &text, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(needle), "{to}:\n{e}");
+    }
+}

@@ -7,10 +7,10 @@ use super::reader::{SceneResult, Table};
 use super::speed::velocity;
 use super::surfaces::{material, sky, textures};
 use super::timing::{self, Timing, TIMING_KEYS};
-use super::worldline;
+use super::worldline::{self, Worldline};
 use super::{PassSet, SceneError, Texture};
 use crate::geometry::Geometry;
-use crate::spacetime::{Boost, Velocity};
+use crate::spacetime::{Boost, Event, Velocity};
 use crate::spectrum::{Colour, Role};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -265,7 +265,7 @@ fn group(
     index: usize,
     total: &mut u64,
 ) -> SceneResult<Vec<Group>> {
-    let segments = worldline::read(t)?;
+    let segments = worldline::read(t, "direction")?;
     let velocity = match segments {
         Some(_) => Velocity::ZERO,
         None => velocity(t, "direction")?.unwrap_or(Velocity::ZERO),
@@ -476,7 +476,12 @@ fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
         }
     };
     let time = t.f64_or("time", 0.0)?;
-    let velocity = velocity(t, "velocity_direction")?.unwrap_or(Velocity::ZERO);
+    let worldline = worldline::read(t, "velocity_direction")?
+        .map(|s| Worldline::new(Event::new(time, position), &s));
+    let velocity = match &worldline {
+        Some(w) => w.velocity(time),
+        None => velocity(t, "velocity_direction")?.unwrap_or(Velocity::ZERO),
+    };
     let shutter = t.f64_where(
         "shutter",
         Some(0.0),
@@ -484,10 +489,21 @@ fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
         "0 (an instant) or more: the exposure in the camera's proper time",
     )?;
     let flash = t.table("flash")?.map(|f| flash(&f)).transpose()?;
+    if worldline.as_ref().is_some_and(|w| !w.is_uniform()) {
+        for (key, what) in [("shutter", shutter > 0.0), ("flash", flash.is_some())] {
+            if what {
+                return Err(t.error(
+                    key,
+                    format!("a camera whose worldline changes velocity cannot have a {key} yet (not built)"),
+                ));
+            }
+        }
+    }
     t.finish(&[
         "position",
         "shutter",
         "flash",
+        "worldline",
         "look_at",
         "direction",
         "up",
@@ -510,14 +526,19 @@ fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
         projection,
         velocity,
         shutter,
+        worldline,
     };
-    let flash = flash.map(|(radiance, inverse_square, timing)| Light {
-        // At rest in the camera's frame, where the camera's worldline is.
-        position: Boost::to_rest(&velocity).event(camera.imaging_event()).x,
-        radiance,
-        velocity,
-        inverse_square,
-        timing,
+    let flash = flash.map(|(radiance, inverse_square, timing)| {
+        // At rest in the camera's frame, where the camera's worldline is. Its times are on the
+        // camera's clock, which reads `time` at the imaging event; a light's are its frame's.
+        let at_camera = Boost::to_rest(&velocity).event(camera.imaging_event());
+        Light {
+            position: at_camera.x,
+            radiance,
+            velocity,
+            inverse_square,
+            timing: timing.delayed(at_camera.t - time),
+        }
     });
     Ok((camera, flash))
 }
@@ -644,10 +665,23 @@ fn film(t: &Table, camera: &Camera) -> SceneResult<Film> {
             "missing: give fps (frames per unit of world time) or step (world time between frames)",
         )),
     };
+    let clock = match t.string("clock")?.unwrap_or("world") {
+        "world" => Clock::World,
+        "proper" => Clock::Proper,
+        other => {
+            let n = t.get("clock").expect("read above");
+            return Err(t.error_at(
+                n,
+                "clock",
+                format!("unknown clock `{other}` (world, proper)"),
+            ));
+        }
+    };
     let f = Film {
         start,
         end,
         spacing,
+        clock,
     };
     let n = ((end - start)
         * match spacing {
@@ -666,7 +700,7 @@ fn film(t: &Table, camera: &Camera) -> SceneResult<Film> {
             ),
         ));
     }
-    t.finish(&["start", "end", "fps", "step"])?;
+    t.finish(&["start", "end", "fps", "step", "clock"])?;
     Ok(f)
 }
 

@@ -43,6 +43,9 @@ pub struct Camera {
     /// (`[camera] shutter`); 0 is an instant. Each sample sees from its own event on the
     /// camera's worldline within it.
     pub shutter: f64,
+    /// Its worldline where it changes velocity (`[camera] worldline`): through the imaging
+    /// event given in the scene; `velocity` is its velocity at `time`. None: uniform motion.
+    pub worldline: Option<super::Worldline>,
 }
 
 impl Camera {
@@ -57,19 +60,34 @@ impl Camera {
         self.imaging_event() + Boost::from_rest(&self.velocity).event(Event::new(tau, DVec3::ZERO))
     }
 
-    /// The same camera at world time `t` on its worldline: it moves with its velocity from
-    /// where it is at `self.time`.
+    /// The same camera at world time `t` on its worldline (uniform: it moves with its
+    /// velocity from where it is at `self.time`), with its velocity there.
     pub fn at_time(&self, t: f64) -> Camera {
         let mut c = self.clone();
-        c.position = self.position + self.velocity.beta_vec() * (t - self.time);
+        match &self.worldline {
+            Some(w) => {
+                c.position = w.position(t);
+                c.velocity = w.velocity(t);
+            }
+            None => c.position = self.position + self.velocity.beta_vec() * (t - self.time),
+        }
         c.time = t;
         c
+    }
+
+    /// The world time at which the camera's clock reads `tau`: it reads `time` at the imaging
+    /// event and runs at the camera's proper rate.
+    pub fn world_time_at(&self, tau: f64) -> f64 {
+        match &self.worldline {
+            Some(w) => w.world_time(tau - self.time),
+            None => self.time + self.velocity.gamma() * (tau - self.time),
+        }
     }
 }
 
 /// A film (`[film]`): frames at view times from `start` to `end` (inclusive, where the
-/// spacing lands on it), `1 / fps` or `step` apart, in world time; frame k is the camera at
-/// `start + k · spacing` on its worldline.
+/// spacing lands on it), `1 / fps` or `step` apart, in world time or on the camera's clock;
+/// frame k is the camera at `start + k · spacing` on its worldline.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     /// The first frame's view time.
@@ -78,6 +96,18 @@ pub struct Film {
     pub end: f64,
     /// The spacing of the frames.
     pub spacing: FrameSpacing,
+    /// Whether the times are world time or the camera's clock (`clock = "proper"`).
+    pub clock: Clock,
+}
+
+/// The clock a film's times are read on (`[film] clock`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Clock {
+    /// World time (the default).
+    #[default]
+    World,
+    /// The camera's proper time: it reads the camera's `time` at the imaging event.
+    Proper,
 }
 
 /// How far apart a film's frames are in world time.
@@ -380,7 +410,11 @@ impl Scene {
     pub fn film_frame(&self, k: u64) -> Option<Scene> {
         let film = self.film.as_ref()?;
         let mut s = self.clone();
-        s.camera = self.camera.at_time(film.time(k));
+        let t = match film.clock {
+            Clock::World => film.time(k),
+            Clock::Proper => self.camera.world_time_at(film.time(k)),
+        };
+        s.camera = self.camera.at_time(t);
         Some(s)
     }
 
@@ -392,6 +426,7 @@ impl Scene {
         let mut s = self.clone();
         s.camera.position += shift.x;
         s.camera.time += shift.t;
+        s.camera.worldline = s.camera.worldline.as_ref().map(|w| w.translated(shift));
         for l in &mut s.lights {
             let own = Boost::to_rest(&l.velocity).event(shift);
             l.position += own.x;

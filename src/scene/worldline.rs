@@ -1,7 +1,8 @@
-//! Worldlines of uniform segments (`worldline = [{ until, velocity }, ...]` on a group): the
-//! group's motion changes velocity at given world times, its origin moving continuously. Each
-//! segment becomes a group of its own, at rest in the segment's frame and seen only at emission
-//! events within the segment's world times (docs/physics.md §12.4).
+//! Worldlines of uniform segments (`worldline = [{ until, velocity }, ...]` on a group or the
+//! camera): the motion changes velocity at given world times, moving continuously. A group's
+//! segments become groups of their own, at rest in the segment's frame and seen only at
+//! emission events within the segment's world times; the camera sees, at each imaging event,
+//! with its velocity there (docs/physics.md §12.4-§12.5).
 
 use super::reader::{SceneResult, Table};
 use super::speed::velocity;
@@ -18,18 +19,13 @@ pub(crate) struct Segment {
     pub velocity: Velocity,
 }
 
-/// The segments of a group's `worldline`, in time order; None if it has none.
-pub(crate) fn read(t: &Table) -> SceneResult<Option<Vec<Segment>>> {
+/// The segments of a table's `worldline`, in time order; None if it has none. `dir_key` is the
+/// table's key for a velocity's direction, which a worldline replaces.
+pub(crate) fn read(t: &Table, dir_key: &str) -> SceneResult<Option<Vec<Segment>>> {
     if !t.has("worldline") {
         return Ok(None);
     }
-    for k in [
-        "velocity",
-        "direction",
-        "beta",
-        "rapidity",
-        "one_minus_beta",
-    ] {
+    for k in ["velocity", dir_key, "beta", "rapidity", "one_minus_beta"] {
         if t.has(k) {
             return Err(t.error(
                 k,
@@ -123,22 +119,112 @@ fn spans(segments: &[Segment]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Where the group's origin is at world time `t`: it passes the world origin at world time 0
-/// (every group's convention) and moves with each segment's velocity through its span.
-fn origin_at(segments: &[Segment], spans: &[(f64, f64)], t: f64) -> DVec3 {
-    let (lo, hi) = if t >= 0.0 { (0.0, t) } else { (t, 0.0) };
-    let travelled: DVec3 = segments
-        .iter()
-        .zip(spans)
-        .map(|(s, &(a, b))| {
-            let overlap = (b.min(hi) - a.max(lo)).max(0.0);
-            s.velocity.beta_vec() * overlap
-        })
-        .sum();
-    if t >= 0.0 {
-        travelled
-    } else {
-        -travelled
+/// A worldline of uniform segments through the event `anchor`: continuous, each segment's
+/// velocity held through its span of world time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Worldline {
+    anchor: Event,
+    segments: Vec<Segment>,
+    spans: Vec<(f64, f64)>,
+}
+
+impl Worldline {
+    /// Through `anchor`, with `segments` in time order (neighbours of one velocity merged).
+    pub(crate) fn new(anchor: Event, segments: &[Segment]) -> Worldline {
+        let segments = merged(segments);
+        let spans = spans(&segments);
+        Worldline {
+            anchor,
+            segments,
+            spans,
+        }
+    }
+
+    /// Whether it is one uniform motion.
+    pub fn is_uniform(&self) -> bool {
+        self.segments.len() == 1
+    }
+
+    /// `f(velocity, dt)` summed over the segments, dt the share of each segment's span in the
+    /// world times from the anchor to `t` (negative before the anchor).
+    fn along<T: std::iter::Sum<T> + std::ops::Neg<Output = T>>(
+        &self,
+        t: f64,
+        f: impl Fn(&Velocity, f64) -> T,
+    ) -> T {
+        let t0 = self.anchor.t;
+        let (lo, hi) = if t >= t0 { (t0, t) } else { (t, t0) };
+        let sum: T = self
+            .segments
+            .iter()
+            .zip(&self.spans)
+            .map(|(s, &(a, b))| f(&s.velocity, (b.min(hi) - a.max(lo)).max(0.0)))
+            .sum();
+        if t >= t0 {
+            sum
+        } else {
+            -sum
+        }
+    }
+
+    /// Where it is at world time `t`.
+    pub fn position(&self, t: f64) -> DVec3 {
+        self.anchor.x + self.along(t, |v, dt| v.beta_vec() * dt)
+    }
+
+    /// Its velocity at world time `t` (a segment's own from its start, up to its end).
+    pub fn velocity(&self, t: f64) -> Velocity {
+        let k = self.spans.partition_point(|&(_, end)| end <= t);
+        self.segments[k.min(self.segments.len() - 1)].velocity
+    }
+
+    /// The proper time from the anchor to world time `t` (negative before it).
+    pub fn proper_time(&self, t: f64) -> f64 {
+        self.along(t, |v, dt| dt / v.gamma())
+    }
+
+    /// The world time at which the proper time from the anchor is `tau`.
+    pub fn world_time(&self, tau: f64) -> f64 {
+        // Segment by segment from the anchor, forward or backward in time.
+        let t0 = self.anchor.t;
+        let k0 = self.spans.partition_point(|&(_, end)| end <= t0);
+        let k0 = k0.min(self.segments.len() - 1);
+        let (mut t, mut left) = (t0, tau);
+        if tau >= 0.0 {
+            for k in k0..self.segments.len() {
+                let g = self.segments[k].velocity.gamma();
+                let end = self.spans[k].1;
+                if left <= (end - t) / g || k + 1 == self.segments.len() {
+                    return t + left * g;
+                }
+                left -= (end - t) / g;
+                t = end;
+            }
+        } else {
+            for k in (0..=k0).rev() {
+                let g = self.segments[k].velocity.gamma();
+                let start = self.spans[k].0;
+                if -left <= (t - start) / g || k == 0 {
+                    return t + left * g;
+                }
+                left += (t - start) / g;
+                t = start;
+            }
+        }
+        t
+    }
+
+    /// The same worldline moved by the spacetime translation `shift`.
+    pub fn translated(&self, shift: Event) -> Worldline {
+        let mut w = self.clone();
+        w.anchor = w.anchor + shift;
+        for s in &mut w.segments {
+            s.until = s.until.map(|u| u + shift.t);
+        }
+        for sp in &mut w.spans {
+            *sp = (sp.0 + shift.t, sp.1 + shift.t);
+        }
+        w
     }
 }
 
@@ -147,8 +233,8 @@ fn origin_at(segments: &[Segment], spans: &[(f64, f64)], t: f64) -> DVec3 {
 /// segment's frame and seen only at emission events in the segment's world times. One segment
 /// is the uniform group itself.
 pub(crate) fn groups(name: &str, geometry: Arc<Geometry>, segments: &[Segment]) -> Vec<Group> {
-    let segments = merged(segments);
-    let spans = spans(&segments);
+    let line = Worldline::new(Event::new(0.0, DVec3::ZERO), segments);
+    let (segments, spans) = (&line.segments, &line.spans);
     if let [one] = segments.as_slice() {
         return vec![Group {
             name: name.to_string(),
@@ -159,12 +245,12 @@ pub(crate) fn groups(name: &str, geometry: Arc<Geometry>, segments: &[Segment]) 
     }
     segments
         .iter()
-        .zip(&spans)
+        .zip(spans)
         .map(|(s, &(a, b))| {
             // An event of the origin's worldline within the span (the one nearest world time 0),
             // and where that puts the origin, at rest, in the segment's frame.
             let t = 0.0f64.clamp(a, b);
-            let on_line = Event::new(t, origin_at(&segments, &spans, t));
+            let on_line = Event::new(t, line.position(t));
             let rest = Boost::to_rest(&s.velocity).event(on_line).x;
             let geometry = if rest == DVec3::ZERO {
                 geometry.clone()
@@ -195,8 +281,8 @@ mod tests {
     #[test]
     fn origin_moves_continuously_through_the_segments() {
         let s = [seg(Some(-2.0), 0.5), seg(Some(3.0), -0.25), seg(None, 0.8)];
-        let sp = spans(&s);
-        let x = |t: f64| origin_at(&s, &sp, t).x;
+        let line = Worldline::new(Event::new(0.0, DVec3::ZERO), &s);
+        let x = |t: f64| line.position(t).x;
         assert_eq!(x(0.0), 0.0);
         for (t, want) in [
             (2.0, -0.5),
@@ -220,5 +306,23 @@ mod tests {
             merged(&[seg(Some(1.0), 0.5), seg(Some(2.0), 0.5)]),
             vec![seg(None, 0.5)]
         );
+    }
+
+    #[test]
+    fn proper_time_and_world_time_are_inverse() {
+        // The twin: out at 0.8c until 10, back at 0.8c; anchored at (0, 3).
+        let line = Worldline::new(
+            Event::new(0.0, DVec3::new(3.0, 0.0, 0.0)),
+            &[seg(Some(10.0), 0.8), seg(None, -0.8)],
+        );
+        assert!((line.proper_time(20.0) - 12.0).abs() < 1e-12);
+        assert!((line.proper_time(-5.0) + 3.0).abs() < 1e-12);
+        for tau in [-7.0, -1.0, 0.0, 2.0, 6.0, 8.0, 12.0, 30.0] {
+            let t = line.world_time(tau);
+            assert!((line.proper_time(t) - tau).abs() < 1e-12, "{tau}: {t}");
+        }
+        assert!((line.position(20.0).x - 3.0).abs() < 1e-12);
+        assert_eq!(line.velocity(9.0).beta_vec().x, 0.8);
+        assert!(line.velocity(10.0).beta_vec().x < 0.0);
     }
 }
