@@ -152,6 +152,13 @@ fn bad_worldlines_name_the_key() {
         ),
         ("worldline = []", "give at least one segment"),
     ];
+    let many: Vec<String> = (0..5000)
+        .map(|k| format!("{{ until = {k}, velocity = [0.{}, 0, 0] }}", k % 9))
+        .collect();
+    let many = format!("worldline = [{}]", many.join(", "));
+    let cases = cases
+        .into_iter()
+        .chain([(many.as_str(), "5000 segments: at most 4096")]);
     for (motion, needle) in cases {
         let e = rest_embree::scene::load_str("test.toml", &sphere_scene(motion, 0.0), &[])
             .unwrap_err()

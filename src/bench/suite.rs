@@ -159,7 +159,85 @@ pub(crate) fn cases(quick: bool) -> Vec<LazyCase> {
     light_cases(px, &mut out);
     large_cases(quick, px, &mut out);
     group_cases(quick, px, &mut out);
+    time_cases(px, &mut out);
     out
+}
+
+/// The paper's lattice with its motion given as a worldline of `segments` (None: its uniform
+/// velocity -0.9c), its lights left out (a light cannot rest in a group whose velocity changes).
+fn lattice_in_segments(px: u32, segments: Option<&str>) -> Result<crate::scene::Scene, SceneError> {
+    let (_, text) = PAPER_SCENES[2];
+    let motion = match segments {
+        Some(w) => format!("worldline = {w}"),
+        None => "velocity = [-0.9, 0.0, 0.0]".into(),
+    };
+    let text = text.replacen("velocity = [0.0, 0.0, 0.0]", &motion, 1);
+    let mut s = size(px);
+    s.push("light=[]".into());
+    let sets: Vec<(String, String)> = s
+        .iter()
+        .map(|x| (format!("--set {x}"), x.clone()))
+        .collect();
+    load_str("scenes/lattice.toml", &text, &sets)
+}
+
+/// Motion and light in time: a worldline of segments against the uniform group, pulsed lights
+/// against steady ones, an open shutter against an instant.
+fn time_cases(px: u32, out: &mut Vec<LazyCase>) {
+    // Eight segments, their ends spread over the emission times the view sees (t0 = 3, the
+    // far face's light left ~60 earlier at 0.9c), each a copy of the lattice.
+    out.push(LazyCase::new("lattice beta=0.9, 8 segments", move || {
+        let line = "[{until=-40, velocity=[-0.9,0,0]}, {until=-20, velocity=[-0.88,0,0]}, \
+                    {until=-10, velocity=[-0.9,0,0]}, {until=-5, velocity=[-0.88,0,0]}, \
+                    {until=-2, velocity=[-0.9,0,0]}, {until=0, velocity=[-0.88,0,0]}, \
+                    {until=1, velocity=[-0.9,0,0]}, {velocity=[-0.88,0,0]}]";
+        Ok(Case::new(
+            "lattice beta=0.9, 8 segments",
+            lattice_in_segments(px, Some(line))?,
+            &["embree", "bvh"],
+        )
+        .beside(
+            "the lattice moving uniformly at 0.9c",
+            lattice_in_segments(px, None)?,
+        ))
+    }));
+    // Both lights as Gaussian pulses (a factor per shadow ray, and no shadow ray where it is 0).
+    out.push(LazyCase::new(
+        "lattice beta=0.9, pulsed lights",
+        move || {
+            let mut s = size(px);
+            s.push("group.lattice.velocity=[-0.9,0,0]".into());
+            let steady = paper("lattice", &s)?;
+            s.extend(sets(&[
+                "light.0.pulse={at=-8, width=6}",
+                "light.1.pulse={at=-8, width=6}",
+            ]));
+            Ok(Case::new(
+                "lattice beta=0.9, pulsed lights",
+                paper("lattice", &s)?,
+                &["embree", "bvh"],
+            )
+            .beside("the same lights steady", steady))
+        },
+    ));
+    // An open shutter: every sample from its own event, so no fans and no screen cull.
+    out.push(LazyCase::new("lattice beta=0.9, shutter 0.5", move || {
+        let mut s = size(px);
+        s.extend(sets(&[
+            "group.lattice.velocity=[-0.9,0,0]",
+            "image.samples=4",
+        ]));
+        let instant = paper("lattice", &s)?;
+        s.push("camera.shutter=0.5".into());
+        Ok(Case::new(
+            "lattice beta=0.9, shutter 0.5",
+            paper("lattice", &s)?,
+            &["embree", "bvh"],
+        )
+        .without_hi_reference()
+        .with_spp(&[4])
+        .beside("the same view at an instant", instant))
+    }));
 }
 
 /// The paper's lattice at four speeds, and what its shadow and secondary rays cost at 0.9c.

@@ -36,7 +36,9 @@ impl Timing {
                 (-4.0 * std::f64::consts::LN_2 * x * x).exp()
             }
             Timing::On(spans) => {
-                let on = spans.iter().any(|&[a, b]| a <= tau && tau <= b);
+                // Sorted and disjoint (`read` merges them): the last span starting by tau.
+                let i = spans.partition_point(|s| s[0] <= tau);
+                let on = i > 0 && tau <= spans[i - 1][1];
                 f64::from(u8::from(on))
             }
             Timing::Table(rows) => {
@@ -111,7 +113,7 @@ pub(crate) fn read(t: &Table) -> SceneResult<Timing> {
                 ),
             ));
         }
-        return Ok(Timing::On(spans));
+        return Ok(Timing::On(disjoint(spans)));
     }
     if let Some(n) = t.get("table") {
         let rows = pairs(t, n, "table", "[time, factor]")?;
@@ -140,6 +142,20 @@ pub(crate) fn read(t: &Table) -> SceneResult<Timing> {
         return Ok(Timing::Table(rows));
     }
     Ok(Timing::Steady)
+}
+
+/// Intervals sorted by their starts, overlapping ones joined: so a time finds its interval by
+/// a binary search, however many there are.
+fn disjoint(mut spans: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
+    spans.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let mut out: Vec<[f64; 2]> = Vec::with_capacity(spans.len());
+    for s in spans {
+        match out.last_mut() {
+            Some(last) if s[0] <= last[1] => last[1] = last[1].max(s[1]),
+            _ => out.push(s),
+        }
+    }
+    out
 }
 
 /// A non-empty array of pairs of numbers.
@@ -181,8 +197,12 @@ mod tests {
 
     #[test]
     fn intervals_and_tables() {
-        let on = Timing::On(vec![[0.0, 1.0], [3.0, 4.0]]);
+        let on = Timing::On(super::disjoint(vec![[3.0, 4.0], [0.0, 1.0], [0.5, 0.8]]));
+        assert_eq!(on, Timing::On(vec![[0.0, 1.0], [3.0, 4.0]]));
         let at = |t: f64| on.factor(t);
+        assert_eq!((at(4.0), at(4.5)), (1.0, 0.0));
+        let joined = super::disjoint(vec![[0.0, 2.0], [1.0, 3.0], [3.0, 5.0], [6.0, 7.0]]);
+        assert_eq!(joined, vec![[0.0, 5.0], [6.0, 7.0]]);
         assert_eq!(
             (at(-0.1), at(0.0), at(1.0), at(2.0), at(3.5)),
             (0.0, 1.0, 1.0, 0.0, 1.0)

@@ -12,6 +12,9 @@ use crate::spacetime::{Boost, Event, Velocity};
 use glam::DVec3;
 use std::sync::Arc;
 
+/// The most segments a worldline may have.
+pub(crate) const MAX_SEGMENTS: usize = 4096;
+
 /// One uniform segment: the velocity until world time `until` (None: for ever).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Segment {
@@ -34,6 +37,15 @@ pub(crate) fn read(t: &Table, dir_key: &str) -> SceneResult<Option<Vec<Segment>>
         }
     }
     let tables = t.tables("worldline")?;
+    if tables.len() > MAX_SEGMENTS {
+        return Err(t.error(
+            "worldline",
+            format!(
+                "{} segments: at most {MAX_SEGMENTS} (each segment of a group is a copy of its geometry)",
+                tables.len()
+            ),
+        ));
+    }
     if tables.is_empty() {
         return Err(t.error(
             "worldline",
