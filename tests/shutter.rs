@@ -209,3 +209,24 @@ fn shutter_zero_is_an_instant_and_negative_is_refused() {
         "{err}"
     );
 }
+
+/// The passes come from the imaging event whatever the samples' times, with one sample too.
+#[test]
+fn passes_are_taken_at_the_imaging_event() {
+    let mut open = scene(MOVING);
+    open.image.samples = 1;
+    let mut instant = open.clone();
+    instant.camera.shutter = 0.0;
+    for backend in backends() {
+        let a = render_with(&open, backend);
+        let b = render_with(&instant, backend);
+        for pass in ["lookback.V", "P.X", "object_id"] {
+            assert_eq!(a.channel(pass), b.channel(pass), "{backend}: {pass}");
+        }
+        assert_ne!(
+            a.channel("R"),
+            b.channel("R"),
+            "{backend}: the colour is exposed"
+        );
+    }
+}

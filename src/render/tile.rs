@@ -492,10 +492,11 @@ pub(crate) fn render_tile<B: Band>(
     let mut traced = 0u64;
     // With one sample the pixel centre serves both colour and passes; with more, an extra
     // centre ray gives crisp passes (ids, lookback) that compositors expect. Colour alone needs
-    // neither.
+    // neither. With an open shutter the one sample sees from elsewhere than the imaging event, where
+    // the passes are taken.
     let aov_sample = match passes {
         Passes::Colour => None,
-        Passes::All if n > 1 => Some(n),
+        Passes::All if n > 1 || cam.has_shutter() => Some(n),
         Passes::All => Some(0),
     };
     let aov_pass = aov_sample == Some(n);

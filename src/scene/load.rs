@@ -301,9 +301,26 @@ fn group(
         "object",
         "worldline",
     ])?;
+    if let Some(s) = segments.as_ref().filter(|s| worldline::group_count(s) > 1) {
+        // Each segment holds a copy of the group's listed primitives.
+        let copies = (worldline::group_count(s) - 1) as u64;
+        let held = copies.saturating_mul(geometry.prims.len() as u64);
+        super::objects::budget(t, "worldline", total, held)?;
+        let inside = |m: &Material| m.transmit > 0.0 || m.medium.is_some();
+        if geometry
+            .parts
+            .iter()
+            .any(|p| inside(&materials[p.material as usize]))
+        {
+            return Err(t.error(
+                "worldline",
+                "glass and media in a group whose velocity changes are not built yet (light inside them would be followed in one segment's frame)",
+            ));
+        }
+    }
     let geometry = Arc::new(geometry);
     Ok(match segments {
-        Some(s) => worldline::groups(name, geometry, &s),
+        Some(s) => worldline::groups(t, name, geometry, &s)?,
         None => vec![Group {
             name: name.to_string(),
             velocity,

@@ -54,12 +54,6 @@ impl Camera {
         Event::new(self.time, self.position)
     }
 
-    /// The event on the camera's worldline `tau` after the imaging event in its proper time
-    /// (before it for negative `tau`): the imaging event moved by `(γτ, γβτ)`.
-    pub fn event_after(&self, tau: f64) -> Event {
-        self.imaging_event() + Boost::from_rest(&self.velocity).event(Event::new(tau, DVec3::ZERO))
-    }
-
     /// The same camera at world time `t` on its worldline (uniform: it moves with its
     /// velocity from where it is at `self.time`), with its velocity there.
     pub fn at_time(&self, t: f64) -> Camera {
@@ -76,10 +70,11 @@ impl Camera {
     }
 
     /// The world time at which the camera's clock reads `tau`: it reads `time` at the imaging
-    /// event and runs at the camera's proper rate.
+    /// event the scene gives (where a worldline is anchored) and runs at the camera's proper
+    /// rate. A uniformly moving camera moved by [`Camera::at_time`] has its clock set anew.
     pub fn world_time_at(&self, tau: f64) -> f64 {
         match &self.worldline {
-            Some(w) => w.world_time(tau - self.time),
+            Some(w) => w.world_time(tau - w.anchor_time()),
             None => self.time + self.velocity.gamma() * (tau - self.time),
         }
     }

@@ -69,7 +69,7 @@ fn material_ref(
     }
 }
 
-fn budget(t: &Table, key: &str, total: &mut u64, add: u64) -> SceneResult<()> {
+pub(super) fn budget(t: &Table, key: &str, total: &mut u64, add: u64) -> SceneResult<()> {
     *total = total.saturating_add(add);
     if *total > MAX_PRIMITIVES {
         return Err(t.error(

@@ -152,6 +152,11 @@ impl Worldline {
         }
     }
 
+    /// The world time of the event it was given through.
+    pub fn anchor_time(&self) -> f64 {
+        self.anchor.t
+    }
+
     /// Whether it is one uniform motion.
     pub fn is_uniform(&self) -> bool {
         self.segments.len() == 1
@@ -240,20 +245,30 @@ impl Worldline {
     }
 }
 
+/// How many groups `segments` make (neighbours of one velocity are one).
+pub(crate) fn group_count(segments: &[Segment]) -> usize {
+    merged(segments).len()
+}
+
 /// The groups a worldline makes of one group's geometry: one per segment (neighbours of one
 /// velocity merged), each with the geometry placed where the group's origin rests in that
 /// segment's frame and seen only at emission events in the segment's world times. One segment
 /// is the uniform group itself.
-pub(crate) fn groups(name: &str, geometry: Arc<Geometry>, segments: &[Segment]) -> Vec<Group> {
+pub(crate) fn groups(
+    t: &Table,
+    name: &str,
+    geometry: Arc<Geometry>,
+    segments: &[Segment],
+) -> SceneResult<Vec<Group>> {
     let line = Worldline::new(Event::new(0.0, DVec3::ZERO), segments);
     let (segments, spans) = (&line.segments, &line.spans);
     if let [one] = segments.as_slice() {
-        return vec![Group {
+        return Ok(vec![Group {
             name: name.to_string(),
             velocity: one.velocity,
             geometry,
             during: None,
-        }];
+        }]);
     }
     segments
         .iter()
@@ -261,20 +276,30 @@ pub(crate) fn groups(name: &str, geometry: Arc<Geometry>, segments: &[Segment]) 
         .map(|(s, &(a, b))| {
             // An event of the origin's worldline within the span (the one nearest world time 0),
             // and where that puts the origin, at rest, in the segment's frame.
-            let t = 0.0f64.clamp(a, b);
-            let on_line = Event::new(t, line.position(t));
+            let when = 0.0f64.clamp(a, b);
+            let on_line = Event::new(when, line.position(when));
             let rest = Boost::to_rest(&s.velocity).event(on_line).x;
+            let reach = rest.abs().max_element() + geometry.bounds().max_abs();
+            if reach > super::envelope::MAX_MAGNITUDE {
+                return Err(t.error(
+                    "worldline",
+                    format!(
+                        "a segment puts the group {reach:e} from the origin of its frame: {}",
+                        super::envelope::too_large(reach)
+                    ),
+                ));
+            }
             let geometry = if rest == DVec3::ZERO {
                 geometry.clone()
             } else {
                 Arc::new(geometry.translated(rest))
             };
-            Group {
+            Ok(Group {
                 name: name.to_string(),
                 velocity: s.velocity,
                 geometry,
                 during: Some((a, b)),
-            }
+            })
         })
         .collect()
 }
