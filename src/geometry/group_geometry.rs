@@ -19,6 +19,42 @@ pub struct Part {
     pub corners: Option<std::sync::Arc<Corners>>,
     /// Where a transform placed the object: textures are laid out in its own coordinates.
     pub placement: Option<std::sync::Arc<Placement>>,
+    /// How the object spins in its group's frame, if it does (`spin`).
+    pub spin: Option<Spin>,
+}
+
+/// A rigid rotation in the group's frame: at `omega` radians per unit of the group's time,
+/// counter-clockwise about `axis` (unit) through `centre`. Only bodies of revolution about the
+/// axis spin: their shape in the group's frame stays still while every point of their surface
+/// moves along it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spin {
+    /// A point of the axis.
+    pub centre: DVec3,
+    /// The axis (unit).
+    pub axis: DVec3,
+    /// The angular velocity.
+    pub omega: f64,
+}
+
+impl Spin {
+    /// The velocity (units of c, group frame) of the body's point at `p`.
+    pub fn velocity_at(&self, p: DVec3) -> DVec3 {
+        self.omega * self.axis.cross(p - self.centre)
+    }
+
+    /// The boost from the group's frame into the rest frame of the body's point at `p`.
+    pub fn boost_at(&self, p: DVec3) -> Option<crate::spacetime::Boost> {
+        let v = crate::spacetime::Velocity::from_beta_vec(self.velocity_at(p)).ok()?;
+        Some(crate::spacetime::Boost::to_rest(&v))
+    }
+
+    /// Where the body's point now at `p` was at the group's time 0, by which textures stay
+    /// painted on the turning body: `p` turned back by ω t.
+    pub fn unturned(&self, p: DVec3, t: f64) -> DVec3 {
+        let back = glam::DQuat::from_axis_angle(self.axis, -self.omega * t);
+        self.centre + back * (p - self.centre)
+    }
 }
 
 /// An object placed by `scale`, then `rotate`, then `translate`, and the shape it was before
@@ -126,6 +162,7 @@ impl Geometry {
                     material,
                     corners,
                     placement: None,
+                    spin: None,
                 },
             );
         }
@@ -170,6 +207,7 @@ impl Geometry {
                 material: *material,
                 corners: corners.clone(),
                 placement: None,
+                spin: None,
             });
             start = end;
         }
@@ -371,6 +409,18 @@ impl Geometry {
         }
     }
 
+    /// Give every part of `object` its spin.
+    pub fn set_spin(&mut self, object: u32, spin: Spin) {
+        for p in self.parts.iter_mut().filter(|p| p.object == object) {
+            p.spin = Some(spin);
+        }
+    }
+
+    /// Whether anything in it spins.
+    pub fn spins(&self) -> bool {
+        self.parts.iter().any(|p| p.spin.is_some())
+    }
+
     /// The same geometry moved by `d`.
     pub fn translated(&self, d: DVec3) -> Geometry {
         Geometry {
@@ -379,6 +429,10 @@ impl Geometry {
                 .parts
                 .iter()
                 .map(|p| Part {
+                    spin: p.spin.map(|s| Spin {
+                        centre: s.centre + d,
+                        ..s
+                    }),
                     placement: p.placement.as_ref().map(|x| {
                         std::sync::Arc::new(Placement {
                             translate: x.translate + d,

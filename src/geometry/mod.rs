@@ -17,7 +17,7 @@ mod real;
 pub use aabb::Aabb;
 pub use bars::BarArray;
 pub(crate) use box_tree::{walk, BoxTree, TreeNode, PACKET};
-pub use group_geometry::{Corners, Geometry, ImplicitRun, Part, Placement};
+pub use group_geometry::{Corners, Geometry, ImplicitRun, Part, Placement, Spin};
 pub(crate) use implicit::INSTANCE_OVER;
 pub use implicit::{Blocks, Implicit, Member};
 pub use indexed_mesh::IndexedMesh;

@@ -350,7 +350,7 @@ impl<'a, B: Band> Shader<'a, B> {
                 s_surface,
                 dist,
                 atten,
-            } = l.toward(from, event, g)?;
+            } = l.toward(from, event, g, lit.spin.as_ref())?;
             let ndl = nf.dot(to_light);
             if ndl <= 0.0 {
                 return None;
@@ -393,13 +393,22 @@ impl<'a, B: Band> Shader<'a, B> {
         let nf = smooth.map_or(faced, |s| if s.dot(faced) < 0.0 { -s } else { s });
         // Textures are laid out in the object's own coordinates, on its shape before any
         // transform placed it.
+        // A spinning body's textures turn with it: read where its point was at time 0.
+        let (painted, painted_n) = match &part.spin {
+            Some(sp) => {
+                let t = g.boost.event(event).t;
+                let p = sp.unturned(hit.point, t);
+                (p, sp.unturned(sp.centre + n, t) - sp.centre)
+            }
+            None => (hit.point, n),
+        };
         let (point, outward, prim) = match &part.placement {
             Some(pl) => (
-                pl.to_object(hit.point),
-                pl.normal_to_object(n),
+                pl.to_object(painted),
+                pl.normal_to_object(painted_n),
                 pl.shape.unwrap_or(prim),
             ),
-            None => (hit.point, n, prim),
+            None => (painted, painted_n, prim),
         };
         Lit {
             mat,
@@ -417,6 +426,7 @@ impl<'a, B: Band> Shader<'a, B> {
             inside,
             shift,
             spread: 0.0,
+            spin: part.spin.and_then(|sp| sp.boost_at(hit.point)),
         }
     }
 
@@ -513,13 +523,21 @@ impl<'a, B: Band> Shader<'a, B> {
                         return 1 + spent;
                     }
                 }
+                // A spinning point's directions are in its own frame: into the group's first.
+                let (dir, spun) = match &lit.spin {
+                    Some(b) => {
+                        let (d, _) = b.inverse().view_dir(dir);
+                        (d, b.null_dir(d).1)
+                    }
+                    None => (dir, 1.0),
+                };
                 let r = self.spawn(lit.group, event, side, dir);
-                let s = self.lookback_factor(lit.group, r.dir);
+                let s = self.lookback_factor(lit.group, r.dir) * spun;
                 // The bundle keeps its solid angle in the surface's frame (a flat surface).
                 let spread = match self.cones {
                     Some(_) if lit.spread > 0.0 => Spread {
                         sr: lit.spread,
-                        s: self.world.groups[lit.group].boost.null_dir(r.dir).1,
+                        s: self.world.groups[lit.group].boost.null_dir(r.dir).1 * spun,
                     },
                     _ => Spread::NONE,
                 };
@@ -614,6 +632,9 @@ pub struct Lit<'a> {
     /// The solid angle, in the surface's frame, of the bundle the ray that hit stands for (0:
     /// none is followed).
     spread: f64,
+    /// Where the object spins: the boost from its group's frame into the point's own, where
+    /// it is shaded (its hit's direction and factor are there already, `World::spun`).
+    pub(super) spin: Option<Boost>,
 }
 
 impl Lit<'_> {

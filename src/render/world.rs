@@ -98,6 +98,8 @@ pub struct WorldGroup {
     /// The world times of the emission events it is seen at (a worldline's segment); None:
     /// always.
     pub during: Option<(f64, f64)>,
+    /// Whether anything in it spins.
+    pub spins: bool,
 }
 
 impl WorldGroup {
@@ -248,6 +250,7 @@ impl World {
                 epsilon: g.epsilon,
                 moving: MovingBounds::new(&g.bounds, &g.velocity, event.t),
                 during: g.during,
+                spins: g.spins,
             })
             .collect();
         let (tree, primary_tree, light_trees) =
@@ -402,6 +405,27 @@ impl World {
         }
     }
 
+    /// A hit on a spinning object seen in its point's own frame, which moves at the spin's
+    /// velocity there through the group's frame: the ray's direction and lookback factor
+    /// there (factors multiply along a chain of frames, docs/physics.md §12.6). The point
+    /// stays in the group's coordinates, where the body's shape is still.
+    #[inline]
+    fn spun(&self, hit: SurfaceHit) -> SurfaceHit {
+        if !self.groups[hit.group].spins {
+            return hit;
+        }
+        let part = self.groups[hit.group].geometry.part_of(hit.prim);
+        let Some(boost) = part.spin.and_then(|sp| sp.boost_at(hit.point)) else {
+            return hit;
+        };
+        let (d, s) = boost.null_dir(hit.dir / hit.s);
+        SurfaceHit {
+            dir: d * hit.s,
+            s: s * hit.s,
+            ..hit
+        }
+    }
+
     /// The visible hit on each ray: the one with the smallest world-frame lookback time (the
     /// latest emission event) over all groups, in `(tmin, tmax)` of lookback. With few groups
     /// the rays go to each group's backend together (packets); with many, one by one through
@@ -458,7 +482,7 @@ impl World {
                             shift: shift[i],
                             s: factor[i],
                         };
-                        let hit = Self::surface_hit(gi, &rr, h);
+                        let hit = self.spun(Self::surface_hit(gi, &rr, h));
                         if hit.lambda < best[i] {
                             best[i] = hit.lambda;
                             out[i] = Some(hit);
@@ -507,7 +531,7 @@ impl World {
             return None;
         }
         let rr = self.rest_ray(g, ray, tmin, tmax)?;
-        let sh = Self::surface_hit(gi, &rr, g.intersect1(&rr.ray)?);
+        let sh = self.spun(Self::surface_hit(gi, &rr, g.intersect1(&rr.ray)?));
         (sh.lambda < tmax).then_some(sh)
     }
 

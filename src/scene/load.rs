@@ -199,6 +199,12 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
             "the scene is empty: add a [[group]] with at least one [[group.object]] (box, sphere, rod, mesh, lattice or bar_array), or a [sky]",
         ));
     }
+    if render.integrator == Integrator::Path && groups.iter().any(|g| g.geometry.spins()) {
+        return Err(root.error(
+            "render",
+            "spinning objects are not built yet for integrator = \"path\" (Whitted shades them in each point's own frame)",
+        ));
+    }
     let mut lights = Vec::new();
     for t in root.tables("light")? {
         lights.push(light(&t, &groups)?);
@@ -341,6 +347,16 @@ fn check_object(
     materials: &[Material],
     (first, implicit): (usize, usize),
 ) -> SceneResult<()> {
+    let spins_inside = geometry.parts.iter().filter(|p| p.object == id).any(|p| {
+        let m = &materials[p.material as usize];
+        p.spin.is_some() && (m.transmit > 0.0 || m.medium.is_some())
+    });
+    if spins_inside {
+        return Err(o.error(
+            "spin",
+            "a spinning object of glass or with a medium is not built yet (light inside it would be followed in its group's frame, not its points')",
+        ));
+    }
     // An image needs a mapping: spheres, boxes and rods have one, a mesh its file's
     // texture coordinates.
     let imaged = |m: u32| {

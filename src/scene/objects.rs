@@ -39,6 +39,7 @@ pub(super) const OBJECT_KEYS: &[&str] = &[
     "translate",
     "rotate",
     "scale",
+    "spin",
 ];
 
 fn material_ref(
@@ -275,6 +276,11 @@ pub(super) fn add_object(
             ));
         }
     };
+    if let Some(spin) = t.table("spin")? {
+        let last = adding.geo.prims.last().copied();
+        let spin = read_spin(&spin, kind, last)?;
+        adding.geo.set_spin(id, spin);
+    }
     // Textures turn and move with the object (a box turned by quarter turns as exactly as its
     // corners were).
     if let Some(x) = transform {
@@ -289,6 +295,57 @@ pub(super) fn add_object(
         );
     }
     Ok(kind.to_string())
+}
+
+/// An object's `spin = { axis, omega }`, about the axis through its centre (a sphere's) or
+/// along it (a rod's own): only bodies of revolution about the axis spin, their rim slower
+/// than light. `shape` is the object's primitive as placed (the last one added).
+fn read_spin(
+    t: &Table,
+    kind: &str,
+    shape: Option<crate::geometry::Primitive>,
+) -> SceneResult<crate::geometry::Spin> {
+    use crate::geometry::Primitive;
+    let axis = t.req_vec3("axis")?;
+    if axis.length() == 0.0 {
+        return Err(t.error("axis", "must not be zero"));
+    }
+    let axis = axis.normalize();
+    let omega = t.f64_or("omega", 0.0)?;
+    t.finish(&["axis", "omega"])?;
+    let (centre, rim) = match (kind, shape) {
+        ("sphere", Some(Primitive::Sphere { center, radius })) => (center, radius),
+        ("rod", Some(Primitive::Capsule { a, b, radius })) => {
+            let along = (b - a).normalize_or_zero();
+            if along.cross(axis).length() > 1e-9 {
+                return Err(t.error(
+                    "axis",
+                    "a rod spins about its own axis only (it is a body of revolution about no other)",
+                ));
+            }
+            (0.5 * (a + b), radius)
+        }
+        _ => {
+            return Err(t.error(
+                "axis",
+                format!("a spinning {kind} is not built yet: spheres and rods spin (bodies of revolution about the axis, whose shape stays still)"),
+            ))
+        }
+    };
+    let speed = omega.abs() * rim;
+    if speed >= 1.0 {
+        let n = t.get("omega").expect("read above");
+        return Err(t.error_at(
+            n,
+            "omega",
+            format!("the rim would move at |omega| x radius = {speed}c: at or beyond the speed of light"),
+        ));
+    }
+    Ok(crate::geometry::Spin {
+        centre,
+        axis,
+        omega,
+    })
 }
 
 /// The factor of a uniform scale (1 without a transform): a sphere or rod stays one under a

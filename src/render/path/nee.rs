@@ -102,11 +102,11 @@ impl<B: Band> PathTracer<'_, '_, B> {
         let sh = self.shader;
         let g = &sh.world.groups[here.group];
         for (i, l) in sh.lights.iter().enumerate() {
-            let Some(first) = l.toward(here.event, here.event, g) else {
+            let Some(first) = l.toward(here.event, here.event, g, None) else {
                 continue;
             };
             let from = self.shadow_start(here, first.to_light);
-            let Some(to) = l.toward(from, here.event, g) else {
+            let Some(to) = l.toward(from, here.event, g, None) else {
                 continue;
             };
             let (f, _) = scatter(to.to_light);

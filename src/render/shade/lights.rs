@@ -25,6 +25,7 @@ impl LightRt<'_> {
         from: Event,
         lit: Event,
         g: &WorldGroup,
+        spin: Option<&Boost>,
     ) -> Option<ToLight> {
         let at_light = self.to_light.event(from);
         let delta = self.light.position - at_light.x;
@@ -48,7 +49,12 @@ impl LightRt<'_> {
             strength
         };
         let (dir_w, k) = self.from_light.view_dir(delta / dist);
-        let (to_light, s_surface) = g.boost.view_dir(dir_w);
+        let (mut to_light, mut s_surface) = g.boost.view_dir(dir_w);
+        // A spinning point is lit in its own frame.
+        if let Some(b) = spin {
+            let (d, s) = b.view_dir(to_light);
+            (to_light, s_surface) = (d, s_surface * s);
+        }
         Some(ToLight {
             dir_w,
             k,

@@ -21,6 +21,7 @@ impl World {
         };
         if !self.options.fused_primary
             || g.during.is_some()
+            || g.spins
             || self.clip_rays
             || self.primary_tree.is_some()
             || cam.event() != self.event

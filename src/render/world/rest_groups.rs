@@ -20,6 +20,8 @@ pub(super) struct RestGroup {
     pub epsilon: f64,
     /// The world times of the emission events it is seen at (a worldline's segment).
     pub during: Option<(f64, f64)>,
+    /// Whether anything in it spins (its hits then move into their points' frames).
+    pub spins: bool,
 }
 
 /// The world's groups, built once: the part of a world that a film's frames share (the
@@ -85,6 +87,7 @@ impl RestGroups {
                     ))
                 })?))
             };
+            let spins = geometry.spins();
             groups.push(RestGroup {
                 velocity,
                 boost: Boost::to_rest(&velocity),
@@ -95,6 +98,7 @@ impl RestGroups {
                 // whole renders the same (tests/envelope.rs).
                 epsilon: 1e-7 * bounds.diagonal() + 1e-12 * bounds.max_abs(),
                 during,
+                spins,
             });
         }
         Ok(RestGroups { groups, options })
