@@ -42,6 +42,9 @@ frames=()
 for k in 12 18 24 30 36 46; do frames+=("$film/planet-$(printf %04d $k).png"); done
 oiiotool "${frames[@]}" --mosaic 3x2 -o "$o/planet-film.png"
 rm -rf "$film"
+# A planet spinning with its equator at 0.9c, beside it still.
+$r render scenes/spinning_planet.toml -o "$o/spin-0.png" "${sky[@]}" --samples 4 --set 'group.planet.object.planet.spin.omega=0'
+$r render scenes/spinning_planet.toml -o "$o/spin-0.9.png" "${sky[@]}" --samples 4
 # Six frames of the travelling twin's film, on its own clock (scenes/twin_film.toml).
 film=$(mktemp -d)
 frames=()

@@ -220,6 +220,23 @@ fn time_cases(px: u32, out: &mut Vec<LazyCase>) {
             .beside("the same lights steady", steady))
         },
     ));
+    // A planet at rest spinning with its equator at 0.9c against the same planet still: each
+    // hit carried into its point's frame (a boost per hit), and no fans.
+    out.push(LazyCase::new("planet spinning at 0.9c", move || {
+        let mut s = size(px);
+        s.extend(sets(&[
+            "group.planet.velocity=[0,0,0]",
+            "camera.direction=[0,1,0]",
+            "camera.time=0",
+        ]));
+        let still = planet(&s)?;
+        s.push("group.planet.object.planet.spin={axis=[0,0,1], omega=0.6}".into());
+        Ok(
+            Case::new("planet spinning at 0.9c", planet(&s)?, &["embree", "bvh"])
+                .without_hi_reference()
+                .beside("the same planet still", still),
+        )
+    }));
     // An open shutter: every sample from its own event, so no fans and no screen cull.
     out.push(LazyCase::new("lattice beta=0.9, shutter 0.5", move || {
         let mut s = size(px);
