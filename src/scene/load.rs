@@ -1,18 +1,18 @@
 //! From the scene tree to a validated [`Scene`].
 
+use super::camera_keys::{camera, film};
 use super::doc::Doc;
+use super::lights::light;
 use super::model::*;
 use super::objects::{add_object, OBJECT_KEYS};
 use super::reader::{SceneResult, Table};
 use super::speed::velocity;
 use super::surfaces::{material, sky, textures};
-use super::timing::{self, Timing, TIMING_KEYS};
-use super::worldline::{self, Worldline};
+use super::worldline;
 use super::{PassSet, SceneError, Texture};
 use crate::geometry::Geometry;
-use crate::spacetime::{Boost, Event, Velocity};
+use crate::spacetime::Velocity;
 use crate::spectrum::{Colour, Role};
-use glam::DVec3;
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -436,179 +436,6 @@ fn fog(t: &Table, groups: &[Group], materials: &mut Vec<Material>) -> SceneResul
     })
 }
 
-/// The camera, and the light riding with it where it has a `flash`.
-fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
-    let position = t.req_vec3("position")?;
-    let forward = match (t.vec3("look_at")?, t.vec3("direction")?) {
-        (Some(_), Some(_)) => {
-            return Err(t.error("direction", "give either look_at or direction, not both"))
-        }
-        (Some(p), None) => p - position,
-        (None, Some(d)) => d,
-        (None, None) => {
-            return Err(t.error(
-                "look_at",
-                "missing: give look_at = [x, y, z] or direction = [x, y, z]",
-            ))
-        }
-    };
-    if forward.length() == 0.0 {
-        let k = if t.has("look_at") {
-            "look_at"
-        } else {
-            "direction"
-        };
-        return Err(t.error(
-            k,
-            "the view direction has zero length (look_at equals position?)",
-        ));
-    }
-    let forward = forward.normalize();
-    let up_in = t.vec3("up")?.unwrap_or(DVec3::Z);
-    let right = forward.cross(up_in);
-    if right.length() < 1e-9 * up_in.length().max(1e-300) || up_in.length() == 0.0 {
-        return Err(t.error(
-            "up",
-            "`up` must not be zero or parallel to the view direction",
-        ));
-    }
-    let right = right.normalize();
-    let up = right.cross(forward);
-    // Both projections' keys are read whichever is chosen, so a scene can switch projection
-    // with --set and keep its file valid.
-    let fov_y = t.f64_where(
-        "fov_y",
-        Some(40.0),
-        |v| (super::envelope::MIN_FOV_DEG..180.0).contains(&v),
-        "at least 1e-6 and below 180 degrees",
-    )?;
-    let view_height = t.f64("view_height")?;
-    if let Some(h) = view_height.filter(|&h| h <= 0.0) {
-        return Err(t.error("view_height", format!("must be greater than 0 (got {h:?})")));
-    }
-    let projection = match t.string("projection")?.unwrap_or("pinhole") {
-        "pinhole" | "perspective" => Projection::Pinhole {
-            fov_y: fov_y.to_radians(),
-        },
-        "orthographic" => Projection::Orthographic {
-            view_height: view_height.ok_or_else(|| {
-                t.error(
-                    "view_height",
-                    "missing: an orthographic camera needs view_height (world units)",
-                )
-            })?,
-        },
-        "equirectangular" => Projection::Equirectangular,
-        other => {
-            let n = t.get("projection").expect("read above");
-            return Err(t.error_at(
-                n,
-                "projection",
-                format!("unknown projection `{other}` (pinhole, orthographic, equirectangular)"),
-            ));
-        }
-    };
-    let time = t.f64_or("time", 0.0)?;
-    let worldline = worldline::read(t, "velocity_direction")?
-        .map(|s| Worldline::new(Event::new(time, position), &s));
-    let velocity = match &worldline {
-        Some(w) => w.velocity(time),
-        None => velocity(t, "velocity_direction")?.unwrap_or(Velocity::ZERO),
-    };
-    let shutter = t.f64_where(
-        "shutter",
-        Some(0.0),
-        |s| s >= 0.0,
-        "0 (an instant) or more: the exposure in the camera's proper time",
-    )?;
-    let flash = t.table("flash")?.map(|f| flash(&f)).transpose()?;
-    if worldline.as_ref().is_some_and(|w| !w.is_uniform()) {
-        for (key, what) in [("shutter", shutter > 0.0), ("flash", flash.is_some())] {
-            if what {
-                return Err(t.error(
-                    key,
-                    format!("a camera whose worldline changes velocity cannot have a {key} yet (not built)"),
-                ));
-            }
-        }
-    }
-    t.finish(&[
-        "position",
-        "shutter",
-        "flash",
-        "worldline",
-        "look_at",
-        "direction",
-        "up",
-        "fov_y",
-        "time",
-        "velocity",
-        "velocity_direction",
-        "beta",
-        "rapidity",
-        "one_minus_beta",
-        "projection",
-        "view_height",
-    ])?;
-    let camera = Camera {
-        position,
-        time,
-        forward,
-        right,
-        up,
-        projection,
-        velocity,
-        shutter,
-        worldline,
-    };
-    let flash = flash.map(|(radiance, inverse_square, timing)| {
-        // At rest in the camera's frame, where the camera's worldline is. Its times are on the
-        // camera's clock, which reads `time` at the imaging event; a light's are its frame's.
-        let at_camera = Boost::to_rest(&velocity).event(camera.imaging_event());
-        Light {
-            position: at_camera.x,
-            radiance,
-            velocity,
-            inverse_square,
-            timing: timing.delayed(at_camera.t - time),
-        }
-    });
-    Ok((camera, flash))
-}
-
-/// What a light emits: its colour times its intensity, whether it falls off as 1/r², and how
-/// it varies in its proper time.
-type Emitting = (Colour, bool, Timing);
-
-/// A light's `intensity`, `color`, `falloff` and timing (`pulse`, `on` or `table`).
-fn emitting(t: &Table) -> SceneResult<Emitting> {
-    let intensity = t.f64_where("intensity", Some(1.0), |v| v >= 0.0, "0 or more")?;
-    let color = t
-        .colour("color", Role::Emitter)?
-        .unwrap_or_else(|| Colour::grey(1.0, Role::Emitter));
-    let inverse_square = match t.string("falloff")?.unwrap_or("none") {
-        "none" => false,
-        "inverse_square" => true,
-        other => {
-            let n = t.get("falloff").expect("read above");
-            return Err(t.error_at(
-                n,
-                "falloff",
-                format!("unknown falloff `{other}` (none, inverse_square)"),
-            ));
-        }
-    };
-    Ok((color.scaled(intensity), inverse_square, timing::read(t)?))
-}
-
-/// `[camera] flash`: a point light riding with the camera (the radar world).
-fn flash(t: &Table) -> SceneResult<Emitting> {
-    let e = emitting(t)?;
-    let keys = ["intensity", "color", "falloff"];
-    t.finish(&[&keys[..], &TIMING_KEYS[..]].concat())?;
-    Ok(e)
-}
-
 fn image(t: &Table, frame: FrameSize) -> SceneResult<ImageSettings> {
     let width = t.uint("width", Some(512), 1, 1 << 20)? as u32;
     let height = t.uint("height", Some(512), 1, 1 << 20)? as u32;
@@ -679,64 +506,6 @@ fn image(t: &Table, frame: FrameSize) -> SceneResult<ImageSettings> {
     Ok(s)
 }
 
-fn film(t: &Table, camera: &Camera) -> SceneResult<Film> {
-    let start = t.f64_or("start", camera.time)?;
-    let end = t.f64_where("end", None, |_| true, "the last frame's view time")?;
-    if end < start {
-        return Err(t.error(
-            "end",
-            format!("must not be before start ({start:?}); got {end:?}"),
-        ));
-    }
-    let positive = |v: f64| v > 0.0;
-    let spacing = match (t.has("fps"), t.has("step")) {
-        (true, true) => return Err(t.error("step", "give fps or step, not both")),
-        (true, false) => FrameSpacing::Fps(t.f64_where("fps", None, positive, "more than 0")?),
-        (false, true) => FrameSpacing::Step(t.f64_where("step", None, positive, "more than 0")?),
-        (false, false) => return Err(t.error(
-            "fps",
-            "missing: give fps (frames per unit of world time) or step (world time between frames)",
-        )),
-    };
-    let clock = match t.string("clock")?.unwrap_or("world") {
-        "world" => Clock::World,
-        "proper" => Clock::Proper,
-        other => {
-            let n = t.get("clock").expect("read above");
-            return Err(t.error_at(
-                n,
-                "clock",
-                format!("unknown clock `{other}` (world, proper)"),
-            ));
-        }
-    };
-    let f = Film {
-        start,
-        end,
-        spacing,
-        clock,
-    };
-    let n = ((end - start)
-        * match spacing {
-            FrameSpacing::Fps(x) => x,
-            FrameSpacing::Step(x) => 1.0 / x,
-        })
-    .floor();
-    if n >= MAX_FRAMES as f64 {
-        let key = if t.has("fps") { "fps" } else { "step" };
-        return Err(t.error(
-            key,
-            // Frames 0 ..= n: n + 1 of them.
-            format!(
-                "the film would have {:.0} frames; at most {MAX_FRAMES} are allowed",
-                n + 1.0
-            ),
-        ));
-    }
-    t.finish(&["start", "end", "fps", "step", "clock"])?;
-    Ok(f)
-}
-
 fn render_settings(t: &Table) -> SceneResult<RenderSettings> {
     let d = RenderSettings::default();
     let s = RenderSettings {
@@ -767,56 +536,4 @@ fn render_settings(t: &Table) -> SceneResult<RenderSettings> {
         "seed",
     ])?;
     Ok(s)
-}
-
-fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
-    let position = t.req_vec3("position")?;
-    let (radiance, inverse_square, timing) = emitting(t)?;
-    let own = velocity(t, "velocity_direction")?;
-    let velocity = match (t.string("group")?, own) {
-        (Some(_), Some(_)) => {
-            return Err(t.error("group", "give either `group` or a velocity, not both"))
-        }
-        (Some(g), None) => match groups.iter().find(|x| x.name == g) {
-            Some(x) if x.during.is_some() => {
-                return Err(t.error(
-                    "group",
-                    format!("group `{g}` has a worldline of several segments: a light resting in it is not built yet (give the light its own velocity)"),
-                ))
-            }
-            Some(x) => x.velocity,
-            None => {
-                let names: Vec<&str> = groups.iter().map(|x| x.name.as_str()).collect();
-                let n = t.get("group").expect("read above");
-                return Err(t.error_at(
-                    n,
-                    "group",
-                    format!("no group named `{g}` (groups: {})", names.join(", ")),
-                ));
-            }
-        },
-        (None, v) => v.unwrap_or(Velocity::ZERO),
-    };
-    t.string("name")?;
-    let keys = [
-        "position",
-        "intensity",
-        "color",
-        "group",
-        "falloff",
-        "velocity",
-        "velocity_direction",
-        "beta",
-        "rapidity",
-        "one_minus_beta",
-        "name",
-    ];
-    t.finish(&[&keys[..], &TIMING_KEYS[..]].concat())?;
-    Ok(Light {
-        position,
-        radiance,
-        velocity,
-        inverse_square,
-        timing,
-    })
 }

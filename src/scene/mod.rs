@@ -1,9 +1,11 @@
 //! The scene: its description (camera, image, materials, lights, velocity groups), the TOML
 //! loader with errors that name file, line and key, `--set` overrides, and procedural objects.
 
+mod camera_keys;
 mod colour;
 pub(crate) mod doc;
 mod envelope;
+mod lights;
 mod load;
 mod mesh_file;
 mod model;
