@@ -105,6 +105,12 @@ pub struct WorldGroup {
 }
 
 impl WorldGroup {
+    /// Whether the group is seen at emission events of world time `t` (always, but for a
+    /// worldline's segment); `World::rest_ray` keeps rays to the same times.
+    pub fn shows_at(&self, t: f64) -> bool {
+        self.during.is_none_or(|(a, b)| (a..=b).contains(&t))
+    }
+
     /// The closest hit of each ray in this group (None for inactive rays): through the
     /// accelerator, or the primitives one by one for a group without one.
     fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {

@@ -307,9 +307,10 @@ fn group(
         "object",
         "worldline",
     ])?;
-    if let Some(s) = segments.as_ref().filter(|s| worldline::group_count(s) > 1) {
+    let count = segments.as_deref().map_or(1, worldline::group_count);
+    if count > 1 {
         // Each segment holds a copy of the group's listed primitives.
-        let copies = (worldline::group_count(s) - 1) as u64;
+        let copies = (count - 1) as u64;
         let held = copies.saturating_mul(geometry.prims.len() as u64);
         super::objects::budget(t, "worldline", total, held)?;
         let inside = |m: &Material| m.transmit > 0.0 || m.medium.is_some();
