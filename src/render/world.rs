@@ -21,7 +21,7 @@ mod shadows;
 use crate::accel::{Accelerator, Backend, Faults, Hit, Ray};
 use crate::geometry::{Aabb, Geometry, PACKET};
 use crate::scene::Scene;
-use crate::spacetime::{Boost, NullRay, Velocity};
+use crate::spacetime::{Boost, Event, NullRay, Velocity, Window};
 use glam::DVec3;
 use moving_bounds::MovingBounds;
 pub use primary_hits::PrimaryHits;
@@ -97,18 +97,17 @@ pub struct WorldGroup {
     pub epsilon: f64,
     /// The bounds as they move through the world frame: a test before the boost.
     moving: MovingBounds,
-    /// The world times of the emission events it is seen at (a worldline's segment); None:
-    /// always.
-    pub during: Option<(f64, f64)>,
+    /// The emission events it is seen at (a worldline's segment); None: all.
+    pub window: Option<Window>,
     /// Whether anything in it spins.
     pub spins: bool,
 }
 
 impl WorldGroup {
-    /// Whether the group is seen at emission events of world time `t` (always, but for a
-    /// worldline's segment); `World::rest_ray` keeps rays to the same times.
-    pub fn shows_at(&self, t: f64) -> bool {
-        self.during.is_none_or(|(a, b)| (a..=b).contains(&t))
+    /// Whether the group is seen at emission event `e` (always, but for a worldline's
+    /// segment); `World::rest_ray` keeps rays to the same events.
+    pub fn shows_at(&self, e: Event) -> bool {
+        self.window.is_none_or(|w| w.contains(e))
     }
 
     /// The closest hit of each ray in this group (None for inactive rays): through the
@@ -257,7 +256,7 @@ impl World {
                 accel: g.accel.clone(),
                 epsilon: g.epsilon,
                 moving: MovingBounds::new(&g.bounds, &g.velocity, event.t),
-                during: g.during,
+                window: g.window,
                 spins: g.spins,
             })
             .collect();
@@ -361,20 +360,14 @@ impl World {
 
     /// Boost into group g's rest frame; None when the ray misses the group's bounds in
     /// (tmin, tmax). The origin moves along the ray to where it enters the bounds, so the
-    /// backend never sees large coordinates (docs/physics.md §7.1). A group seen only at some
-    /// world times (a worldline's segment) is met only where the ray's emission time
-    /// `origin.t − λ` lies within them (docs/physics.md §12.4).
+    /// backend never sees large coordinates (docs/physics.md §7.1). A group seen only in a
+    /// window (a worldline's segment) is met only where the ray's emission event lies in it
+    /// (docs/physics.md §12.4).
     #[inline(always)]
     fn rest_ray(&self, g: &WorldGroup, ray: &NullRay, tmin: f64, tmax: f64) -> Option<RestRay> {
-        let (tmin, tmax) = match g.during {
+        let (tmin, tmax) = match &g.window {
             None => (tmin, tmax),
-            Some((from, to)) => {
-                let (lo, hi) = (tmin.max(ray.origin.t - to), tmax.min(ray.origin.t - from));
-                if lo >= hi {
-                    return None;
-                }
-                (lo, hi)
-            }
+            Some(w) => w.lookbacks(ray, tmin, tmax)?,
         };
         // Every primary ray starts at the imaging event: its rest-frame origin is per group.
         let origin = if ray.origin == self.event {

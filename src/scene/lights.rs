@@ -51,7 +51,7 @@ pub(super) fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
             return Err(t.error("group", "give either `group` or a velocity, not both"))
         }
         (Some(g), None) => match groups.iter().find(|x| x.name == g) {
-            Some(x) if x.during.is_some() => {
+            Some(x) if x.window.is_some() => {
                 return Err(t.error(
                     "group",
                     format!("group `{g}` has a worldline of several segments: a light resting in it is not built yet (give the light its own velocity)"),

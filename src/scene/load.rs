@@ -332,7 +332,7 @@ fn group(
             name: name.to_string(),
             velocity,
             geometry,
-            during: None,
+            window: None,
         }],
     })
 }
@@ -410,7 +410,7 @@ fn fog(t: &Table, groups: &[Group], materials: &mut Vec<Material>) -> SceneResul
     let Some(group) = groups.iter().position(|g| g.name == name) else {
         return Err(t.error("group", format!("no group is named `{name}`")));
     };
-    if groups[group].during.is_some() {
+    if groups[group].window.is_some() {
         return Err(t.error(
             "group",
             format!("group `{name}` has a worldline of several segments: a fog resting in it is not built yet"),

@@ -347,9 +347,9 @@ pub struct Group {
     pub velocity: Velocity,
     /// Its primitives, in its rest frame.
     pub geometry: Arc<Geometry>,
-    /// For one segment of a worldline (`worldline`): the world times (from, to) of the
-    /// emission events at which it is seen; None: at all times.
-    pub during: Option<(f64, f64)>,
+    /// For one segment of a worldline (`worldline`): the emission events at which it is
+    /// seen, between two hyperplanes of simultaneity; None: all.
+    pub window: Option<crate::spacetime::Window>,
 }
 
 /// A `[[group.object]]` of the scene, for naming what a pixel sees.
@@ -429,7 +429,7 @@ impl Scene {
         }
         for g in &mut s.groups {
             g.geometry = Arc::new(g.geometry.translated(rest_shift(&g.velocity)));
-            g.during = g.during.map(|(a, b)| (a + shift.t, b + shift.t));
+            g.window = g.window.map(|w| w.translated(shift));
         }
         s
     }

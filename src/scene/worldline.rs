@@ -267,7 +267,7 @@ pub(crate) fn groups(
             name: name.to_string(),
             velocity: one.velocity,
             geometry,
-            during: None,
+            window: None,
         }]);
     }
     segments
@@ -298,7 +298,7 @@ pub(crate) fn groups(
                 name: name.to_string(),
                 velocity: s.velocity,
                 geometry,
-                during: Some((a, b)),
+                window: Some(crate::spacetime::Window::world(a, b)),
             })
         })
         .collect()

@@ -10,6 +10,7 @@ mod null_ray;
 mod pinhole;
 mod retarded;
 mod velocity;
+mod window;
 
 pub use boost::Boost;
 pub use event::Event;
@@ -17,3 +18,4 @@ pub use null_ray::NullRay;
 pub use pinhole::Pinhole;
 pub use retarded::{retarded_delay, retarded_position};
 pub use velocity::{Velocity, VelocityError};
+pub use window::{Slice, Window};

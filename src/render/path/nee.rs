@@ -178,8 +178,7 @@ impl<B: Band> PathTracer<'_, '_, B> {
         }
         let ray = NullRay::new(from, dir_w);
         // A worldline's segment shines only at its own times (as `World::rest_ray` sees it).
-        let emitted = from.t - dist * k_world;
-        if !ge.shows_at(emitted) {
+        if !ge.shows_at(ray.at(dist * k_world)) {
             return;
         }
         let tmax = dist * k_world * (1.0 - 1e-6);

@@ -20,7 +20,7 @@ impl World {
             return None;
         };
         if !self.options.fused_primary
-            || g.during.is_some()
+            || g.window.is_some()
             || g.spins
             || self.clip_rays
             || self.primary_tree.is_some()

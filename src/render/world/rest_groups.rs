@@ -6,7 +6,7 @@ use super::WorldOptions;
 use crate::accel::{Accelerator, Backend};
 use crate::geometry::{Aabb, Geometry, ImplicitRun};
 use crate::scene::Scene;
-use crate::spacetime::{Boost, Velocity};
+use crate::spacetime::{Boost, Velocity, Window};
 use std::sync::Arc;
 
 /// A group of the world as it is in its rest frame, whatever the camera: its merged geometry
@@ -18,8 +18,8 @@ pub(super) struct RestGroup {
     pub geometry: Arc<Geometry>,
     pub accel: Option<Arc<dyn Accelerator>>,
     pub epsilon: f64,
-    /// The world times of the emission events it is seen at (a worldline's segment).
-    pub during: Option<(f64, f64)>,
+    /// The emission events it is seen at (a worldline's segment).
+    pub window: Option<Window>,
     /// Whether anything in it spins (its hits then move into their points' frames).
     pub spins: bool,
 }
@@ -39,8 +39,8 @@ impl RestGroups {
         options: WorldOptions,
     ) -> crate::Result<RestGroups> {
         // Which scene groups share a rest frame and the times they are seen at, in file order.
-        type Key = ([u64; 4], Option<(u64, u64)>);
-        type Set = (Velocity, Option<(f64, f64)>, Vec<usize>);
+        type Key = ([u64; 4], Option<[u64; 10]>);
+        type Set = (Velocity, Option<Window>, Vec<usize>);
         let mut sets: Vec<Set> = Vec::new();
         let mut index: std::collections::HashMap<Key, usize> = std::collections::HashMap::new();
         for (i, g) in scene.groups.iter().enumerate() {
@@ -48,20 +48,17 @@ impl RestGroups {
                 continue;
             }
             let v = g.velocity;
-            let key = (
-                v.identity_key(),
-                g.during.map(|(a, b)| (a.to_bits(), b.to_bits())),
-            );
+            let key = (v.identity_key(), g.window.map(|w| w.key()));
             match index.get(&key).filter(|_| options.merge_equal_velocities) {
                 Some(&k) => sets[k].2.push(i),
                 None => {
                     index.insert(key, sets.len());
-                    sets.push((v, g.during, vec![i]));
+                    sets.push((v, g.window, vec![i]));
                 }
             }
         }
         let mut groups = Vec::with_capacity(sets.len());
-        for (velocity, during, members) in sets {
+        for (velocity, window, members) in sets {
             let geos: Vec<&Arc<Geometry>> =
                 members.iter().map(|&i| &scene.groups[i].geometry).collect();
             let mut geometry = merge(&geos);
@@ -97,7 +94,7 @@ impl RestGroups {
                 // Relative to the group's size and place alone, so that a scene scaled as a
                 // whole renders the same (tests/envelope.rs).
                 epsilon: 1e-7 * bounds.diagonal() + 1e-12 * bounds.max_abs(),
-                during,
+                window,
                 spins,
             });
         }
