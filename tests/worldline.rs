@@ -144,7 +144,7 @@ fn bad_worldlines_name_the_key() {
         ),
         (
             "worldline = [{ until = 2, acceleration = [0.1, 0, 0] }]",
-            "worldline.0.acceleration`: segments of constant proper acceleration are not built yet",
+            "worldline.0.acceleration`: the first segment cannot accelerate",
         ),
         (
             "worldline = [{ until = 2, velocity = [1.2, 0, 0] }, { velocity = [0, 0, 0] }]",

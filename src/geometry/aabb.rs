@@ -101,6 +101,15 @@ impl Aabb {
         2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
     }
 
+    /// The farthest the box reaches along `dir`: the largest p·dir over its points.
+    pub fn support(&self, dir: DVec3) -> f64 {
+        let pick = |k: usize| {
+            let (lo, hi) = (self.min[k] * dir[k], self.max[k] * dir[k]);
+            lo.max(hi)
+        };
+        pick(0) + pick(1) + pick(2)
+    }
+
     /// The largest absolute coordinate of the box.
     pub fn max_abs(&self) -> f64 {
         self.min.abs().max(self.max.abs()).max_element()

@@ -350,7 +350,7 @@ impl<'a, B: Band> Shader<'a, B> {
                 s_surface,
                 dist,
                 atten,
-            } = l.toward(from, event, g, lit.spin.as_ref())?;
+            } = l.toward(from, event, g, lit.own_frame.as_ref())?;
             let ndl = nf.dot(to_light);
             if ndl <= 0.0 {
                 return None;
@@ -426,7 +426,10 @@ impl<'a, B: Band> Shader<'a, B> {
             inside,
             shift,
             spread: 0.0,
-            spin: part.spin.and_then(|sp| sp.boost_at(hit.point)),
+            own_frame: match &g.accelerated {
+                Some(acc) => Some(crate::render::world::point_boost(acc, g.boost.event(event))),
+                None => part.spin.and_then(|sp| sp.boost_at(hit.point)),
+            },
         }
     }
 
@@ -523,8 +526,9 @@ impl<'a, B: Band> Shader<'a, B> {
                         return 1 + spent;
                     }
                 }
-                // A spinning point's directions are in its own frame: into the group's first.
-                let (dir, spun) = match &lit.spin {
+                // A spinning or accelerated point's directions are in its own frame: into the
+                // group's first.
+                let (dir, spun) = match &lit.own_frame {
                     Some(b) => {
                         let (d, _) = b.inverse().view_dir(dir);
                         (d, b.null_dir(d).1)
@@ -632,9 +636,11 @@ pub struct Lit<'a> {
     /// The solid angle, in the surface's frame, of the bundle the ray that hit stands for (0:
     /// none is followed).
     spread: f64,
-    /// Where the object spins: the boost from its group's frame into the point's own, where
-    /// it is shaded (its hit's direction and factor are there already, `World::spun`).
-    pub(super) spin: Option<Boost>,
+    /// Where the point moves in its group's frame (a spinning object, a group on an
+    /// accelerated segment): the boost from the group's frame into the point's own, where it
+    /// is shaded (its hit's direction and factor are there already, `World::spun`,
+    /// `World::surface_hit`).
+    pub(super) own_frame: Option<Boost>,
 }
 
 impl Lit<'_> {

@@ -13,6 +13,8 @@ use super::apparent_tree::ApparentTree;
 use super::group_tree::SlicedGroupTree;
 use super::light_tree::LightTree;
 
+mod accelerated;
+pub(crate) use accelerated::point_boost;
 mod moving_bounds;
 mod rest_groups;
 pub use rest_groups::RestGroups;
@@ -101,6 +103,9 @@ pub struct WorldGroup {
     pub window: Option<Window>,
     /// Whether anything in it spins.
     pub spins: bool,
+    /// Its hyperbolic motion, for a segment of constant proper acceleration (its rays start
+    /// on the segment's start hyperplane, `World::rest_ray`).
+    pub accelerated: Option<crate::scene::Accelerated>,
 }
 
 impl WorldGroup {
@@ -113,6 +118,12 @@ impl WorldGroup {
     /// The closest hit of each ray in this group (None for inactive rays): through the
     /// accelerator, or the primitives one by one for a group without one.
     fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        if let Some(acc) = &self.accelerated {
+            for (r, h) in rays.iter().zip(hits.iter_mut()) {
+                *h = accelerated::intersect(acc, &self.geometry, r);
+            }
+            return;
+        }
         if let Some(accel) = &self.accel {
             return accel.intersect(rays, hits);
         }
@@ -133,6 +144,12 @@ impl WorldGroup {
 
     /// Whether anything of this group lies on each ray (false for inactive rays).
     fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
+        if let Some(acc) = &self.accelerated {
+            for (r, o) in rays.iter().zip(out.iter_mut()) {
+                *o = accelerated::occluded(acc, &self.geometry, r);
+            }
+            return;
+        }
         if let Some(accel) = &self.accel {
             return accel.occluded(rays, out);
         }
@@ -258,6 +275,7 @@ impl World {
                 moving: MovingBounds::new(&g.bounds, &g.velocity, event.t),
                 window: g.window,
                 spins: g.spins,
+                accelerated: g.accelerated,
             })
             .collect();
         let (tree, primary_tree, light_trees) =
@@ -369,6 +387,9 @@ impl World {
             None => (tmin, tmax),
             Some(w) => w.lookbacks(ray, tmin, tmax)?,
         };
+        if let Some(acc) = &g.accelerated {
+            return self.rest_ray_accelerated(g, acc, ray, tmin, tmax);
+        }
         // Every primary ray starts at the imaging event: its rest-frame origin is per group.
         let origin = if ray.origin == self.event {
             g.event_rest
@@ -395,7 +416,48 @@ impl World {
         })
     }
 
-    fn surface_hit(gi: usize, rr: &RestRay, h: Hit) -> SurfaceHit {
+    /// [`World::rest_ray`] into an accelerated segment's start frame S': the ray moved along
+    /// itself to where it crosses the segment's start hyperplane (so its S' time there is the
+    /// origin's start time), after the cull by the bounds the body sweeps through.
+    fn rest_ray_accelerated(
+        &self,
+        g: &WorldGroup,
+        acc: &crate::scene::Accelerated,
+        ray: &NullRay,
+        tmin: f64,
+        tmax: f64,
+    ) -> Option<RestRay> {
+        let origin = g.boost.event(ray.origin);
+        let (dir, s) = g.boost.null_dir(ray.dir);
+        if self.clip_rays {
+            g.bounds.clip(origin.x, dir.recip(), tmin, tmax)?;
+        }
+        let shift = (origin.t - acc.start.t) / s;
+        Some(RestRay {
+            ray: Ray {
+                origin: origin.x + shift * dir,
+                dir,
+                tmin: tmin - shift,
+                tmax: tmax - shift,
+                len: s,
+            },
+            shift,
+            s,
+        })
+    }
+
+    fn surface_hit(&self, gi: usize, rr: &RestRay, h: Hit) -> SurfaceHit {
+        if let Some(acc) = &self.groups[gi].accelerated {
+            let (point, _, dir, s) = accelerated::point_frame(acc, &rr.ray, h.t);
+            return SurfaceHit {
+                group: gi,
+                prim: h.prim,
+                lambda: rr.shift + h.t,
+                point,
+                dir,
+                s,
+            };
+        }
         SurfaceHit {
             group: gi,
             prim: h.prim,
@@ -483,7 +545,7 @@ impl World {
                             shift: shift[i],
                             s: factor[i],
                         };
-                        let hit = self.spun(Self::surface_hit(gi, &rr, h));
+                        let hit = self.spun(self.surface_hit(gi, &rr, h));
                         if hit.lambda < best[i] {
                             best[i] = hit.lambda;
                             out[i] = Some(hit);
@@ -532,7 +594,7 @@ impl World {
             return None;
         }
         let rr = self.rest_ray(g, ray, tmin, tmax)?;
-        let sh = self.spun(Self::surface_hit(gi, &rr, g.intersect1(&rr.ray)?));
+        let sh = self.spun(self.surface_hit(gi, &rr, g.intersect1(&rr.ray)?));
         (sh.lambda < tmax).then_some(sh)
     }
 

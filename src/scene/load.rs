@@ -205,6 +205,12 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
             "spinning objects are not built yet for integrator = \"path\" (Whitted shades them in each point's own frame)",
         ));
     }
+    if render.integrator == Integrator::Path && groups.iter().any(|g| g.accelerated.is_some()) {
+        return Err(root.error(
+            "render",
+            "groups on accelerated segments are not built yet for integrator = \"path\" (Whitted shades them in each point's own frame)",
+        ));
+    }
     let mut lights = Vec::new();
     for t in root.tables("light")? {
         lights.push(light(&t, &groups)?);
@@ -325,6 +331,11 @@ fn group(
             ));
         }
     }
+    if segments.as_deref().is_some_and(worldline::accelerates) {
+        if let Some(why) = worldline::accelerated_refusal(&geometry) {
+            return Err(t.error("worldline", why));
+        }
+    }
     let geometry = Arc::new(geometry);
     Ok(match segments {
         Some(s) => worldline::groups(t, name, geometry, &s)?,
@@ -333,6 +344,7 @@ fn group(
             velocity,
             geometry,
             window: None,
+            accelerated: None,
         }],
     })
 }

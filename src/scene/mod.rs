@@ -28,8 +28,8 @@ pub(crate) use load::load_file_as;
 pub use load::{load_file, load_str, FrameSize};
 pub(crate) use model::MAX_FRAME_PIXELS;
 pub use model::{
-    Camera, Clock, Film, Fog, FrameSpacing, Group, ImageSettings, Integrator, Light, Material,
-    Medium, ObjectInfo, Projection, RenderSettings, Scene,
+    Accelerated, Camera, Clock, Film, Fog, FrameSpacing, Group, ImageSettings, Integrator, Light,
+    Material, Medium, ObjectInfo, Projection, RenderSettings, Scene,
 };
 pub use pass_set::{Pass, PassSet};
 pub use texture::{ImageTexture, Sample as TextureSample, Sky, Texture};

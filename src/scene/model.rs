@@ -350,6 +350,25 @@ pub struct Group {
     /// For one segment of a worldline (`worldline`): the emission events at which it is
     /// seen, between two hyperplanes of simultaneity; None: all.
     pub window: Option<crate::spacetime::Window>,
+    /// For a segment of constant proper acceleration: how its geometry moves through the
+    /// frame it starts at rest in (`velocity` is that frame's).
+    pub accelerated: Option<Accelerated>,
+}
+
+/// A group's hyperbolic motion (docs/physics.md §12.7), in the frame S' it starts at rest in:
+/// its origin starts at `start` and moves with proper acceleration `a` along `axis`; every
+/// point keeps its place relative to the origin in the frame moving with it (Born-rigid). Its
+/// geometry is its shape in that moving frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Accelerated {
+    /// The origin's start event, in S'.
+    pub start: Event,
+    /// The proper acceleration of the origin, a > 0.
+    pub a: f64,
+    /// The unit direction of the acceleration (in S').
+    pub axis: glam::DVec3,
+    /// The origin's rapidity (relative to S') at the end of the segment.
+    pub theta_end: f64,
 }
 
 /// A `[[group.object]]` of the scene, for naming what a pixel sees.
@@ -428,8 +447,12 @@ impl Scene {
             l.timing = l.timing.delayed(own.t);
         }
         for g in &mut s.groups {
-            g.geometry = Arc::new(g.geometry.translated(rest_shift(&g.velocity)));
             g.window = g.window.map(|w| w.translated(shift));
+            match &mut g.accelerated {
+                // Its shape is in the frame moving with it: its start moves instead.
+                Some(acc) => acc.start = acc.start + Boost::to_rest(&g.velocity).event(shift),
+                None => g.geometry = Arc::new(g.geometry.translated(rest_shift(&g.velocity))),
+            }
         }
         s
     }

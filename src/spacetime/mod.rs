@@ -6,6 +6,7 @@
 
 mod boost;
 mod event;
+mod hyperbola;
 mod null_ray;
 mod pinhole;
 mod retarded;
@@ -14,6 +15,7 @@ mod window;
 
 pub use boost::Boost;
 pub use event::Event;
+pub use hyperbola::{cosh_m1, Hyperbola};
 pub use null_ray::NullRay;
 pub use pinhole::Pinhole;
 pub use retarded::{retarded_delay, retarded_position};

@@ -25,7 +25,7 @@ impl LightRt<'_> {
         from: Event,
         lit: Event,
         g: &WorldGroup,
-        spin: Option<&Boost>,
+        own_frame: Option<&Boost>,
     ) -> Option<ToLight> {
         let at_light = self.to_light.event(from);
         let delta = self.light.position - at_light.x;
@@ -50,8 +50,8 @@ impl LightRt<'_> {
         };
         let (dir_w, k) = self.from_light.view_dir(delta / dist);
         let (mut to_light, mut s_surface) = g.boost.view_dir(dir_w);
-        // A spinning point is lit in its own frame.
-        if let Some(b) = spin {
+        // A spinning or accelerated point is lit in its own frame.
+        if let Some(b) = own_frame {
             let (d, s) = b.view_dir(to_light);
             (to_light, s_surface) = (d, s_surface * s);
         }

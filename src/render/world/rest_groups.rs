@@ -22,6 +22,8 @@ pub(super) struct RestGroup {
     pub window: Option<Window>,
     /// Whether anything in it spins (its hits then move into their points' frames).
     pub spins: bool,
+    /// Its hyperbolic motion, for a segment of constant proper acceleration.
+    pub accelerated: Option<crate::scene::Accelerated>,
 }
 
 /// The world's groups, built once: the part of a world that a film's frames share (the
@@ -39,7 +41,8 @@ impl RestGroups {
         options: WorldOptions,
     ) -> crate::Result<RestGroups> {
         // Which scene groups share a rest frame and the times they are seen at, in file order.
-        type Key = ([u64; 4], Option<[u64; 10]>);
+        // An accelerated segment is never merged (its key holds its index).
+        type Key = ([u64; 4], Option<[u64; 10]>, Option<usize>);
         type Set = (Velocity, Option<Window>, Vec<usize>);
         let mut sets: Vec<Set> = Vec::new();
         let mut index: std::collections::HashMap<Key, usize> = std::collections::HashMap::new();
@@ -48,7 +51,11 @@ impl RestGroups {
                 continue;
             }
             let v = g.velocity;
-            let key = (v.identity_key(), g.window.map(|w| w.key()));
+            let key = (
+                v.identity_key(),
+                g.window.map(|w| w.key()),
+                g.accelerated.map(|_| i),
+            );
             match index.get(&key).filter(|_| options.merge_equal_velocities) {
                 Some(&k) => sets[k].2.push(i),
                 None => {
@@ -68,12 +75,16 @@ impl RestGroups {
                 // best; large ones stay themselves, to be instanced.
                 geometry = Arc::new(geometry.listing(options.instance_over));
             }
-            let bounds = geometry.bounds();
+            let accelerated = scene.groups[members[0]].accelerated;
+            let bounds = match &accelerated {
+                Some(acc) => super::accelerated::swept_bounds(acc, geometry.bounds()),
+                None => geometry.bounds(),
+            };
             let names: Vec<&str> = members
                 .iter()
                 .map(|&i| scene.groups[i].name.as_str())
                 .collect();
-            let accel = if geometry.len() as usize <= options.direct_max {
+            let accel = if geometry.len() as usize <= options.direct_max || accelerated.is_some() {
                 None
             } else {
                 Some(Arc::from(backend.build(geometry.clone()).map_err(|e| {
@@ -96,6 +107,7 @@ impl RestGroups {
                 epsilon: 1e-7 * bounds.diagonal() + 1e-12 * bounds.max_abs(),
                 window,
                 spins,
+                accelerated,
             });
         }
         Ok(RestGroups { groups, options })
