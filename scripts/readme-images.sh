@@ -54,7 +54,6 @@ for k in 14 22 40 56 76 96; do
 done
 oiiotool "${frames[@]}" --mosaic 3x2 -o "$o/twin-film.png"
 rm -rf "$film"
-echo "wrote $(ls "$o" | wc -l) images to $o"
 # The lattice at 0.9c with the shutter open for 0.12 of the camera's time.
 $r render scenes/lattice.toml -o "$o/lattice-shutter-0.9.png" "${size[@]}" --samples 32 --set 'group.lattice.velocity=[-0.9, 0, 0]' --set camera.shutter=0.12
 # Six frames of the train accelerating Born-rigidly past a camera at rest.
@@ -66,3 +65,4 @@ for k in 8 20 32 44 56 68; do
 done
 oiiotool "${frames[@]}" --mosaic 3x2 -o "$o/accelerating-train.png"
 rm -r "$film"
+echo "wrote $(ls "$o" | wc -l) images to $o"

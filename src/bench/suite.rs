@@ -237,6 +237,28 @@ fn time_cases(px: u32, out: &mut Vec<LazyCase>) {
                 .beside("the same planet still", still),
         )
     }));
+    // The train accelerating Born-rigidly past the camera against the same train at rest:
+    // every ray tries each car in closed form, in Rindler coordinates, without a tree.
+    out.push(LazyCase::new("train accelerating at 0.5", move || {
+        const TRAIN: &str = include_str!("../../scenes/accelerating_train.toml");
+        let motion = "worldline = [{ until = 0.0, velocity = [0, 0, 0] }, { until = 8.0, acceleration = [0.5, 0, 0] }]";
+        assert!(TRAIN.contains(motion), "the bench's train is the scene's");
+        let mut s = size(px);
+        s.push("camera.time=18".into());
+        let sets: Vec<(String, String)> = s
+            .iter()
+            .map(|x| (format!("--set {x}"), x.clone()))
+            .collect();
+        let load = |text: &str| load_str("scenes/accelerating_train.toml", text, &sets);
+        let still = load(&TRAIN.replacen(motion, "velocity = [0, 0, 0]", 1))?;
+        Ok(Case::new(
+            "train accelerating at 0.5",
+            load(TRAIN)?,
+            &["embree", "bvh"],
+        )
+        .without_hi_reference()
+        .beside("the same train at rest", still))
+    }));
     // An open shutter: every sample from its own event, so no fans and no screen cull.
     out.push(LazyCase::new("lattice beta=0.9, shutter 0.5", move || {
         let mut s = size(px);
