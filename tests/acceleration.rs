@@ -179,6 +179,84 @@ fn an_accelerating_sphere_is_where_the_search_along_the_ray_finds_it() {
     );
 }
 
+/// Where the light cone of the view cuts the segment's end, the coasting piece after it takes
+/// over on the hyperplane of simultaneity of the frame moving with the body there. The
+/// independent model, piece by piece: at rest before world time 0; Rindler coordinates between;
+/// after, at rest in the frame S_end moving at rapidity θ_end, whose time T cosh θ_end − X sinh
+/// θ_end (about the horizon) is then positive and in which the body keeps its shape at
+/// X_e = 1/a + ξ.
+#[test]
+fn the_coast_after_the_acceleration_takes_over_on_the_moving_frames_simultaneity() {
+    let (a, until, time) = (0.25f64, 4.5f64, 14.0f64);
+    let theta_end = (a * until).asinh();
+    let (ce, se) = (theta_end.cosh(), theta_end.sinh());
+    // The shape point at lookback λ along the ray through pixel centre u, and its piece.
+    let point = |u: f64, lambda: f64| -> (DVec3, u8) {
+        let d = DVec3::new(u, F, 0.0).normalize();
+        let t = time - lambda;
+        let p = DVec3::new(0.0, -10.0, 0.0) + lambda * d;
+        if t < 0.0 {
+            return (p, 0);
+        }
+        let x = 1.0 / a + p.x;
+        let t_end = t * ce - x * se;
+        if t_end >= 0.0 {
+            let x_end = x * ce - t * se;
+            return (DVec3::new(x_end - 1.0 / a, p.y, p.z), 2);
+        }
+        let rho = (x * x - t * t).sqrt();
+        (DVec3::new(rho - 1.0 / a, p.y, p.z), 1)
+    };
+    let first = |u: f64| -> Option<(f64, u8)> {
+        let inside = |l: f64| point(u, l).0.length() < 1.0;
+        let mut l = 0.0;
+        while l < 40.0 {
+            if inside(l + 1e-3) {
+                let (mut lo, mut hi) = (l, l + 1e-3);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    if inside(mid) {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                return Some((hi, point(u, hi).1));
+            }
+            l += 1e-3;
+        }
+        None
+    };
+    let row = (H / 2) as usize * W as usize;
+    for backend in backends() {
+        let f = render_with(&scene(&accelerating(a, until, time, 1)), backend);
+        let (alpha, lookback) = (f.channel("A").unwrap(), f.channel("lookback.V").unwrap());
+        let (mut pieces, mut worst) = ([0; 3], 0.0f64);
+        for x in 0..W as usize {
+            let u = x as f64 + 0.5 - W as f64 / 2.0;
+            let truth = first(u);
+            let i = row + x;
+            assert_eq!(alpha[i] > 0.0, truth.is_some(), "{backend}: pixel {x}");
+            if let Some((lambda, piece)) = truth {
+                pieces[piece as usize] += 1;
+                worst = worst.max((lookback[i] as f64 / lambda - 1.0).abs());
+            }
+        }
+        assert!(
+            pieces[1] > 5 && pieces[2] > 5,
+            "{backend}: both pieces seen: {pieces:?}"
+        );
+        report(
+            "accelerating sphere across its segment's end: lookback",
+            backend,
+            0.0,
+            worst,
+            1e-6,
+            "relative",
+        );
+    }
+}
+
 /// As the acceleration goes to zero, the accelerated segment's picture becomes the uniform one:
 /// the same pixels covered and lookbacks that differ by O(a).
 #[test]
@@ -329,6 +407,10 @@ fn bad_accelerations_name_the_key() {
             "primitives: a group with an accelerated segment is intersected primitive by primitive, at most 4096",
         ),
         (
+            base("worldline = [{ until = 0, velocity = [0.5, 0, 0] }, { until = 3, acceleration = [0, 0.1, 0] }]", sphere),
+            "a segment accelerates across the velocity it starts with",
+        ),
+        (
             format!("[render]\nintegrator = \"path\"\n{}", base("worldline = [{ until = 0, velocity = [0, 0, 0] }, { until = 3, acceleration = [0.1, 0, 0] }]", sphere)),
             "groups on accelerated segments are not built yet for integrator = \"path\"",
         ),
@@ -338,5 +420,23 @@ fn bad_accelerations_name_the_key() {
             .unwrap_err()
             .to_string();
         assert!(e.contains(needle), "{text}\n{e}");
+    }
+}
+
+/// Moving the whole scene (camera, groups, the accelerated segment's start) by a spacetime
+/// translation leaves the picture: the segment's start moves in its own frame, its shape not.
+#[test]
+fn a_translated_scene_with_an_accelerated_segment_renders_the_same() {
+    use rest_embree::spacetime::Event;
+    let s = scene(&accelerating(0.25, 4.5, 14.0, 1));
+    for backend in backends() {
+        let a = render_with(&s, backend);
+        for shift in [
+            Event::new(3.0, DVec3::new(2.0, -1.0, 0.5)),
+            Event::new(-40.0, DVec3::new(100.0, 0.0, -30.0)),
+        ] {
+            let b = render_with(&s.translated(shift), backend);
+            same_picture(&a, &b, "translated", 2.0 / (W * H) as f64, 1e-4);
+        }
     }
 }

@@ -242,6 +242,15 @@ pub fn needs_spectra(scene: &Scene) -> bool {
     if colours.iter().any(|c| !c.from_rgb) {
         return true;
     }
+    // Points that move within their group's frame (accelerated segments, spin) are shaded in
+    // frames of their own.
+    if scene
+        .groups
+        .iter()
+        .any(|g| g.accelerated.is_some() || g.geometry.spins())
+    {
+        return true;
+    }
     let mut frames = vec![scene.camera.velocity.identity_key()];
     frames.extend(scene.lights.iter().map(|l| l.velocity.identity_key()));
     frames.extend(

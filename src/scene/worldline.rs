@@ -519,8 +519,20 @@ pub(crate) fn groups(
                     })
                 }
                 Piece::Accelerated(h) => {
+                    // Accelerated across its motion, a body's frame at the end is the plain
+                    // boost to its velocity turned by a Thomas-Wigner rotation, which the
+                    // segments after it do not carry yet.
+                    let across = h.v0.direction().cross(h.axis).length();
+                    if !h.v0.is_zero() && across > 1e-9 {
+                        return Err(t.error(
+                            "worldline",
+                            "a segment accelerates across the velocity it starts with: only along it (or from rest) is built yet (the body would come out of it turned by a Thomas-Wigner rotation)".to_string(),
+                        ));
+                    }
                     let start = h.to_start_frame().event(h.start);
-                    let reach = start.x.abs().max_element() + geometry.bounds().max_abs();
+                    let sweep = (1.0 / h.a + geometry.bounds().support(h.axis))
+                        * crate::spacetime::cosh_m1(h.theta_at(b));
+                    let reach = start.x.abs().max_element() + geometry.bounds().max_abs() + sweep;
                     if reach > super::envelope::MAX_MAGNITUDE {
                         return Err(too_far(reach));
                     }

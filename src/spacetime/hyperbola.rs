@@ -71,24 +71,31 @@ impl Hyperbola {
     /// `sinh θ + b (cosh θ − 1) = k`, a quadratic in e^θ; e^θ − 1 is formed without
     /// cancellation, so tiny accelerations keep their digits.
     pub fn theta_at(&self, t: f64) -> f64 {
-        let b = self.v0.beta_vec().dot(self.axis);
+        let (beta, c) = (self.v0.beta(), self.v0.direction().dot(self.axis));
+        // 1 ± b from 1 − β where b is near ∓1 (a speed near c along ∓â), exact there.
+        let om = self.v0.one_minus_beta();
+        let one_plus_b = if c < 0.0 {
+            om + beta * (1.0 + c)
+        } else {
+            1.0 + beta * c
+        };
+        let one_minus_b = if c > 0.0 {
+            om + beta * (1.0 - c)
+        } else {
+            1.0 - beta * c
+        };
+        let b = beta * c;
         let k = self.a * (t - self.start.t) / self.v0.gamma();
         let big_b = b + k;
-        let s = (big_b * big_b + (1.0 - b) * (1.0 + b)).sqrt();
-        // S + B, and S − 1 = (B² − b²)/(S + 1), without subtracting near-equal numbers.
-        let s_plus_b = if big_b >= 0.0 {
-            s + big_b
+        let s = (big_b * big_b + one_minus_b * one_plus_b).sqrt();
+        // e^θ = u, the root of (1 + b)u² − 2Bu − (1 − b) = 0 that is positive, in the form
+        // that subtracts nothing; and u − 1 = k(1 + u)/(S + 1) (as S² − 1 = k(2b + k)).
+        let u = if big_b >= 0.0 {
+            (s + big_b) / one_plus_b
         } else {
-            (1.0 - b) * (1.0 + b) / (s - big_b)
+            one_minus_b / (s - big_b)
         };
-        let s_m1 = k * (2.0 * b + k) / (s + 1.0);
-        // e^θ − 1 = (B + S − 1 − b)/(1 + b) = (k + S − 1)/(1 + b); for k < 0 the other form.
-        let e_m1 = if k >= 0.0 {
-            (k + s_m1) / (1.0 + b)
-        } else {
-            s_plus_b / (1.0 + b) - 1.0
-        };
-        e_m1.ln_1p()
+        (k * (1.0 + u) / (s + 1.0)).ln_1p()
     }
 
     /// The world time at rapidity θ.
@@ -147,12 +154,19 @@ mod tests {
 
     #[test]
     fn theta_at_inverts_time() {
-        for h in sample() {
+        // Braking from a speed near c along −â as well: 1 + b is 1 − β there.
+        let braking = Hyperbola::new(
+            Event::ORIGIN,
+            Velocity::from_one_minus_beta(DVec3::X, 1e-12).unwrap(),
+            DVec3::new(-0.3, 0.0, 0.0),
+        )
+        .unwrap();
+        for h in sample().into_iter().chain([braking]) {
             for theta in [-2.0, -0.3, -1e-7, 0.0, 1e-8, 0.25, 1.0, 4.0] {
                 let t = h.time(theta);
                 let back = h.theta_at(t);
                 assert!(
-                    (back - theta).abs() < 1e-9 * (1.0 + theta.abs()),
+                    (back - theta).abs() <= 1e-12 * theta.abs().max(1e-300) + 1e-15,
                     "{h:?}: θ {theta} → t {t} → {back}"
                 );
             }

@@ -76,6 +76,7 @@ impl RestGroups {
                 geometry = Arc::new(geometry.listing(options.instance_over));
             }
             let accelerated = scene.groups[members[0]].accelerated;
+            let own = geometry.bounds();
             let bounds = match &accelerated {
                 Some(acc) => super::accelerated::swept_bounds(acc, geometry.bounds()),
                 None => geometry.bounds(),
@@ -103,8 +104,9 @@ impl RestGroups {
                 geometry,
                 accel,
                 // Relative to the group's size and place alone, so that a scene scaled as a
-                // whole renders the same (tests/envelope.rs).
-                epsilon: 1e-7 * bounds.diagonal() + 1e-12 * bounds.max_abs(),
+                // whole renders the same (tests/envelope.rs); an accelerated body's own, not the
+                // box it sweeps.
+                epsilon: 1e-7 * own.diagonal() + 1e-12 * bounds.max_abs(),
                 window,
                 spins,
                 accelerated,
