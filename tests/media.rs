@@ -400,3 +400,31 @@ fn a_bad_fog_is_named() {
         .to_string();
     assert!(err.contains("holds no objects"), "{err}");
 }
+
+/// A fog bank reaching 1e15 in a group with small lamps: the group's ε (from its bounds) is
+/// then larger than a shadow ray toward a lamp, whose last crossing of the fog's boundary
+/// steps past its end; that stretch has no length (it once had a negative one, and the
+/// transmittance e^{+σd} overflowed into NaN pixels; found by tests/fuzz.rs).
+#[test]
+fn a_vast_fog_bank_beside_small_lamps_gives_finite_pixels() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/glowing_pass.toml"
+    ))
+    .unwrap();
+    let needle = "min = [3.0, 0.0, -4.0]";
+    assert!(
+        text.contains(needle),
+        "the fog bank of scenes/glowing_pass.toml"
+    );
+    let text = text.replacen(needle, "min = [3.0, 0.0, -1e15]", 1);
+    let mut s = rest_embree::scene::load_str("scenes/glowing_pass.toml", &text, &[]).unwrap();
+    s.image.width = 48;
+    s.image.height = 27;
+    s.image.samples = 4;
+    for backend in backends() {
+        // render_with asserts that no pixel is NaN or infinite.
+        let f = render_with(&s, backend);
+        assert_all_finite(&f, backend);
+    }
+}

@@ -106,7 +106,8 @@ impl<B: Band> Shader<'_, B> {
             };
             let gs = self.world.groups[g].boost.null_dir(ray.dir).1;
             let shift_m = self.seen.radiance(s / gs, shift).0;
-            if let Some(a) = self.attenuation(m, shift_m, gs * (to - from)) {
+            // A boundary crossed within ε of the shadow ray's end can step past it: no length.
+            if let Some(a) = self.attenuation(m, shift_m, gs * (to - from).max(0.0)) {
                 match &mut share {
                     Some(t) => t.mul_by(&a),
                     None => share = Some(a),
