@@ -128,17 +128,24 @@ fn bad_spins_are_refused() {
         e.contains("test.toml:27: key `group.ball.object.0.spin.omega`: the rim would move at"),
         "{e}"
     );
-    let boxed = spinning(0.5, 0.0, "").replace(
+    let lattice = spinning(0.5, 0.0, "").replace(
         "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 2",
-        "type = \"box\"\nmin = [-1, -1, -1]\nmax = [1, 1, 1]",
+        "type = \"lattice\"\ncounts = [2, 2, 2]",
     );
-    let e = load(&boxed);
-    assert!(e.contains("a spinning box is not built yet"), "{e}");
+    let e = load(&lattice);
+    assert!(e.contains("a spinning lattice is not built yet"), "{e}");
+    let turned_box = spinning(0.5, 0.0, "").replace(
+        "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 2",
+        "type = \"box\"\nmin = [-1, -1, -1]\nmax = [1, 1, 1]\nrotate = { axis = [0, 0, 1], degrees = 30 }",
+    );
+    let e = load(&turned_box);
+    assert!(e.contains("a spinning mesh is not built yet"), "{e}");
+    // A rod about a cross axis turns; about its own it is a body of revolution.
     let rod = spinning(0.5, 0.0, "").replace(
         "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 2",
         "type = \"rod\"\nfrom = [-1, 0, 0]\nto = [1, 0, 0]\nradius = 0.5",
     );
-    assert!(load(&rod).contains("a rod spins about its own axis only"));
+    scene(&rod);
     let path = spinning(0.5, 0.0, "").replace("[render]\n", "[render]\nintegrator = \"path\"\n");
     assert!(load(&path).contains("spinning objects are not built yet for integrator = \"path\""));
     // A rod about its own axis spins.

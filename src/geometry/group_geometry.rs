@@ -24,9 +24,9 @@ pub struct Part {
 }
 
 /// A rigid rotation in the group's frame: at `omega` radians per unit of the group's time,
-/// counter-clockwise about `axis` (unit) through `centre`. Only bodies of revolution about the
-/// axis spin: their shape in the group's frame stays still while every point of their surface
-/// moves along it.
+/// counter-clockwise about `axis` (unit) through `centre`. A body of revolution about the axis
+/// keeps its shape in the group's frame while every point of its surface moves along it;
+/// any other body (`turning`) is where its shape at time 0 turned by ω t puts it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spin {
     /// A point of the axis.
@@ -35,6 +35,9 @@ pub struct Spin {
     pub axis: DVec3,
     /// The angular velocity.
     pub omega: f64,
+    /// Whether its shape turns (it is not a body of revolution about the axis): its rays are
+    /// then followed to the turning shape (render/world/turning.rs).
+    pub turning: bool,
 }
 
 impl Spin {
@@ -54,6 +57,11 @@ impl Spin {
     pub fn unturned(&self, p: DVec3, t: f64) -> DVec3 {
         let back = glam::DQuat::from_axis_angle(self.axis, -self.omega * t);
         self.centre + back * (p - self.centre)
+    }
+
+    /// A direction of the shape at time 0 as it points at time `t`.
+    pub fn turned_dir(&self, d: DVec3, t: f64) -> DVec3 {
+        glam::DQuat::from_axis_angle(self.axis, self.omega * t) * d
     }
 }
 
@@ -419,6 +427,34 @@ impl Geometry {
     /// Whether anything in it spins.
     pub fn spins(&self) -> bool {
         self.parts.iter().any(|p| p.spin.is_some())
+    }
+
+    /// Whether anything in it spins whose shape turns (not a body of revolution).
+    pub fn turns(&self) -> bool {
+        self.parts.iter().any(|p| p.spin.is_some_and(|s| s.turning))
+    }
+
+    /// The box holding every primitive at every time: a turning part's as the ball about its
+    /// centre that holds it turned any way.
+    pub fn swept_bounds(&self) -> Aabb {
+        let mut b = self.bounds();
+        for part in &self.parts {
+            let Some(sp) = part.spin.filter(|s| s.turning) else {
+                continue;
+            };
+            let reach = (part.start..part.end)
+                .map(|i| {
+                    let pb = self.prim(i).bounds();
+                    pb.corners()
+                        .iter()
+                        .map(|c| (*c - sp.centre).length())
+                        .fold(0.0, f64::max)
+                })
+                .fold(0.0, f64::max);
+            let r = DVec3::splat(reach);
+            b = b.union(&Aabb::new(sp.centre - r, sp.centre + r));
+        }
+        b
     }
 
     /// The same geometry moved by `d`.

@@ -130,6 +130,26 @@ impl Primitive {
         }
     }
 
+    /// The signed distance from `p` to a solid primitive (negative inside); None for a
+    /// triangle, which bounds nothing. It changes by at most |Δp| as p moves.
+    pub fn distance(&self, p: DVec3) -> Option<f64> {
+        Some(match *self {
+            Primitive::Sphere { center, radius } => (p - center).length() - radius,
+            Primitive::Capsule { a, b, radius } => {
+                let ab = b - a;
+                let h =
+                    ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+                (p - (a + h * ab)).length() - radius
+            }
+            Primitive::Cuboid { min, max } => {
+                let (c, h) = (0.5 * (min + max), 0.5 * (max - min));
+                let q = (p - c).abs() - h;
+                q.max(DVec3::ZERO).length() + q.max_element().min(0.0)
+            }
+            Primitive::Triangle { .. } => return None,
+        })
+    }
+
     /// The outward geometric normal at a point on the surface (unit).
     pub fn normal(&self, p: DVec3) -> DVec3 {
         match *self {

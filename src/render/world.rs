@@ -16,6 +16,8 @@ use super::light_tree::LightTree;
 mod accelerated;
 pub(crate) use accelerated::point_boost;
 mod moving_bounds;
+mod turning;
+pub(crate) use turning::TurningPart;
 mod rest_groups;
 pub use rest_groups::RestGroups;
 mod primary_hits;
@@ -106,9 +108,23 @@ pub struct WorldGroup {
     /// Its hyperbolic motion, for a segment of constant proper acceleration (its rays start
     /// on the segment's start hyperplane, `World::rest_ray`).
     pub accelerated: Option<crate::scene::Accelerated>,
+    /// Its spinning bodies whose shape turns (not of revolution), if any: the group is then
+    /// intersected directly, its rays starting on its hyperplane of time 0.
+    pub turning: Option<Arc<[TurningPart]>>,
 }
 
 impl WorldGroup {
+    /// The group's time at which its rays are made to start (`World::rest_ray`), where its
+    /// intersection needs the time along them: an accelerated segment's start, or 0 for
+    /// turning bodies.
+    fn time_origin(&self) -> Option<f64> {
+        match (&self.accelerated, &self.turning) {
+            (Some(acc), _) => Some(acc.start.t),
+            (None, Some(_)) => Some(0.0),
+            (None, None) => None,
+        }
+    }
+
     /// Whether the group is seen at emission event `e` (always, but for a worldline's
     /// segment); `World::rest_ray` keeps rays to the same events.
     pub fn shows_at(&self, e: Event) -> bool {
@@ -118,6 +134,12 @@ impl WorldGroup {
     /// The closest hit of each ray in this group (None for inactive rays): through the
     /// accelerator, or the primitives one by one for a group without one.
     fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        if let Some(parts) = &self.turning {
+            for (r, h) in rays.iter().zip(hits.iter_mut()) {
+                *h = turning::intersect(&self.geometry, parts, r);
+            }
+            return;
+        }
         if let Some(acc) = &self.accelerated {
             for (r, h) in rays.iter().zip(hits.iter_mut()) {
                 *h = accelerated::intersect(acc, &self.geometry, r);
@@ -144,6 +166,12 @@ impl WorldGroup {
 
     /// Whether anything of this group lies on each ray (false for inactive rays).
     fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
+        if let Some(parts) = &self.turning {
+            for (r, o) in rays.iter().zip(out.iter_mut()) {
+                *o = turning::intersect(&self.geometry, parts, r).is_some();
+            }
+            return;
+        }
         if let Some(acc) = &self.accelerated {
             for (r, o) in rays.iter().zip(out.iter_mut()) {
                 *o = accelerated::occluded(acc, &self.geometry, r);
@@ -276,6 +304,7 @@ impl World {
                 window: g.window,
                 spins: g.spins,
                 accelerated: g.accelerated,
+                turning: g.turning.clone(),
             })
             .collect();
         let (tree, primary_tree, light_trees) =
@@ -387,8 +416,8 @@ impl World {
             None => (tmin, tmax),
             Some(w) => w.lookbacks(ray, tmin, tmax)?,
         };
-        if let Some(acc) = &g.accelerated {
-            return self.rest_ray_accelerated(g, acc, ray, tmin, tmax);
+        if let Some(t_ref) = g.time_origin() {
+            return self.rest_ray_timed(g, t_ref, ray, tmin, tmax);
         }
         // Every primary ray starts at the imaging event: its rest-frame origin is per group.
         let origin = if ray.origin == self.event {
@@ -416,13 +445,13 @@ impl World {
         })
     }
 
-    /// [`World::rest_ray`] into an accelerated segment's start frame S': the ray moved along
-    /// itself to where it crosses the segment's start hyperplane (so its S' time there is the
-    /// origin's start time), after the cull by the bounds the body sweeps through.
-    fn rest_ray_accelerated(
+    /// [`World::rest_ray`] for a group whose intersection needs the time along the ray (an
+    /// accelerated segment, turning bodies): the ray moved along itself to where it crosses the
+    /// group's hyperplane of time `t_ref`, after the cull by the bounds the body sweeps.
+    fn rest_ray_timed(
         &self,
         g: &WorldGroup,
-        acc: &crate::scene::Accelerated,
+        t_ref: f64,
         ray: &NullRay,
         tmin: f64,
         tmax: f64,
@@ -432,7 +461,7 @@ impl World {
         if self.clip_rays {
             g.bounds.clip(origin.x, dir.recip(), tmin, tmax)?;
         }
-        let shift = (origin.t - acc.start.t) / s;
+        let shift = (origin.t - t_ref) / s;
         Some(RestRay {
             ray: Ray {
                 origin: origin.x + shift * dir,

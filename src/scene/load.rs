@@ -331,6 +331,20 @@ fn group(
             ));
         }
     }
+    if geometry.turns() {
+        if segments.is_some() {
+            return Err(t.error(
+                "worldline",
+                "a spinning box, wheel or rod about a cross axis in a group whose velocity changes is not built yet",
+            ));
+        }
+        if geometry.len() > worldline::MAX_ACCELERATED_PRIMS {
+            return Err(t.error(
+                "object",
+                format!("the group has {} primitives and a spinning box, wheel or rod about a cross axis: such a group is intersected primitive by primitive, at most {}", geometry.len(), worldline::MAX_ACCELERATED_PRIMS),
+            ));
+        }
+    }
     if segments.as_deref().is_some_and(worldline::accelerates) {
         if let Some(why) = worldline::accelerated_refusal(&geometry) {
             return Err(t.error("worldline", why));

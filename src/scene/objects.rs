@@ -40,6 +40,9 @@ pub(super) const OBJECT_KEYS: &[&str] = &[
     "rotate",
     "scale",
     "spin",
+    "spokes",
+    "rim_segments",
+    "hub_radius",
 ];
 
 fn material_ref(
@@ -264,6 +267,18 @@ pub(super) fn add_object(
             ));
         }
         "lattice" => adding.add_lattice(mats).map(|_| None)?,
+        "wheel" if transform.is_some() => {
+            let key = KEYS
+                .into_iter()
+                .find(|k| t.has(k))
+                .expect("a transform has a key");
+            return Err(at_value(
+                t,
+                key,
+                "a wheel is placed by its own keys (center, axis, radius)",
+            ));
+        }
+        "wheel" => Some(adding.add_wheel()?),
         "bar_array" => adding.add_bar_array().map(|_| None)?,
         other => {
             let n = t.get("type").expect("read above");
@@ -271,14 +286,22 @@ pub(super) fn add_object(
                 n,
                 "type",
                 format!(
-                    "unknown object type `{other}` (box, sphere, rod, mesh, lattice, bar_array)"
+                    "unknown object type `{other}` (box, sphere, rod, mesh, lattice, bar_array, wheel)"
                 ),
             ));
         }
     };
     if let Some(spin) = t.table("spin")? {
-        let last = adding.geo.prims.last().copied();
-        let spin = read_spin(&spin, kind, last)?;
+        let prims: Vec<Primitive> = adding
+            .geo
+            .parts
+            .iter()
+            .filter(|p| p.object == id)
+            .flat_map(|p| p.start..p.end)
+            .filter(|&i| (i as usize) < adding.geo.prims.len())
+            .map(|i| adding.geo.prims[i as usize])
+            .collect();
+        let spin = read_spin(&spin, kind, &prims)?;
         adding.geo.set_spin(id, spin);
     }
     // Textures turn and move with the object (a box turned by quarter turns as exactly as its
@@ -297,15 +320,11 @@ pub(super) fn add_object(
     Ok(kind.to_string())
 }
 
-/// An object's `spin = { axis, omega }`, about the axis through its centre (a sphere's) or
-/// along it (a rod's own): only bodies of revolution about the axis spin, their rim slower
-/// than light. `shape` is the object's primitive as placed (the last one added).
-fn read_spin(
-    t: &Table,
-    kind: &str,
-    shape: Option<crate::geometry::Primitive>,
-) -> SceneResult<crate::geometry::Spin> {
-    use crate::geometry::Primitive;
+/// An object's `spin = { axis, omega }`, about the axis through its centre, its rim slower
+/// than light. A sphere, and a rod about its own axis, are bodies of revolution about it, whose
+/// shape stays still; a box, a rod about another axis and a wheel turn (`Spin::turning`).
+/// `prims`: the object's primitives as placed.
+fn read_spin(t: &Table, kind: &str, prims: &[Primitive]) -> SceneResult<crate::geometry::Spin> {
     let axis = t.req_vec3("axis")?;
     if axis.length() == 0.0 {
         return Err(t.error("axis", "must not be zero"));
@@ -313,25 +332,43 @@ fn read_spin(
     let axis = axis.normalize();
     let omega = t.f64_or("omega", 0.0)?;
     t.finish(&["axis", "omega"])?;
-    let (centre, rim) = match (kind, shape) {
-        ("sphere", Some(Primitive::Sphere { center, radius })) => (center, radius),
-        ("rod", Some(Primitive::Capsule { a, b, radius })) => {
-            let along = (b - a).normalize_or_zero();
-            if along.cross(axis).length() > 1e-9 {
-                return Err(t.error(
-                    "axis",
-                    "a rod spins about its own axis only (it is a body of revolution about no other)",
-                ));
-            }
-            (0.5 * (a + b), radius)
+    let (centre, turning) = match (kind, prims) {
+        ("sphere", [Primitive::Sphere { center, .. }]) => (*center, false),
+        ("rod", [Primitive::Capsule { a, b, .. }]) => {
+            let along = (*b - *a).normalize_or_zero();
+            (0.5 * (*a + *b), along.cross(axis).length() > 1e-9)
+        }
+        ("box", [Primitive::Cuboid { min, max }]) => (0.5 * (*min + *max), true),
+        // A wheel's first primitive is its hub, at its centre.
+        ("wheel", [Primitive::Sphere { center, .. }, ..]) => (*center, true),
+        ("box", _) => {
+            return Err(t.error(
+                "axis",
+                "a box turned other than by quarter turns is a mesh, and a spinning mesh is not built yet",
+            ))
         }
         _ => {
             return Err(t.error(
                 "axis",
-                format!("a spinning {kind} is not built yet: spheres and rods spin (bodies of revolution about the axis, whose shape stays still)"),
+                format!("a spinning {kind} is not built yet: spheres, rods, boxes and wheels spin"),
             ))
         }
     };
+    // The farthest any point of it lies from the axis.
+    let off = |p: DVec3| (p - centre).cross(axis).length();
+    let rim = prims
+        .iter()
+        .map(|p| match *p {
+            Primitive::Sphere { center, radius } => off(center) + radius,
+            Primitive::Capsule { a, b, radius } => off(a).max(off(b)) + radius,
+            other => other
+                .bounds()
+                .corners()
+                .iter()
+                .map(|c| off(*c))
+                .fold(0.0, f64::max),
+        })
+        .fold(0.0, f64::max);
     let speed = omega.abs() * rim;
     if speed >= 1.0 {
         let n = t.get("omega").expect("read above");
@@ -345,6 +382,7 @@ fn read_spin(
         centre,
         axis,
         omega,
+        turning,
     })
 }
 
@@ -440,6 +478,55 @@ impl Adding<'_, '_> {
             }],
         );
         Ok(given)
+    }
+
+    /// A spoked wheel (`center`, `axis` [0, 0, 1], `radius` of the rim's centre line,
+    /// `spokes` 8, `rim_segments` 6 per spoke, `rod_radius` radius/25, `hub_radius` three rod
+    /// radii): a hub sphere, then the spokes and the rim as rods; returns the hub.
+    fn add_wheel(&mut self) -> SceneResult<Primitive> {
+        let (t, id, mat) = (self.t, self.id, self.mat);
+        let (geo, total) = (&mut *self.geo, &mut *self.total);
+        let center = t.req_vec3("center")?;
+        let axis = t.vec3("axis")?.unwrap_or(DVec3::Z);
+        if !(axis.is_finite() && axis.length() > 0.0) {
+            return Err(t.error("axis", "must be a direction, not zero"));
+        }
+        let axis = axis.normalize();
+        let radius = t.f64_where("radius", None, |v| v > 0.0, "greater than 0")?;
+        let spokes = t.uint("spokes", Some(8), 1, 1000)? as usize;
+        let rim_segments = t.uint("rim_segments", Some(6 * spokes as u64), 3, 100_000)? as usize;
+        let rod = t.f64_where(
+            "rod_radius",
+            Some(radius / 25.0),
+            |v| v > 0.0,
+            "greater than 0",
+        )?;
+        let hub = t.f64_where("hub_radius", Some(3.0 * rod), |v| v > 0.0, "greater than 0")?;
+        // Two directions across the axis.
+        let u = axis.any_orthonormal_vector();
+        let v = axis.cross(u);
+        let at = |k: usize, n: usize| {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            center + radius * (a.cos() * u + a.sin() * v)
+        };
+        let hub_prim = Primitive::Sphere {
+            center,
+            radius: hub,
+        };
+        let mut prims = vec![hub_prim];
+        prims.extend((0..spokes).map(|k| Primitive::Capsule {
+            a: center,
+            b: at(k, spokes),
+            radius: rod,
+        }));
+        prims.extend((0..rim_segments).map(|k| Primitive::Capsule {
+            a: at(k, rim_segments),
+            b: at(k + 1, rim_segments),
+            radius: rod,
+        }));
+        budget(t, "type", total, prims.len() as u64)?;
+        geo.push_part(id, mat, prims);
+        Ok(hub_prim)
     }
 
     /// A rod (`from`, `to`, `radius`), a capsule; returns it as given.

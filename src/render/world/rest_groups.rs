@@ -24,6 +24,8 @@ pub(super) struct RestGroup {
     pub spins: bool,
     /// Its hyperbolic motion, for a segment of constant proper acceleration.
     pub accelerated: Option<crate::scene::Accelerated>,
+    /// Its turning bodies, if any (world/turning.rs).
+    pub turning: Option<Arc<[super::TurningPart]>>,
 }
 
 /// The world's groups, built once: the part of a world that a film's frames share (the
@@ -54,7 +56,7 @@ impl RestGroups {
             let key = (
                 v.identity_key(),
                 g.window.map(|w| w.key()),
-                g.accelerated.map(|_| i),
+                (g.accelerated.is_some() || g.geometry.turns()).then_some(i),
             );
             match index.get(&key).filter(|_| options.merge_equal_velocities) {
                 Some(&k) => sets[k].2.push(i),
@@ -77,15 +79,20 @@ impl RestGroups {
             }
             let accelerated = scene.groups[members[0]].accelerated;
             let own = geometry.bounds();
+            let turning: Option<Arc<[super::TurningPart]>> = geometry
+                .turns()
+                .then(|| super::turning::turning_parts(&geometry).into());
             let bounds = match &accelerated {
                 Some(acc) => super::accelerated::swept_bounds(acc, geometry.bounds()),
+                None if turning.is_some() => geometry.swept_bounds(),
                 None => geometry.bounds(),
             };
             let names: Vec<&str> = members
                 .iter()
                 .map(|&i| scene.groups[i].name.as_str())
                 .collect();
-            let accel = if geometry.len() as usize <= options.direct_max || accelerated.is_some() {
+            let direct = accelerated.is_some() || turning.is_some();
+            let accel = if geometry.len() as usize <= options.direct_max || direct {
                 None
             } else {
                 Some(Arc::from(backend.build(geometry.clone()).map_err(|e| {
@@ -110,6 +117,7 @@ impl RestGroups {
                 window,
                 spins,
                 accelerated,
+                turning,
             });
         }
         Ok(RestGroups { groups, options })
