@@ -65,4 +65,7 @@ for k in 8 20 32 44 56 68; do
 done
 oiiotool "${frames[@]}" --mosaic 3x2 -o "$o/accelerating-train.png"
 rm -r "$film"
+# The spoked wheel, still and with its rim at 0.9c.
+$r render scenes/spoked_wheel.toml -o "$o/wheel-0.png" --width 320 --height 240 --quiet --set 'group.wheel.object.wheel.spin.omega=0'
+$r render scenes/spoked_wheel.toml -o "$o/wheel-0.9.png" --width 320 --height 240 --quiet
 echo "wrote $(ls "$o" | wc -l) images to $o"

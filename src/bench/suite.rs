@@ -259,6 +259,25 @@ fn time_cases(px: u32, out: &mut Vec<LazyCase>) {
         .without_hi_reference()
         .beside("the same train at rest", still))
     }));
+    // The spoked wheel with its rim at 0.9c against the same wheel without spin: every ray
+    // marched through the turning wheel, against the still one's exact tests.
+    out.push(LazyCase::new("wheel spinning at 0.9c", move || {
+        const WHEEL: &str = include_str!("../../scenes/spoked_wheel.toml");
+        let spin = "spin = { axis = [0.0, -1.0, 0.4], omega = 0.43 }";
+        assert!(WHEEL.contains(spin), "the bench's wheel is the scene's");
+        let s = size(px);
+        let sets: Vec<(String, String)> = s
+            .iter()
+            .map(|x| (format!("--set {x}"), x.clone()))
+            .collect();
+        let load = |text: &str| load_str("scenes/spoked_wheel.toml", text, &sets);
+        let still = load(&WHEEL.replacen(spin, "", 1))?;
+        Ok(
+            Case::new("wheel spinning at 0.9c", load(WHEEL)?, &["embree", "bvh"])
+                .without_hi_reference()
+                .beside("the same wheel still", still),
+        )
+    }));
     // An open shutter: every sample from its own event, so no fans and no screen cull.
     out.push(LazyCase::new("lattice beta=0.9, shutter 0.5", move || {
         let mut s = size(px);

@@ -9,20 +9,102 @@
 //! group's time is T = −|d| t along `origin + t dir`.
 
 use crate::accel::{Hit, Ray};
-use crate::geometry::{Geometry, Spin};
+use crate::geometry::{Geometry, Primitive, Spin};
 use glam::DVec3;
 
 /// The most steps a ray takes through one turning body; a ray that grazes it so closely that
 /// it needs more is taken to miss it.
 const MAX_STEPS: usize = 20_000;
 
-/// A run of primitives turning together, and how far they reach from its centre.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A run of primitives turning together, how far they reach from its centre, and where each
+/// lies about the axis: its ranges of distance from the axis, of height along it, and of angle
+/// about it (in the shape at time 0), which bound its distance from below without computing it.
+#[derive(Clone, Debug, PartialEq)]
 pub struct TurningPart {
     pub start: u32,
     pub end: u32,
     pub spin: Spin,
     pub reach: f64,
+    /// Per primitive from `start`: (ρ_lo, ρ_hi, z_lo, z_hi, angle centre, angular half-width),
+    /// the half-width π where it surrounds the axis.
+    pub shells: Vec<[f64; 6]>,
+    /// Two directions across the axis, for the angle.
+    pub across: (DVec3, DVec3),
+    /// The heights along the axis and the farthest distance from it, over all its primitives.
+    pub z_range: (f64, f64),
+    pub rho_max: f64,
+}
+
+/// Cylindrical coordinates about the spin's axis: (ρ, z, φ) of `q`.
+fn cylindrical(sp: &Spin, across: (DVec3, DVec3), q: DVec3) -> (f64, f64, f64) {
+    let r = q - sp.centre;
+    let z = r.dot(sp.axis);
+    let (x, y) = (r.dot(across.0), r.dot(across.1));
+    ((x * x + y * y).sqrt(), z, y.atan2(x))
+}
+
+/// Where primitive `p` lies about the axis (see [`TurningPart::shells`]).
+fn shell(sp: &Spin, across: (DVec3, DVec3), p: &Primitive) -> [f64; 6] {
+    use std::f64::consts::PI;
+    let cyl = |q: DVec3| cylindrical(sp, across, q);
+    // The centre line's ends (a sphere's centre twice) and the radius about it; a box by its
+    // corners, all around.
+    let (a, b, r) = match *p {
+        Primitive::Sphere { center, radius } => (center, center, radius),
+        Primitive::Capsule { a, b, radius } => (a, b, radius),
+        other => {
+            let c = other.bounds().corners().map(cyl);
+            let (lo, hi) = c
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+                    (l.min(q.1), h.max(q.1))
+                });
+            let rho = c.iter().map(|q| q.0).fold(0.0, f64::max);
+            return [0.0, rho, lo, hi, 0.0, PI];
+        }
+    };
+    let ((ra, za, pa), (rb, zb, pb)) = (cyl(a), cyl(b));
+    // The least distance of the segment a-b from the axis: |w(t)|² is quadratic in t.
+    let across_axis = |q: DVec3| (q - sp.centre) - (q - sp.centre).dot(sp.axis) * sp.axis;
+    let (wa, wb) = (across_axis(a), across_axis(b));
+    let dw = wb - wa;
+    let t = if dw.length_squared() > 0.0 {
+        (-wa.dot(dw) / dw.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let closest = (wa + t * dw).length();
+    let (rho_lo, rho_hi) = ((closest - r).max(0.0), ra.max(rb) + r);
+    let (z_lo, z_hi) = (za.min(zb) - r, za.max(zb) + r);
+    if closest <= r {
+        return [rho_lo, rho_hi, z_lo, z_hi, 0.0, PI];
+    }
+    // The segment does not pass the axis: it subtends the shorter arc between its ends,
+    // widened by the angle its radius takes at its closest.
+    let mut gap = pb - pa;
+    if gap > PI {
+        gap -= 2.0 * PI;
+    } else if gap < -PI {
+        gap += 2.0 * PI;
+    }
+    let half = 0.5 * gap.abs() + (r / closest).min(1.0).asin();
+    [rho_lo, rho_hi, z_lo, z_hi, pa + 0.5 * gap, half.min(PI)]
+}
+
+/// A lower bound on the distance from the point at (ρ, z, φ) to what lies within `sh`.
+#[inline]
+fn below(sh: &[f64; 6], (rho, z, phi): (f64, f64, f64)) -> f64 {
+    use std::f64::consts::PI;
+    let mut lb = (sh[0] - rho).max(rho - sh[1]).max(sh[2] - z).max(z - sh[3]);
+    if sh[5] < PI {
+        let mut off = (phi - sh[4]).abs() % (2.0 * PI);
+        if off > PI {
+            off = 2.0 * PI - off;
+        }
+        let outside = (off - sh[5]).clamp(0.0, 0.5 * PI);
+        lb = lb.max(rho * outside.sin());
+    }
+    lb
 }
 
 /// The turning parts of a geometry (empty if nothing turns).
@@ -41,11 +123,26 @@ pub(crate) fn turning_parts(geometry: &Geometry) -> Vec<TurningPart> {
                         .fold(0.0, f64::max)
                 })
                 .fold(0.0, f64::max);
+            let u = spin.axis.any_orthonormal_vector();
+            let across = (u, spin.axis.cross(u));
+            let shells: Vec<[f64; 6]> = (part.start..part.end)
+                .map(|i| shell(&spin, across, &geometry.prim(i)))
+                .collect();
+            let z_range = shells
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |r, sh| {
+                    (r.0.min(sh[2]), r.1.max(sh[3]))
+                });
+            let rho_max = shells.iter().map(|sh| sh[1]).fold(0.0, f64::max);
             Some(TurningPart {
                 start: part.start,
                 end: part.end,
                 spin,
                 reach,
+                shells,
+                across,
+                z_range,
+                rho_max,
             })
         })
         .collect()
@@ -81,13 +178,21 @@ pub(super) fn intersect(geometry: &Geometry, parts: &[TurningPart], ray: &Ray) -
 }
 
 /// The signed distance of the part's shape at time 0 from `q`, and the primitive nearest.
+/// Primitives whose shell lies farther than the nearest found so far are not asked.
 fn distance(geometry: &Geometry, part: &TurningPart, q: DVec3) -> (f64, u32) {
-    (part.start..part.end)
-        .map(|i| (geometry.prim(i).distance(q).unwrap_or(f64::INFINITY), i))
-        .fold(
-            (f64::INFINITY, part.start),
-            |a, b| if b.0 < a.0 { b } else { a },
-        )
+    let at = cylindrical(&part.spin, part.across, q);
+    let mut best = (f64::INFINITY, part.start);
+    for (k, sh) in part.shells.iter().enumerate() {
+        if below(sh, at) >= best.0 {
+            continue;
+        }
+        let i = part.start + k as u32;
+        let d = geometry.prim(i).distance(q).unwrap_or(f64::INFINITY);
+        if d < best.0 {
+            best = (d, i);
+        }
+    }
+    best
 }
 
 /// Sphere tracing through one turning part, within the ball it sweeps.
@@ -107,7 +212,35 @@ fn march(geometry: &Geometry, part: &TurningPart, ray: &Ray, tmax: f64) -> Optio
     }
     let root = disc.sqrt();
     let (enter, leave) = ((-b - root) / a, (-b + root) / a);
-    let (mut t, end) = (enter.max(ray.tmin), leave.min(tmax));
+    let (mut t, mut end) = (enter.max(ray.tmin), leave.min(tmax));
+    // Height along the axis and distance from it do not change as the body turns: along the
+    // ray the first is linear and the second's square quadratic, so the march is kept to
+    // where both are within the part's ranges (a wheel's thin slab, a bar's cylinder).
+    let (z0, dz) = (oc.dot(sp.axis), ray.dir.dot(sp.axis));
+    if dz != 0.0 {
+        let (ta, tb) = ((part.z_range.0 - z0) / dz, (part.z_range.1 - z0) / dz);
+        t = t.max(ta.min(tb));
+        end = end.min(ta.max(tb));
+    } else if z0 < part.z_range.0 || z0 > part.z_range.1 {
+        return None;
+    }
+    let (w0, dw) = (oc - z0 * sp.axis, ray.dir - dz * sp.axis);
+    let (qa, qb, qc) = (
+        dw.length_squared(),
+        w0.dot(dw),
+        w0.length_squared() - part.rho_max * part.rho_max,
+    );
+    if qa > 0.0 {
+        let disc = qb * qb - qa * qc;
+        if disc < 0.0 {
+            return None;
+        }
+        let root = disc.sqrt();
+        t = t.max((-qb - root) / qa);
+        end = end.min((-qb + root) / qa);
+    } else if qc > 0.0 {
+        return None;
+    }
     if t >= end {
         return None;
     }
@@ -131,7 +264,6 @@ fn march(geometry: &Geometry, part: &TurningPart, ray: &Ray, tmax: f64) -> Optio
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Primitive;
 
     /// A bar turning about z: every hit found lies on the bar's surface turned by ω T, and
     /// no point the ray passes before it lies inside.
