@@ -246,3 +246,66 @@ fn flash_rides_with_a_moving_camera_and_timings_are_checked() {
         "camera.flash.pulse.shape",
     );
 }
+
+/// A flash on a camera whose worldline changes velocity rides along that worldline, found on
+/// it event by event: with the camera at rest through the round trip (its velocity changes
+/// only at world time 1000), the echo is exactly the one a camera at rest receives.
+#[test]
+fn a_flash_on_a_changing_worldline_rides_along_it() {
+    let (d, w) = (5.0, 0.5);
+    // Both in spectra (a light on a changing worldline is seen through them).
+    let still = radar_scene(
+        &format!("on = [[0, {w:?}]], color = {{ blackbody = 5800 }}"),
+        d,
+        0.0,
+    );
+    let text = |camera_motion: &str| {
+        format!(
+            r#"
+[camera]
+position = [0, 0, 0]
+direction = [0, 1, 0]
+fov_y = {FOV}
+{camera_motion}
+flash = {{ intensity = 1, on = [[0, {w:?}]], color = {{ blackbody = 5800 }} }}
+[image]
+width = {SIZE}
+height = {SIZE}
+[render]
+ambient = 0
+[[group]]
+name = "plate"
+[[group.object]]
+type = "box"
+min = [-100, {d:?}, -100]
+max = [100, {:?}, 100]
+"#,
+            d + 1.0
+        )
+    };
+    let moving = scene(&text(
+        "worldline = [{ until = 1000, velocity = [0, 0, 0] }, { velocity = [0.5, 0, 0] }]",
+    ));
+    assert!(
+        moving.lights[0].worldline.is_some(),
+        "the flash has the camera's worldline"
+    );
+    for backend in backends() {
+        for t in [
+            2.0 * d - 1e-6,
+            2.0 * d + 1e-6,
+            2.0 * d + 0.3,
+            2.0 * d + w + 1e-6,
+        ] {
+            let (a, b) = (
+                seen_at(&still, backend, t, CENTRE),
+                seen_at(&moving, backend, t, CENTRE),
+            );
+            assert!(
+                (a - b).abs() <= 1e-6 * a.max(1e-30),
+                "{backend} at {t}: {a} against {b}"
+            );
+            assert_eq!(a > 0.0, b > 0.0, "{backend} at {t}");
+        }
+    }
+}

@@ -355,3 +355,64 @@ fn glass_in_a_group_that_changes_velocity_is_refused() {
         "radius = 1\nmaterial = \"glass\"\n[[material]]\nname = \"glass\"\ntransmit = 0.9\n",
     ));
 }
+
+/// A lamp on a worldline is found on it at the emission event on each lit point's past light
+/// cone: while every such event lies in its first segment (the lamp moving at 0.6c until world
+/// time 1000), it lights the scene as the uniformly moving lamp does.
+#[test]
+fn a_lamp_on_a_worldline_lights_as_its_segment_does() {
+    // A uniformly moving light's `position` is in its rest frame (its origin passing the
+    // world's at world time 0); a worldline's is where it is at world time 0: x = x'/γ.
+    let lamp = |motion: &str, x: f64| {
+        format!(
+            r#"
+[camera]
+position = [0, -10, 0]
+look_at = [0, 0, 0]
+fov_y = 30
+time = 4
+[image]
+width = 48
+height = 32
+[[light]]
+position = [{x:?}, -4, 3]
+intensity = 2
+color = {{ blackbody = 5800 }}
+{motion}
+[[group]]
+name = "ball"
+[[group.object]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1.5
+[[group.object]]
+type = "box"
+min = [-8, -3, -2.5]
+max = [8, 3, -1.5]
+"#
+        )
+    };
+    let uniform = scene(&lamp("velocity = [0.6, 0, 0]", -7.5));
+    let line = scene(&lamp(
+        "worldline = [{ until = 1000, velocity = [0.6, 0, 0] }, { velocity = [-0.3, 0, 0] }]",
+        -6.0,
+    ));
+    assert!(line.lights[0].worldline.is_some());
+    for backend in backends() {
+        let (a, b) = (render_with(&uniform, backend), render_with(&line, backend));
+        let worst = a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .flat_map(|(p, q)| {
+                (0..3).map(move |k| (p.color[k] - q.color[k]).abs() / p.color[k].abs().max(1e-3))
+            })
+            .fold(0.0f32, f32::max);
+        assert!(
+            worst < 1e-5,
+            "{backend}: colours differ by {worst} (relative)"
+        );
+        let lit = a.pixels.iter().filter(|p| p.color[0] > 0.01).count();
+        assert!(lit > 100, "{backend}: {lit} pixels lit");
+    }
+}

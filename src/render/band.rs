@@ -248,6 +248,7 @@ pub fn needs_spectra(scene: &Scene) -> bool {
         .groups
         .iter()
         .any(|g| g.accelerated.is_some() || g.geometry.spins())
+        || scene.lights.iter().any(|l| l.worldline.is_some())
     {
         return true;
     }

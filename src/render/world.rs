@@ -377,7 +377,7 @@ impl World {
             .lights
             .iter()
             .map(|l| {
-                l.velocity.is_zero().then(|| {
+                (l.velocity.is_zero() && l.worldline.is_none()).then(|| {
                     LightTree::new(
                         items.clone(),
                         crate::accel::light_buffers(l.position),

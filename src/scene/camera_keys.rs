@@ -96,7 +96,7 @@ pub(super) fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
     )?;
     let flash = t.table("flash")?.map(|f| flash(&f)).transpose()?;
     if worldline.as_ref().is_some_and(|w| !w.is_uniform()) {
-        for (key, what) in [("shutter", shutter > 0.0), ("flash", flash.is_some())] {
+        for (key, what) in [("shutter", shutter > 0.0)] {
             if what {
                 return Err(t.error(
                     key,
@@ -138,12 +138,18 @@ pub(super) fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
         // At rest in the camera's frame, where the camera's worldline is. Its times are on the
         // camera's clock, which reads `time` at the imaging event; a light's are its frame's.
         let at_camera = Boost::to_rest(&velocity).event(camera.imaging_event());
+        // On a worldline that changes velocity the flash rides along it, on its clock.
+        let line = camera.worldline.clone().filter(|w| !w.is_uniform());
         Light {
             position: at_camera.x,
             radiance,
             velocity,
             inverse_square,
-            timing: timing.delayed(at_camera.t - time),
+            timing: match line {
+                Some(_) => timing,
+                None => timing.delayed(at_camera.t - time),
+            },
+            worldline: line,
         }
     });
     Ok((camera, flash))

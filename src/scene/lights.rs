@@ -70,6 +70,18 @@ pub(super) fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
         },
         (None, v) => v.unwrap_or(Velocity::ZERO),
     };
+    // A worldline through `position` at world time 0, whose clock reads 0 there.
+    let segments = super::worldline::read(t, "velocity_direction")?;
+    if segments.is_some() && t.has("group") {
+        return Err(t.error("group", "give either `group` or a worldline, not both"));
+    }
+    let worldline = segments
+        .map(|s| super::Worldline::new(crate::spacetime::Event::new(0.0, position), &s))
+        .filter(|w| !w.is_uniform());
+    let velocity = match &worldline {
+        Some(w) => w.velocity(0.0),
+        None => velocity,
+    };
     t.string("name")?;
     let keys = [
         "position",
@@ -83,6 +95,7 @@ pub(super) fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
         "rapidity",
         "one_minus_beta",
         "name",
+        "worldline",
     ];
     t.finish(&[&keys[..], &TIMING_KEYS[..]].concat())?;
     Ok(Light {
@@ -91,5 +104,6 @@ pub(super) fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
         velocity,
         inverse_square,
         timing,
+        worldline,
     })
 }

@@ -336,6 +336,10 @@ pub struct Light {
     /// How its emission varies over its proper time: the time of the frame it rests in, whose
     /// clock reads 0 where that frame's origin passes the world origin at world time 0.
     pub timing: super::Timing,
+    /// Its worldline where its velocity changes (`worldline`, or a flash on a camera whose
+    /// velocity changes): then `position` and `velocity` are unused, and its clock reads the
+    /// worldline's anchor time at the anchor.
+    pub worldline: Option<super::Worldline>,
 }
 
 /// Objects sharing one uniform velocity; geometry in their rest frame.
@@ -442,9 +446,18 @@ impl Scene {
         s.camera.time += shift.t;
         s.camera.worldline = s.camera.worldline.as_ref().map(|w| w.translated(shift));
         for l in &mut s.lights {
-            let own = Boost::to_rest(&l.velocity).event(shift);
-            l.position += own.x;
-            l.timing = l.timing.delayed(own.t);
+            match &l.worldline {
+                Some(w) => {
+                    // The clock moves with the anchor: it reads the same at the moved events.
+                    l.worldline = Some(w.translated(shift));
+                    l.timing = l.timing.delayed(shift.t);
+                }
+                None => {
+                    let own = Boost::to_rest(&l.velocity).event(shift);
+                    l.position += own.x;
+                    l.timing = l.timing.delayed(own.t);
+                }
+            }
         }
         for g in &mut s.groups {
             g.window = g.window.map(|w| w.translated(shift));

@@ -406,6 +406,55 @@ impl Worldline {
         t
     }
 
+    /// The world time of the event on it that lies on the past light cone of `e`: the root
+    /// of g(t) = (e.t − t) − |X(t) − e.x|, which falls at least 1 − |v| > 0 per unit of t (so
+    /// the root is one), by Newton's steps kept within a bracket that halves when a step
+    /// leaves it.
+    pub fn retarded(&self, e: Event) -> f64 {
+        let g = |t: f64| {
+            let d = self.position(t) - e.x;
+            let len = d.length();
+            let slope = if len > 0.0 {
+                -1.0 - d.dot(self.velocity(t).beta_vec()) / len
+            } else {
+                -1.0
+            };
+            ((e.t - t) - len, slope)
+        };
+        // g(e.t) ≤ 0; step back until g > 0.
+        let mut hi = e.t;
+        let mut back = 1.0 + (self.position(e.t) - e.x).length();
+        let mut lo = e.t - back;
+        while g(lo).0 <= 0.0 {
+            back *= 2.0;
+            lo = e.t - back;
+            if !lo.is_finite() {
+                return lo;
+            }
+        }
+        let mut t = 0.5 * (lo + hi);
+        for _ in 0..100 {
+            let (v, slope) = g(t);
+            if v > 0.0 {
+                lo = t;
+            } else {
+                hi = t;
+            }
+            let newton = t - v / slope;
+            let next = if newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+            let done = (next - t).abs() <= 1e-15 * t.abs().max(1.0);
+            t = next;
+            if done || hi - lo <= 1e-15 * t.abs().max(1.0) {
+                break;
+            }
+        }
+        t
+    }
+
     /// The same worldline moved by the spacetime translation `shift`.
     pub fn translated(&self, shift: Event) -> Worldline {
         Worldline {
@@ -662,6 +711,37 @@ mod tests {
         assert_eq!(w.from.frame(), line.velocity(9.0));
         assert!((w.to.frame().beta_vec().x + 0.8).abs() < 1e-12);
         assert!(w.contains(Event::new(10.0 + turn / 2.0, DVec3::new(far, 0.0, 0.0))));
+    }
+
+    /// The retarded event lies on the past light cone of the event asked about.
+    #[test]
+    fn retarded_events_lie_on_the_past_light_cone() {
+        let line = Worldline::new(
+            Event::new(0.0, DVec3::new(1.0, 2.0, 0.0)),
+            &[
+                seg(Some(-3.0), 0.9),
+                accel(2.0, -0.7),
+                Segment {
+                    until: None,
+                    motion: Motion::Coast,
+                },
+            ],
+        );
+        for (t, x) in [
+            (0.0, 5.0),
+            (10.0, -3.0),
+            (-20.0, 40.0),
+            (3.0, 1.0),
+            (100.0, 0.0),
+        ] {
+            let e = Event::new(t, DVec3::new(x, -1.0, 2.0));
+            let te = line.retarded(e);
+            let gap = (e.t - te) - (line.position(te) - e.x).length();
+            assert!(
+                te <= e.t && gap.abs() < 1e-12 * (1.0 + e.t.abs()),
+                "{e:?}: {te}, {gap}"
+            );
+        }
     }
 
     /// A tiny acceleration moves as the uniform motion does, to its own small order.
