@@ -184,6 +184,76 @@ fn wide_exposure_is_the_mean_of_narrow_ones() {
     }
 }
 
+/// The same on an accelerated worldline: the camera at rest until world time −3, then
+/// accelerating at 0.3 toward where it looks until world time 8, so the exposure of 4 proper
+/// time about the imaging event at world time 0 is all acceleration (β from 0.2 to 0.89).
+/// Narrow render i is the camera at its clock's τᵢ on the worldline, with its velocity there.
+/// The picture changes more over this exposure than over the uniform one, so the pixels'
+/// sampling noise (the narrow renders share their sub-pixel positions) leaves more in Σ|Δ|;
+/// the signed difference, the bias, is checked tightly.
+#[test]
+fn wide_exposure_on_an_accelerating_camera_is_the_mean_of_narrow_ones() {
+    let text = MOVING.replace(
+        "velocity = [0, 0.7, 0]",
+        "worldline = [{ until = -3, velocity = [0, 0, 0] }, { until = 8, acceleration = [0, 0.3, 0] }]",
+    );
+    let wide_scene = scene(&text);
+    let n = 32;
+    let cam = wide_scene.camera.clone();
+    let with = |samples: u32, shutter: f64, time: f64| {
+        let mut s = wide_scene.clone();
+        s.image.samples = samples;
+        s.camera = cam.at_time(time);
+        s.camera.shutter = shutter;
+        s
+    };
+    for backend in backends() {
+        let mut mean = vec![[0.0f64; 4]; 64 * 40];
+        for i in 0..n {
+            let tau = cam.shutter * ((i as f64 + 0.5) / n as f64 - 0.5);
+            let f = render_with(&with(32, 0.0, cam.world_time_at(cam.time + tau)), backend);
+            for (m, p) in mean.iter_mut().zip(&f.pixels) {
+                for (mk, v) in m.iter_mut().zip(p.values()) {
+                    *mk += v as f64 / n as f64;
+                }
+            }
+        }
+        let wide = render_with(&with(256, cam.shutter, cam.time), backend);
+        let unsigned = relative_difference(&wide, &mean);
+        let instant = relative_difference(&render_with(&with(256, 0.0, cam.time), backend), &mean);
+        let bias = (0..3)
+            .map(|k| {
+                let (mut d, mut size) = (0.0, 0.0);
+                for (p, q) in wide.pixels.iter().zip(&mean) {
+                    d += p.values()[k] as f64 - q[k];
+                    size += q[k].abs();
+                }
+                (d / size).abs()
+            })
+            .fold(0.0, f64::max);
+        report(
+            "shutter on an accelerating camera: wide against the mean of narrow",
+            backend,
+            0.0,
+            unsigned,
+            0.005,
+            "relative",
+        );
+        report(
+            "shutter on an accelerating camera: bias of wide against the mean of narrow",
+            backend,
+            0.0,
+            bias,
+            5e-4,
+            "relative",
+        );
+        assert!(
+            instant > 5.0 * unsigned,
+            "{backend}: the test tells exposures apart ({unsigned}; instant {instant})"
+        );
+    }
+}
+
 #[test]
 fn shutter_zero_is_an_instant_and_negative_is_refused() {
     let open = scene(MOVING);

@@ -318,11 +318,6 @@ fn bad_camera_worldlines_and_clocks_are_refused() {
         ),
         (
             "fov_y = 20",
-            "fov_y = 20\nshutter = 0.1",
-            "camera.shutter`: a camera whose worldline changes velocity cannot have a shutter yet",
-        ),
-        (
-            "fov_y = 20",
             "fov_y = 20\nvelocity = [0.1, 0, 0]",
             "give the motion either as a velocity or as a worldline",
         ),

@@ -49,9 +49,43 @@ impl CameraRays {
     /// [`CameraRays::ray`] from the event `f` of the exposure after the imaging event (`f`
     /// from −½ to ½): the same direction, its origin moved along the camera's worldline.
     pub fn ray_in_exposure(&self, px: f64, py: f64, f: f64) -> NullRay {
+        if let Some(line) = self.camera.worldline.as_ref().filter(|w| !w.is_uniform()) {
+            // On a worldline that changes velocity: the event a proper time f·s on, seen with
+            // the velocity there (its clock from the worldline's anchor).
+            let tau = line.proper_time(self.event.t) + f * self.camera.shutter;
+            let t = line.world_time(tau);
+            let to_world = Boost::from_rest(&line.velocity(t));
+            return self.ray_from(px, py, Event::new(t, line.position(t)), &to_world);
+        }
         let r = self.ray(px, py);
         let shift = Event::new(f * self.exposure.t, f * self.exposure.x);
         NullRay::new(r.origin + shift, r.dir)
+    }
+
+    /// [`CameraRays::ray`] as the camera sees from `event`, moving with the boost `to_world`
+    /// out of its rest frame there (a sample of an exposure on a worldline that changes
+    /// velocity).
+    fn ray_from(&self, px: f64, py: f64, event: Event, to_world: &Boost) -> NullRay {
+        let c = &self.camera;
+        let (u, v) = self.centred(px, py);
+        let (origin, dir_cam) = match c.projection {
+            Projection::Pinhole { .. } => (
+                event,
+                (self.focal * c.forward + u * c.right + v * c.up).normalize(),
+            ),
+            Projection::Orthographic { view_height } => {
+                let offset = (u * c.right + v * c.up) * (view_height / self.height);
+                (event + to_world.event(Event::new(0.0, offset)), c.forward)
+            }
+            Projection::Equirectangular => {
+                let lon = (px / self.width - 0.5) * 2.0 * PI;
+                let lat = (0.5 - py / self.height) * PI;
+                let d =
+                    lat.cos() * (lon.cos() * c.forward + lon.sin() * c.right) + lat.sin() * c.up;
+                (event, d)
+            }
+        };
+        NullRay::new(origin, to_world.view_dir(dir_cam).0)
     }
 
     /// The pinhole camera's looking directions (None for other projections).
@@ -191,5 +225,18 @@ impl CameraRays {
     /// the Doppler factor of a surface with factor s is this over s.
     pub fn lookback_factor(&self, dir_world: DVec3) -> f64 {
         self.to_camera.null_dir(dir_world).1
+    }
+
+    /// [`CameraRays::lookback_factor`] of a primary ray, with the camera's velocity where the
+    /// ray starts: on a worldline that changes velocity, a sample of an exposure sees with the
+    /// velocity at its own event.
+    pub fn lookback_factor_of(&self, ray: &NullRay) -> f64 {
+        match self.camera.worldline.as_ref() {
+            Some(line) if self.has_shutter() && !line.is_uniform() => {
+                let v = line.velocity(ray.origin.t);
+                Boost::to_rest(&v).null_dir(ray.dir).1
+            }
+            _ => self.lookback_factor(ray.dir),
+        }
     }
 }

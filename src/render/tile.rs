@@ -270,7 +270,7 @@ fn shade_hits<'a, B: Band>(
     lits.extend((0..primary.len()).map(|i| {
         let ray = primary.ray(i);
         let camera_s = if follows {
-            cam.lookback_factor(ray.dir)
+            cam.lookback_factor_of(&ray)
         } else {
             1.0
         };
@@ -281,7 +281,7 @@ fn shade_hits<'a, B: Band>(
                 let lit = if spreads {
                     let (x, y) = coords[i];
                     let omega = cam.pixel_solid_angle(x + ox, y + oy);
-                    lit.with_spread(omega * (cam.lookback_factor(ray.dir) / h.s).powi(2))
+                    lit.with_spread(omega * (cam.lookback_factor_of(&ray) / h.s).powi(2))
                 } else {
                     lit
                 };
@@ -334,7 +334,7 @@ fn shade_hits<'a, B: Band>(
             if let Some(h) = primary.hit(k) {
                 let ray = primary.ray(k);
                 let camera_s = if follows {
-                    cam.lookback_factor(ray.dir)
+                    cam.lookback_factor_of(&ray)
                 } else {
                     1.0
                 };
@@ -417,7 +417,7 @@ fn shade_paths<B: Band>(
     colors.extend((0..primary.len()).map(|i| {
         let ray = primary.ray(i);
         let camera_s = if follows {
-            cam.lookback_factor(ray.dir)
+            cam.lookback_factor_of(&ray)
         } else {
             1.0
         };
@@ -429,7 +429,7 @@ fn shade_paths<B: Band>(
                 let spread = match spreads {
                     true => Spread {
                         sr: cam.pixel_solid_angle(x, y),
-                        s: cam.lookback_factor(ray.dir),
+                        s: cam.lookback_factor_of(&ray),
                     },
                     false => Spread::NONE,
                 };
@@ -586,7 +586,7 @@ fn background_sums<B: Band>(
                 let ray = cam.ray((x + ox) as f64 + 0.5, (y + oy) as f64 + 0.5);
                 n as f64
                     * shader
-                        .background(cam.lookback_factor(ray.dir), 1.0)
+                        .background(cam.lookback_factor_of(&ray), 1.0)
                         .to_rgb()
             })
             .collect()

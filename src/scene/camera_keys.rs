@@ -95,16 +95,6 @@ pub(super) fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
         "0 (an instant) or more: the exposure in the camera's proper time",
     )?;
     let flash = t.table("flash")?.map(|f| flash(&f)).transpose()?;
-    if worldline.as_ref().is_some_and(|w| !w.is_uniform()) {
-        for (key, what) in [("shutter", shutter > 0.0)] {
-            if what {
-                return Err(t.error(
-                    key,
-                    format!("a camera whose worldline changes velocity cannot have a {key} yet (not built)"),
-                ));
-            }
-        }
-    }
     t.finish(&[
         "position",
         "shutter",

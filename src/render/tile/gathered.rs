@@ -106,7 +106,7 @@ fn fill_passes(
     let prim = g.geometry.prim(hit.prim);
     let nrm = prim.normal(hit.point);
     value.lookback = to_f32(hit.lambda);
-    value.doppler = to_f32(cam.lookback_factor(r.dir) / hit.s);
+    value.doppler = to_f32(cam.lookback_factor_of(r) / hit.s);
     let part = g.geometry.part_of(hit.prim);
     value.object_id = part.object + 1;
     value.material_id = part.material + 1;
