@@ -27,9 +27,6 @@ pub(crate) fn accelerated_refusal(geometry: &Geometry) -> Option<String> {
     if n > MAX_ACCELERATED_PRIMS {
         return Some(format!("the group has {n} primitives: a group with an accelerated segment is intersected primitive by primitive, at most {MAX_ACCELERATED_PRIMS}"));
     }
-    if (0..n).any(|i| matches!(geometry.prim(i), crate::geometry::Primitive::Capsule { .. })) {
-        return Some("rods in a group with an accelerated segment are not built yet (spheres, boxes and meshes are)".into());
-    }
     if geometry.spins() {
         return Some(
             "spinning objects in a group with an accelerated segment are not built yet".into(),
