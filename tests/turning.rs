@@ -104,6 +104,10 @@ fn a_spinning_bar_is_where_the_march_along_the_ray_finds_it() {
                 continue;
             }
             let Some(lambda) = truth else { continue };
+            assert!(
+                lookback[i].is_finite() && doppler[i].is_finite(),
+                "{backend}: pixel {x}"
+            );
             covered += 1;
             worst = worst.max((lookback[i] as f64 / lambda - 1.0).abs());
             let p = DVec3::new(px[i] as f64, py[i] as f64, 0.0);
@@ -206,4 +210,29 @@ fn bad_wheels_are_refused() {
     assert!(e.contains("object.0.spokes"), "{e}");
     let e = load("type = \"wheel\"\ncenter = [0, 0, 0]\nradius = 1\nscale = 2");
     assert!(e.contains("a wheel is placed by its own keys"), "{e}");
+}
+
+/// Far in time (about 10⁶ turns later... a million units of time) the bar looks as it did a
+/// whole number of turns before: its rays start near the imaging event in the group's time,
+/// so their lookbacks stay small however late the view.
+#[test]
+fn a_bar_a_million_units_of_time_later_is_the_same_bar() {
+    let period = std::f64::consts::TAU / OMEGA;
+    let turns = (1e6 / period).round();
+    for backend in backends() {
+        let at = |t: f64| render_with(&scene(&view(&bar(OMEGA), t, 120, 41, 100.0)), backend);
+        let (a, b) = (at(10.0), at(10.0 + turns * period));
+        same_picture(&a, &b, "a million units later", 2.0 / (120.0 * 41.0), 1e-3);
+        let (la, lb) = (
+            a.channel("lookback.V").unwrap(),
+            b.channel("lookback.V").unwrap(),
+        );
+        let worst = la
+            .iter()
+            .zip(&lb)
+            .filter(|(x, y)| **x > 0.0 && **y > 0.0)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-4, "{backend}: lookbacks differ by {worst}");
+    }
 }

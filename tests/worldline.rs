@@ -407,6 +407,12 @@ max = [8, 3, -1.5]
             worst < 1e-5,
             "{backend}: colours differ by {worst} (relative)"
         );
+        assert!(
+            b.pixels
+                .iter()
+                .all(|p| p.color.iter().all(|c| c.is_finite())),
+            "{backend}: finite colours"
+        );
         let lit = a.pixels.iter().filter(|p| p.color[0] > 0.01).count();
         assert!(lit > 100, "{backend}: {lit} pixels lit");
     }

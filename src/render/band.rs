@@ -249,6 +249,12 @@ pub fn needs_spectra(scene: &Scene) -> bool {
         .iter()
         .any(|g| g.accelerated.is_some() || g.geometry.spins())
         || scene.lights.iter().any(|l| l.worldline.is_some())
+        || (scene.camera.shutter > 0.0
+            && scene
+                .camera
+                .worldline
+                .as_ref()
+                .is_some_and(|w| !w.is_uniform()))
     {
         return true;
     }

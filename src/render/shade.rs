@@ -385,14 +385,7 @@ impl<'a, B: Band> Shader<'a, B> {
         let part = g.geometry.part_of(hit.prim);
         let mat = &self.scene.materials[part.material as usize];
         let v = hit.dir / hit.s;
-        // A turning body's normal is its shape's at time 0, turned as the body is.
-        let n = match &part.spin {
-            Some(sp) if sp.turning => {
-                let t = g.boost.event(event).t;
-                sp.turned_dir(prim.normal(sp.unturned(hit.point, t)), t)
-            }
-            _ => prim.normal(hit.point),
-        };
+        let n = crate::render::world::surface_normal(g, hit, event);
         let inside = n.dot(v) > 0.0;
         let faced = if inside { -n } else { n };
         // A mesh's vertex normals shade it smoothly, turned to the side the ray sees.

@@ -109,8 +109,11 @@ pub struct WorldGroup {
     /// on the segment's start hyperplane, `World::rest_ray`).
     pub accelerated: Option<crate::scene::Accelerated>,
     /// Its spinning bodies whose shape turns (not of revolution), if any: the group is then
-    /// intersected directly, its rays starting on its hyperplane of time 0.
+    /// intersected directly, its rays starting on its hyperplane of time `turn_time`.
     pub turning: Option<Arc<[TurningPart]>>,
+    /// The group's time of the imaging event, where a turning group's rays are made to start
+    /// (near the events they meet, so that their lookbacks stay small).
+    pub turn_time: f64,
 }
 
 impl WorldGroup {
@@ -120,7 +123,7 @@ impl WorldGroup {
     fn time_origin(&self) -> Option<f64> {
         match (&self.accelerated, &self.turning) {
             (Some(acc), _) => Some(acc.start.t),
-            (None, Some(_)) => Some(0.0),
+            (None, Some(_)) => Some(self.turn_time),
             (None, None) => None,
         }
     }
@@ -136,7 +139,7 @@ impl WorldGroup {
     fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         if let Some(parts) = &self.turning {
             for (r, h) in rays.iter().zip(hits.iter_mut()) {
-                *h = turning::intersect(&self.geometry, parts, r);
+                *h = turning::intersect(&self.geometry, parts, r, self.turn_time);
             }
             return;
         }
@@ -168,7 +171,7 @@ impl WorldGroup {
     fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
         if let Some(parts) = &self.turning {
             for (r, o) in rays.iter().zip(out.iter_mut()) {
-                *o = turning::intersect(&self.geometry, parts, r).is_some();
+                *o = turning::intersect(&self.geometry, parts, r, self.turn_time).is_some();
             }
             return;
         }
@@ -200,6 +203,19 @@ impl WorldGroup {
         let mut o = [false];
         self.occluded(std::slice::from_ref(r), &mut o);
         o[0]
+    }
+}
+
+/// The outward normal (rest frame) at a hit seen at world event `event`: a turning body's is
+/// its shape's at time 0 at the point turned back, turned as the body is.
+pub(crate) fn surface_normal(g: &WorldGroup, hit: &SurfaceHit, event: Event) -> DVec3 {
+    let prim = g.geometry.prim(hit.prim);
+    match &g.geometry.part_of(hit.prim).spin {
+        Some(sp) if sp.turning => {
+            let t = g.boost.event(event).t;
+            sp.turned_dir(prim.normal(sp.unturned(hit.point, t)), t)
+        }
+        _ => prim.normal(hit.point),
     }
 }
 
@@ -305,6 +321,7 @@ impl World {
                 spins: g.spins,
                 accelerated: g.accelerated,
                 turning: g.turning.clone(),
+                turn_time: g.boost.event(event).t,
             })
             .collect();
         let (tree, primary_tree, light_trees) =

@@ -75,9 +75,10 @@ pub(super) fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
     if segments.is_some() && t.has("group") {
         return Err(t.error("group", "give either `group` or a worldline, not both"));
     }
-    let worldline = segments
-        .map(|s| super::Worldline::new(crate::spacetime::Event::new(0.0, position), &s))
-        .filter(|w| !w.is_uniform());
+    // Kept even when it is one uniform motion: `position` is then still where the light is
+    // at world time 0, not in its rest frame.
+    let worldline =
+        segments.map(|s| super::Worldline::new(crate::spacetime::Event::new(0.0, position), &s));
     let velocity = match &worldline {
         Some(w) => w.velocity(0.0),
         None => velocity,

@@ -575,6 +575,17 @@ pub(crate) fn groups(
                             "a segment accelerates across the velocity it starts with: only along it (or from rest) is built yet (the body would come out of it turned by a Thomas-Wigner rotation)".to_string(),
                         ));
                     }
+                    // A rod is marched with steps that shrink as e^-θ_end (accelerated.rs).
+                    let theta_end = h.theta_at(b);
+                    let rods = (0..geometry.len()).any(|i| {
+                        matches!(geometry.prim(i), crate::geometry::Primitive::Capsule { .. })
+                    });
+                    if rods && theta_end > 5.0 {
+                        return Err(t.error(
+                            "worldline",
+                            format!("a segment accelerates the group to rapidity {theta_end:.3} (more than 5, a speed of 0.99991c, relative to its start): its rods are marched with steps too fine to finish; give the group spheres, boxes or meshes, or a shorter segment"),
+                        ));
+                    }
                     let start = h.to_start_frame().event(h.start);
                     let sweep = (1.0 / h.a + geometry.bounds().support(h.axis))
                         * crate::spacetime::cosh_m1(h.theta_at(b));

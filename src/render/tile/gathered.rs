@@ -103,8 +103,7 @@ fn fill_passes(
     (scene, to_camera, eye): (&Scene, &crate::spacetime::Boost, crate::spacetime::Event),
 ) {
     let g = &world.groups[hit.group];
-    let prim = g.geometry.prim(hit.prim);
-    let nrm = prim.normal(hit.point);
+    let nrm = crate::render::world::surface_normal(g, hit, r.at(hit.lambda));
     value.lookback = to_f32(hit.lambda);
     value.doppler = to_f32(cam.lookback_factor_of(r) / hit.s);
     let part = g.geometry.part_of(hit.prim);

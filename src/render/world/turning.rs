@@ -5,8 +5,8 @@
 //! most s (1 + |ω| R) per unit of lookback (s the ray's lookback factor, R the body's reach from
 //! its centre), so a step of the distance over that never passes a surface.
 //!
-//! The rays reaching here start on the group's hyperplane of time 0 (`World::rest_ray`), so the
-//! group's time is T = −|d| t along `origin + t dir`.
+//! The rays reaching here start on the group's hyperplane of time T₀ (the imaging event's,
+//! `World::rest_ray`), so the group's time is T = T₀ − |d| t along `origin + t dir`.
 
 use crate::accel::{Hit, Ray};
 use crate::geometry::{Geometry, Primitive, Spin};
@@ -150,7 +150,12 @@ pub(crate) fn turning_parts(geometry: &Geometry) -> Vec<TurningPart> {
 
 /// The first primitive on the ray: the still ones by their own tests, each turning part by
 /// sphere tracing.
-pub(super) fn intersect(geometry: &Geometry, parts: &[TurningPart], ray: &Ray) -> Option<Hit> {
+pub(super) fn intersect(
+    geometry: &Geometry,
+    parts: &[TurningPart],
+    ray: &Ray,
+    t0: f64,
+) -> Option<Hit> {
     if !ray.is_active() {
         return None;
     }
@@ -170,7 +175,7 @@ pub(super) fn intersect(geometry: &Geometry, parts: &[TurningPart], ray: &Ray) -
     }
     for p in parts {
         let tmax = best.map_or(ray.tmax, |h| h.t);
-        if let Some(h) = march(geometry, p, ray, tmax) {
+        if let Some(h) = march(geometry, p, ray, tmax, t0) {
             best = Some(h);
         }
     }
@@ -196,7 +201,7 @@ fn distance(geometry: &Geometry, part: &TurningPart, q: DVec3) -> (f64, u32) {
 }
 
 /// Sphere tracing through one turning part, within the ball it sweeps.
-fn march(geometry: &Geometry, part: &TurningPart, ray: &Ray, tmax: f64) -> Option<Hit> {
+fn march(geometry: &Geometry, part: &TurningPart, ray: &Ray, tmax: f64, t0: f64) -> Option<Hit> {
     let sp = &part.spin;
     let s = ray.len;
     // The ball about the centre that holds the part at every turn.
@@ -248,7 +253,7 @@ fn march(geometry: &Geometry, part: &TurningPart, ray: &Ray, tmax: f64) -> Optio
     let tol = 1e-10 * part.reach.max(1e-300);
     for _ in 0..MAX_STEPS {
         let p = ray.origin + t * ray.dir;
-        let q = sp.unturned(p, -s * t);
+        let q = sp.unturned(p, t0 - s * t);
         let (d, prim) = distance(geometry, part, q);
         if d < tol {
             return (t > ray.tmin).then_some(Hit { t, prim });
@@ -292,7 +297,7 @@ mod tests {
             let x = -3.0 + 0.02 * i as f64;
             let look = DVec3::new(0.0, 1.0, 0.05).normalize();
             let ray = Ray::new(DVec3::new(x, -5.0, 0.0), look, 0.0, 50.0);
-            let Some(h) = intersect(&g, &parts, &ray) else {
+            let Some(h) = intersect(&g, &parts, &ray, 0.0) else {
                 continue;
             };
             hits += 1;
