@@ -55,7 +55,7 @@ done
 oiiotool "${frames[@]}" --mosaic 3x2 -o "$o/twin-film.png"
 rm -rf "$film"
 # The lattice at 0.9c with the shutter open for 0.12 of the camera's time.
-$r render scenes/lattice.toml -o "$o/lattice-shutter-0.9.png" "${size[@]}" --samples 32 --set 'group.lattice.velocity=[-0.9, 0, 0]' --set camera.shutter=0.12
+$r render scenes/lattice.toml -o "$o/lattice-shutter-0.9.png" --width 320 --height 320 --samples 32 --quiet --set 'group.lattice.velocity=[-0.9, 0, 0]' --set camera.shutter=0.12
 # Six frames of the train accelerating Born-rigidly past a camera at rest.
 film=$(mktemp -d)
 frames=()
