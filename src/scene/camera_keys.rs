@@ -4,8 +4,9 @@
 use super::lights::flash;
 use super::model::*;
 use super::reader::{SceneResult, Table};
+use super::segments;
 use super::speed::velocity;
-use super::worldline::{self, Worldline};
+use super::worldline::Worldline;
 use crate::spacetime::{Boost, Event, Velocity};
 use glam::DVec3;
 
@@ -82,7 +83,7 @@ pub(super) fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
         }
     };
     let time = t.f64_or("time", 0.0)?;
-    let worldline = worldline::read(t, "velocity_direction")?
+    let worldline = segments::read(t, "velocity_direction")?
         .map(|s| Worldline::new(Event::new(time, position), &s));
     let velocity = match &worldline {
         Some(w) => w.velocity(time),

@@ -8,7 +8,8 @@ use super::objects::{add_object, OBJECT_KEYS};
 use super::reader::{SceneResult, Table};
 use super::speed::velocity;
 use super::surfaces::{material, sky, textures};
-use super::worldline;
+// A group's `worldline` key and the groups it makes.
+use super::segments as worldline;
 use super::{PassSet, SceneError, Texture};
 use crate::geometry::Geometry;
 use crate::spacetime::Velocity;
@@ -319,12 +320,7 @@ fn group(
         let copies = (count - 1) as u64;
         let held = copies.saturating_mul(geometry.prims.len() as u64);
         super::objects::budget(t, "worldline", total, held)?;
-        let inside = |m: &Material| m.transmit > 0.0 || m.medium.is_some();
-        if geometry
-            .parts
-            .iter()
-            .any(|p| inside(&materials[p.material as usize]))
-        {
+        if holds_glass_or_media(&geometry, materials) {
             return Err(t.error(
                 "worldline",
                 "glass and media in a group whose velocity changes are not built yet (light inside them would be followed in one segment's frame)",
@@ -338,12 +334,7 @@ fn group(
                 "a spinning box, wheel or rod about a cross axis in a group whose velocity changes is not built yet",
             ));
         }
-        let inside = |m: &Material| m.transmit > 0.0 || m.medium.is_some();
-        if geometry
-            .parts
-            .iter()
-            .any(|p| inside(&materials[p.material as usize]))
-        {
+        if holds_glass_or_media(&geometry, materials) {
             return Err(t.error(
                 "object",
                 "glass and media in a group with a spinning box, wheel or rod about a cross axis are not built yet (light inside them is followed in the group's frame, where the turning body is not)",
@@ -371,6 +362,15 @@ fn group(
             window: None,
             accelerated: None,
         }],
+    })
+}
+
+/// Whether any part of `geometry` is glass or holds a medium: light inside it is followed in
+/// its group's frame, which a group whose velocity changes or that holds a turning body lacks.
+fn holds_glass_or_media(geometry: &Geometry, materials: &[Material]) -> bool {
+    geometry.parts.iter().any(|p| {
+        let m = &materials[p.material as usize];
+        m.transmit > 0.0 || m.medium.is_some()
     })
 }
 
