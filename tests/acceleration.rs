@@ -63,24 +63,7 @@ fn first_inside(a: f64, until: f64, time: f64, u: f64) -> Option<f64> {
         let rho = (x * x - t * t).sqrt();
         DVec3::new(rho - 1.0 / a, p.y, p.z).length() < 1.0
     };
-    let step = 1e-3;
-    let mut lambda = 0.0;
-    while lambda < 40.0 {
-        if inside(lambda + step) {
-            let (mut lo, mut hi) = (lambda, lambda + step);
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if inside(mid) {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            return Some(hi);
-        }
-        lambda += step;
-    }
-    None
+    first_entry(inside, 0.0, 40.0, 1e-3)
 }
 
 /// Where the centre row's outline lies, to a small fraction of a pixel: the pixel coordinate
@@ -209,23 +192,7 @@ fn the_coast_after_the_acceleration_takes_over_on_the_moving_frames_simultaneity
     };
     let first = |u: f64| -> Option<(f64, u8)> {
         let inside = |l: f64| point(u, l).0.length() < 1.0;
-        let mut l = 0.0;
-        while l < 40.0 {
-            if inside(l + 1e-3) {
-                let (mut lo, mut hi) = (l, l + 1e-3);
-                for _ in 0..60 {
-                    let mid = 0.5 * (lo + hi);
-                    if inside(mid) {
-                        hi = mid;
-                    } else {
-                        lo = mid;
-                    }
-                }
-                return Some((hi, point(u, hi).1));
-            }
-            l += 1e-3;
-        }
-        None
+        first_entry(inside, 0.0, 40.0, 1e-3).map(|l| (l, point(u, l).1))
     };
     let row = (H / 2) as usize * W as usize;
     for backend in backends() {
@@ -287,23 +254,7 @@ fn an_accelerating_rod_is_where_the_search_along_the_ray_finds_it() {
             let h = ((q - p0).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
             (q - (p0 + h * ab)).length() < r
         };
-        let mut l = 0.0;
-        while l < 40.0 {
-            if inside(l + 1e-3) {
-                let (mut lo, mut hi) = (l, l + 1e-3);
-                for _ in 0..60 {
-                    let mid = 0.5 * (lo + hi);
-                    if inside(mid) {
-                        hi = mid;
-                    } else {
-                        lo = mid;
-                    }
-                }
-                return Some(hi);
-            }
-            l += 1e-3;
-        }
-        None
+        first_entry(inside, 0.0, 40.0, 1e-3)
     };
     let row = (H / 2) as usize * W as usize;
     for backend in backends() {

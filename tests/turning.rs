@@ -67,23 +67,7 @@ fn a_spinning_bar_is_where_the_march_along_the_ray_finds_it() {
             let q = back * p;
             q.x.abs() <= 2.0 && q.y.abs() <= 0.2 && q.z.abs() <= 0.3
         };
-        let mut l = 5.0;
-        while l < 15.0 {
-            if inside(l + 1e-4) {
-                let (mut lo, mut hi) = (l, l + 1e-4);
-                for _ in 0..60 {
-                    let mid = 0.5 * (lo + hi);
-                    if inside(mid) {
-                        hi = mid;
-                    } else {
-                        lo = mid;
-                    }
-                }
-                return Some(hi);
-            }
-            l += 1e-4;
-        }
-        None
+        first_entry(inside, 5.0, 15.0, 1e-4)
     };
     let row = (H / 2) as usize * W as usize;
     for backend in backends() {

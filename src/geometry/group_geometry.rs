@@ -434,6 +434,20 @@ impl Geometry {
         self.parts.iter().any(|p| p.spin.is_some_and(|s| s.turning))
     }
 
+    /// How far `part`'s primitives reach from `centre` (their boxes' farthest corners): the
+    /// ball a turning part sweeps.
+    pub fn reach(&self, part: &Part, centre: DVec3) -> f64 {
+        (part.start..part.end)
+            .map(|i| {
+                let b = self.prim(i).bounds();
+                b.corners()
+                    .iter()
+                    .map(|c| (*c - centre).length())
+                    .fold(0.0, f64::max)
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// The box holding every primitive at every time: a turning part's as the ball about its
     /// centre that holds it turned any way.
     pub fn swept_bounds(&self) -> Aabb {
@@ -442,16 +456,7 @@ impl Geometry {
             let Some(sp) = part.spin.filter(|s| s.turning) else {
                 continue;
             };
-            let reach = (part.start..part.end)
-                .map(|i| {
-                    let pb = self.prim(i).bounds();
-                    pb.corners()
-                        .iter()
-                        .map(|c| (*c - sp.centre).length())
-                        .fold(0.0, f64::max)
-                })
-                .fold(0.0, f64::max);
-            let r = DVec3::splat(reach);
+            let r = DVec3::splat(self.reach(part, sp.centre));
             b = b.union(&Aabb::new(sp.centre - r, sp.centre + r));
         }
         b

@@ -80,3 +80,26 @@ pub fn write_png(path: &std::path::Path, w: u32, h: u32, f: impl Fn(u32, u32) ->
     }
     writer.write_image_data(&data).unwrap();
 }
+
+/// The first parameter in (`from`, `to`) at which `inside` holds, marched in steps of `step`
+/// and refined by 60 bisections: the independent search the closed forms and marches of the
+/// renderer are checked against (features thinner than a step are not seen).
+pub fn first_entry(inside: impl Fn(f64) -> bool, from: f64, to: f64, step: f64) -> Option<f64> {
+    let mut l = from;
+    while l < to {
+        if inside(l + step) {
+            let (mut lo, mut hi) = (l, l + step);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if inside(mid) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            return Some(hi);
+        }
+        l += step;
+    }
+    None
+}

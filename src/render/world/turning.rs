@@ -114,15 +114,7 @@ pub(crate) fn turning_parts(geometry: &Geometry) -> Vec<TurningPart> {
         .iter()
         .filter_map(|part| {
             let spin = part.spin.filter(|s| s.turning)?;
-            let reach = (part.start..part.end)
-                .map(|i| {
-                    let b = geometry.prim(i).bounds();
-                    b.corners()
-                        .iter()
-                        .map(|c| (*c - spin.centre).length())
-                        .fold(0.0, f64::max)
-                })
-                .fold(0.0, f64::max);
+            let reach = geometry.reach(part, spin.centre);
             let u = spin.axis.any_orthonormal_vector();
             let across = (u, spin.axis.cross(u));
             let shells: Vec<[f64; 6]> = (part.start..part.end)
