@@ -110,6 +110,18 @@ impl Aabb {
         pick(0) + pick(1) + pick(2)
     }
 
+    /// The box about this one turned by the rotation `r` (its corners turned).
+    pub fn turned(&self, r: glam::DMat3) -> Aabb {
+        if self.is_empty() {
+            return *self;
+        }
+        let mut b = Aabb::EMPTY;
+        for c in self.corners() {
+            b.grow(r * c);
+        }
+        b
+    }
+
     /// The largest absolute coordinate of the box.
     pub fn max_abs(&self) -> f64 {
         self.min.abs().max(self.max.abs()).max_element()

@@ -94,6 +94,9 @@ pub struct WorldGroup {
     /// Into the group's rest frame (its inverse leads out).
     pub boost: Boost,
     pub bounds: Aabb,
+    /// The bounds in the axes of the plain boost to its velocity (`bounds` unless its axes are
+    /// turned, `scene::Group::turn`): for the tests before the boost.
+    pub plain_bounds: Aabb,
     pub geometry: Arc<Geometry>,
     /// None for groups intersected directly; shared by every frame of a film.
     pub accel: Option<Arc<dyn Accelerator>>,
@@ -316,7 +319,8 @@ impl World {
                 geometry: g.geometry.clone(),
                 accel: g.accel.clone(),
                 epsilon: g.epsilon,
-                moving: MovingBounds::new(&g.bounds, &g.velocity, event.t),
+                moving: MovingBounds::new(&g.plain_bounds, &g.velocity, event.t),
+                plain_bounds: g.plain_bounds,
                 window: g.window,
                 spins: g.spins,
                 accelerated: g.accelerated,
@@ -369,7 +373,10 @@ impl World {
         backend: &dyn Backend,
     ) -> crate::Result<(Kinetic, ApparentTree, Vec<Option<LightTree>>)> {
         let event = scene.camera.imaging_event();
-        let items: Vec<(Aabb, Velocity)> = groups.iter().map(|g| (g.bounds, g.velocity)).collect();
+        let items: Vec<(Aabb, Velocity)> = groups
+            .iter()
+            .map(|g| (g.plain_bounds, g.velocity))
+            .collect();
         // Kinetic trees are tight near their reference times: spread them over the window in
         // which primary rays meet the groups, twice as deep as the farthest emission seen
         // from the imaging event (secondary rays reach further back).

@@ -361,6 +361,7 @@ fn group(
             geometry,
             window: None,
             accelerated: None,
+            turn: None,
         }],
     })
 }

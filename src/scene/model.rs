@@ -357,6 +357,21 @@ pub struct Group {
     /// For a segment of constant proper acceleration: how its geometry moves through the
     /// frame it starts at rest in (`velocity` is that frame's).
     pub accelerated: Option<Accelerated>,
+    /// After accelerating across its motion: the rotation (passive, X ↦ R X) from the axes of
+    /// the plain boost to `velocity` to the axes its geometry is given in, a Thomas-Wigner
+    /// rotation (docs/physics.md §12.7); None: those axes.
+    pub turn: Option<glam::DMat3>,
+}
+
+impl Group {
+    /// The transformation from the world frame into its rest frame, in its own axes.
+    pub fn to_rest(&self) -> Boost {
+        let plain = Boost::to_rest(&self.velocity);
+        match self.turn {
+            Some(r) => plain.turned(r),
+            None => plain,
+        }
+    }
 }
 
 /// A group's hyperbolic motion (docs/physics.md §12.7), in the frame S' it starts at rest in:
@@ -365,11 +380,12 @@ pub struct Group {
 /// geometry is its shape in that moving frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Accelerated {
-    /// The origin's start event, in S'.
+    /// The origin's start event, in S' (in the group's axes).
     pub start: Event,
     /// The proper acceleration of the origin, a > 0.
     pub a: f64,
-    /// The unit direction of the acceleration (in S').
+    /// The unit direction of the acceleration (in S', in the group's axes: turned as
+    /// `Group::turn` says).
     pub axis: glam::DVec3,
     /// The origin's rapidity (relative to S') at the end of the segment.
     pub theta_end: f64,
@@ -440,7 +456,6 @@ impl Scene {
     /// frame). Physics is translation-invariant, so the image must not change; each group's
     /// rest-frame geometry moves by the spatial part of the shift as that group measures it.
     pub fn translated(&self, shift: Event) -> Scene {
-        let rest_shift = |v: &Velocity| Boost::to_rest(v).event(shift).x;
         let mut s = self.clone();
         s.camera.position += shift.x;
         s.camera.time += shift.t;
@@ -461,10 +476,11 @@ impl Scene {
         }
         for g in &mut s.groups {
             g.window = g.window.map(|w| w.translated(shift));
+            let own = g.to_rest().event(shift);
             match &mut g.accelerated {
                 // Its shape is in the frame moving with it: its start moves instead.
-                Some(acc) => acc.start = acc.start + Boost::to_rest(&g.velocity).event(shift),
-                None => g.geometry = Arc::new(g.geometry.translated(rest_shift(&g.velocity))),
+                Some(acc) => acc.start = acc.start + own,
+                None => g.geometry = Arc::new(g.geometry.translated(own.x)),
             }
         }
         s

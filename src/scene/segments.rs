@@ -9,7 +9,7 @@ use super::worldline::{Piece, Worldline};
 use super::Group;
 use crate::geometry::Geometry;
 use crate::spacetime::{Boost, Event, Velocity};
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use std::sync::Arc;
 
 /// The most segments a worldline may have.
@@ -198,6 +198,7 @@ pub(crate) fn groups(
             geometry,
             window: None,
             accelerated: None,
+            turn: None,
         }]);
     }
     let too_far = |reach: f64| {
@@ -215,13 +216,16 @@ pub(crate) fn groups(
         .enumerate()
         .map(|(k, (piece, &(a, b)))| {
             let window = Some(line.window(k));
+            // The piece's axes, turned by the accelerations across the motion before it.
+            let r = line.turns[k];
+            let turn = (r != DMat3::IDENTITY).then_some(r);
             match piece {
                 Piece::Uniform { velocity, .. } => {
                     // An event of the origin's worldline within the span (the one nearest
                     // world time 0), and where that puts the origin, at rest, in the frame.
                     let when = 0.0f64.clamp(a, b);
                     let on_line = piece.event_at(when);
-                    let rest = Boost::to_rest(velocity).event(on_line).x;
+                    let rest = Boost::to_rest(velocity).turned(r).event(on_line).x;
                     let reach = rest.abs().max_element() + geometry.bounds().max_abs();
                     if reach > super::envelope::MAX_MAGNITUDE {
                         return Err(too_far(reach));
@@ -237,19 +241,13 @@ pub(crate) fn groups(
                         geometry,
                         window,
                         accelerated: None,
+                        turn,
                     })
                 }
                 Piece::Accelerated(h) => {
-                    // Accelerated across its motion, a body's frame at the end is the plain
-                    // boost to its velocity turned by a Thomas-Wigner rotation, which the
-                    // segments after it do not carry yet.
-                    let across = h.v0.direction().cross(h.axis).length();
-                    if !h.v0.is_zero() && across > 1e-9 {
-                        return Err(t.error(
-                            "worldline",
-                            "a segment accelerates across the velocity it starts with: only along it (or from rest) is built yet (the body would come out of it turned by a Thomas-Wigner rotation)".to_string(),
-                        ));
-                    }
+                    // The motion in the piece's own axes: those of S' turned by r, in which
+                    // the geometry is given.
+                    let axis = r * h.axis;
                     // A rod is marched with steps that shrink as e^-θ_end (accelerated.rs).
                     let theta_end = h.theta_at(b);
                     let rods = (0..geometry.len()).any(|i| {
@@ -261,15 +259,15 @@ pub(crate) fn groups(
                             format!("a segment accelerates the group to rapidity {theta_end:.3} (more than 5, a speed of 0.99991c, relative to its start): its rods are marched with steps too fine to finish; give the group spheres, boxes or meshes, or a shorter segment"),
                         ));
                     }
-                    let start = h.to_start_frame().event(h.start);
-                    let sweep = (1.0 / h.a + geometry.bounds().support(h.axis))
+                    let start = h.to_start_frame().turned(r).event(h.start);
+                    let sweep = (1.0 / h.a + geometry.bounds().support(axis))
                         * crate::spacetime::cosh_m1(h.theta_at(b));
                     let reach = start.x.abs().max_element() + geometry.bounds().max_abs() + sweep;
                     if reach > super::envelope::MAX_MAGNITUDE {
                         return Err(too_far(reach));
                     }
                     // Every point must stay ahead of the horizon, 1/a behind the origin.
-                    let behind = geometry.bounds().support(-h.axis);
+                    let behind = geometry.bounds().support(-axis);
                     if behind * h.a >= 1.0 {
                         return Err(t.error(
                             "worldline",
@@ -288,9 +286,10 @@ pub(crate) fn groups(
                         accelerated: Some(super::Accelerated {
                             start,
                             a: h.a,
-                            axis: h.axis,
+                            axis,
                             theta_end: h.theta_at(b),
                         }),
+                        turn,
                     })
                 }
             }

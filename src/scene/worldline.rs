@@ -5,7 +5,7 @@
 
 use super::segments::{Motion, Segment};
 use crate::spacetime::{Boost, Event, Hyperbola, Slice, Velocity, Window};
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 
 /// A piece of a resolved worldline.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,17 +63,25 @@ impl Piece {
     }
 }
 
+/// A resolved worldline: its pieces, their world-time spans, and the turn of each piece's axes
+/// (see [`Worldline::turns`]).
+type Resolved = (Vec<Piece>, Vec<(f64, f64)>, Vec<DMat3>);
+
 /// Resolve segments into pieces through `anchor`, with their world-time spans: velocities
 /// chained (an accelerated segment starts at the velocity before it, a coasting one keeps the
-/// velocity reached), positions continuous, neighbouring uniform pieces of one velocity
-/// merged (so that they render as one, to the bit), and after an accelerated last segment a
-/// coast at the velocity reached.
-fn resolve(anchor: Event, segments: &[Segment]) -> (Vec<Piece>, Vec<(f64, f64)>) {
+/// velocity reached), positions continuous, neighbouring uniform pieces of one velocity (and
+/// turn) merged (so that they render as one, to the bit), and after an accelerated last
+/// segment a coast at the velocity reached. The axes turn across an acceleration by the
+/// Thomas-Wigner rotation of its start velocity and the velocity it adds; a coast keeps them,
+/// and a segment that gives its velocity starts again from the plain boost's.
+fn resolve(anchor: Event, segments: &[Segment]) -> Resolved {
     let mut pieces: Vec<Piece> = Vec::with_capacity(segments.len() + 1);
     let mut spans: Vec<(f64, f64)> = Vec::with_capacity(segments.len() + 1);
+    let mut turns: Vec<DMat3> = Vec::with_capacity(segments.len() + 1);
     // Positions first relative to an arbitrary origin, then moved through the anchor.
     let mut start = f64::NEG_INFINITY;
     let mut here = Event::ORIGIN;
+    let mut turn = DMat3::IDENTITY;
     for s in segments {
         let end = s.until.unwrap_or(f64::INFINITY);
         let (last_v, last) = match pieces.last() {
@@ -88,10 +96,13 @@ fn resolve(anchor: Event, segments: &[Segment]) -> (Vec<Piece>, Vec<(f64, f64)>)
                 velocity: v,
                 at: Event::new(if end.is_finite() { end } else { 0.0 }, DVec3::ZERO),
             },
-            Motion::Uniform(v) => Piece::Uniform {
-                velocity: v,
-                at: here,
-            },
+            Motion::Uniform(v) => {
+                turn = DMat3::IDENTITY;
+                Piece::Uniform {
+                    velocity: v,
+                    at: here,
+                }
+            }
             Motion::Coast => Piece::Uniform {
                 velocity: last_v,
                 at: here,
@@ -100,17 +111,21 @@ fn resolve(anchor: Event, segments: &[Segment]) -> (Vec<Piece>, Vec<(f64, f64)>)
                 Piece::Accelerated(Hyperbola::new(here, last_v, a).expect("checked on reading"))
             }
         };
-        // Neighbouring uniform pieces of one velocity are one.
+        // Neighbouring uniform pieces of one velocity and turn are one.
         match (pieces.last(), &piece) {
             (Some(Piece::Uniform { velocity: v1, .. }), Piece::Uniform { velocity: v2, .. })
-                if v1 == v2 =>
+                if v1 == v2 && turns.last() == Some(&turn) =>
             {
                 spans.last_mut().expect("a piece").1 = end;
             }
             _ => {
                 pieces.push(piece);
                 spans.push((start, end));
+                turns.push(turn);
             }
+        }
+        if let Piece::Accelerated(h) = piece {
+            turn *= h.wigner(h.theta_at(end));
         }
         start = end;
     }
@@ -124,6 +139,7 @@ fn resolve(anchor: Event, segments: &[Segment]) -> (Vec<Piece>, Vec<(f64, f64)>)
                 at,
             });
             spans.push((end, f64::INFINITY));
+            turns.push(turn);
         }
         _ => spans.last_mut().expect("a piece").1 = f64::INFINITY,
     }
@@ -136,7 +152,7 @@ fn resolve(anchor: Event, segments: &[Segment]) -> (Vec<Piece>, Vec<(f64, f64)>)
         .iter()
         .map(|p| p.translated(Event::new(0.0, off)))
         .collect();
-    (pieces, spans)
+    (pieces, spans, turns)
 }
 
 /// A worldline of segments through the event `anchor`: continuous, each segment's motion held
@@ -146,16 +162,21 @@ pub struct Worldline {
     anchor: Event,
     pub(super) pieces: Vec<Piece>,
     pub(super) spans: Vec<(f64, f64)>,
+    /// Each piece's axes (at its start, for an accelerated one) as the rotation from those of
+    /// the plain boost to its velocity: the identity but after an acceleration across the
+    /// motion (docs/physics.md §12.7). A body's; a camera or light keeps the plain axes.
+    pub(super) turns: Vec<DMat3>,
 }
 
 impl Worldline {
     /// Through `anchor`, with `segments` in time order.
     pub(crate) fn new(anchor: Event, segments: &[Segment]) -> Worldline {
-        let (pieces, spans) = resolve(anchor, segments);
+        let (pieces, spans, turns) = resolve(anchor, segments);
         Worldline {
             anchor,
             pieces,
             spans,
+            turns,
         }
     }
 
@@ -295,6 +316,7 @@ impl Worldline {
                 .iter()
                 .map(|sp| (sp.0 + shift.t, sp.1 + shift.t))
                 .collect(),
+            turns: self.turns.clone(),
         }
     }
 
@@ -365,13 +387,13 @@ mod tests {
 
     #[test]
     fn equal_neighbours_merge_into_one() {
-        let (p, spans) = resolve(
+        let (p, spans, _) = resolve(
             Event::ORIGIN,
             &[seg(Some(1.0), 0.5), seg(Some(4.0), 0.5), seg(None, 0.1)],
         );
         assert_eq!(p.len(), 2);
         assert_eq!(spans, vec![(f64::NEG_INFINITY, 4.0), (4.0, f64::INFINITY)]);
-        let (p, spans) = resolve(Event::ORIGIN, &[seg(Some(1.0), 0.5), seg(Some(2.0), 0.5)]);
+        let (p, spans, _) = resolve(Event::ORIGIN, &[seg(Some(1.0), 0.5), seg(Some(2.0), 0.5)]);
         assert_eq!(p.len(), 1);
         assert_eq!(spans, vec![(f64::NEG_INFINITY, f64::INFINITY)]);
     }
@@ -428,6 +450,49 @@ mod tests {
         assert_eq!(w.from.frame(), line.velocity(9.0));
         assert!((w.to.frame().beta_vec().x + 0.8).abs() < 1e-12);
         assert!(w.contains(Event::new(10.0 + turn / 2.0, DVec3::new(far, 0.0, 0.0))));
+    }
+
+    /// Axes turn across an acceleration across the motion (by the Thomas-Wigner rotation of
+    /// the start velocity and the velocity added), not along it; a coast keeps the turn and a
+    /// given velocity starts from the plain boost's axes again.
+    #[test]
+    fn axes_turn_across_an_acceleration_across_the_motion() {
+        let v0 = Velocity::from_beta_vec(DVec3::new(0.0, 0.8, 0.0)).unwrap();
+        let coast = Segment {
+            until: Some(12.0),
+            motion: Motion::Coast,
+        };
+        let line = Worldline::new(
+            Event::ORIGIN,
+            &[
+                Segment {
+                    until: Some(0.0),
+                    motion: Motion::Uniform(v0),
+                },
+                accel(6.0, 0.3),
+                coast,
+                seg(None, 0.5),
+            ],
+        );
+        assert_eq!(line.pieces.len(), 4);
+        let Piece::Accelerated(h) = line.pieces[1] else {
+            panic!("accelerated")
+        };
+        let want = crate::spacetime::wigner_rotation(
+            &v0,
+            &Velocity::from_rapidity(DVec3::X, h.theta_at(6.0)).unwrap(),
+        );
+        assert_eq!(line.turns[0], DMat3::IDENTITY);
+        assert_eq!(line.turns[1], DMat3::IDENTITY);
+        assert_eq!(line.turns[2], want);
+        assert!(
+            (want * DVec3::X).dot(DVec3::X) < 0.99,
+            "a turn of some degrees"
+        );
+        assert_eq!(line.turns[3], DMat3::IDENTITY);
+        // Along the motion nothing turns.
+        let line = Worldline::new(Event::ORIGIN, &[seg(Some(0.0), 0.5), accel(3.0, 0.2)]);
+        assert!(line.turns.iter().all(|&r| r == DMat3::IDENTITY));
     }
 
     /// The retarded event lies on the past light cone of the event asked about.

@@ -1,10 +1,14 @@
 use super::{Event, Velocity};
 use crate::geometry::Real;
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 
 /// A passive Lorentz boost along any direction, evaluated in light-cone coordinates along the
 /// boost axis (docs/physics.md §8.2 item 4): `u = t − x∥`, `w = t + x∥`, `u' = e^{φ} u`, `w' = e^{−φ} w`,
 /// `x⊥' = x⊥`. No step subtracts nearly equal numbers, so speeds like 1 − 1e-12 stay exact.
+///
+/// It may carry a turn of the axes after the boost (`turned`), as the frame of a body that
+/// accelerated across its motion does (a Thomas-Wigner rotation, docs/physics.md §1.4, §12.7);
+/// its inverse turns them back before the boost back.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Boost {
     axis: DVec3,
@@ -14,6 +18,10 @@ pub struct Boost {
     /// `Some((k, σ))` where the axis is σ times the k-th unit vector (motion along x, y or z,
     /// as in most scenes): `null_dir` then skips the products with the axis' zeros.
     aligned: Option<(usize, f64)>,
+    /// The passive rotation of the axes before the boost (X ↦ R X), if any.
+    before: Option<DMat3>,
+    /// The passive rotation of the axes after the boost, if any.
+    after: Option<DMat3>,
 }
 
 impl Boost {
@@ -24,6 +32,8 @@ impl Boost {
         e_neg: 1.0,
         identity: true,
         aligned: None,
+        before: None,
+        after: None,
     };
 
     /// The boost from a frame into the frame that moves at `v` relative to it
@@ -40,7 +50,29 @@ impl Boost {
             e_neg: (-phi).exp(),
             identity: false,
             aligned: aligned(axis),
+            before: None,
+            after: None,
         }
+    }
+
+    /// This boost, then the axes turned by the rotation `r` (a passive X ↦ r X); an identity
+    /// `r` leaves it as it is.
+    pub fn turned(&self, r: DMat3) -> Boost {
+        if r == DMat3::IDENTITY {
+            return *self;
+        }
+        Boost {
+            after: Some(match self.after {
+                Some(a) => r * a,
+                None => r,
+            }),
+            ..*self
+        }
+    }
+
+    /// Whether it turns the axes.
+    pub fn turns(&self) -> bool {
+        self.before.is_some() || self.after.is_some()
     }
 
     /// The boost out of the frame moving at `v` back into the frame `v` is measured in.
@@ -50,28 +82,36 @@ impl Boost {
 
     /// The boost back (into the frame this one starts from).
     pub fn inverse(&self) -> Boost {
-        if self.identity {
-            return *self;
-        }
         Boost {
             axis: self.axis,
             e_pos: self.e_neg,
             e_neg: self.e_pos,
-            identity: false,
+            identity: self.identity,
             aligned: self.aligned,
+            before: self.after.map(|r| r.transpose()),
+            after: self.before.map(|r| r.transpose()),
         }
     }
 
     /// Transform an event (or any 4-vector).
     pub fn event(&self, e: Event) -> Event {
-        if self.identity {
-            return e;
+        let e = match self.before {
+            Some(r) => Event::new(e.t, r * e.x),
+            None => e,
+        };
+        let e = if self.identity {
+            e
+        } else {
+            let xp = e.x.dot(self.axis);
+            let u = self.e_pos * (e.t - xp);
+            let w = self.e_neg * (e.t + xp);
+            let xp_new = 0.5 * (w - u);
+            Event::new(0.5 * (u + w), e.x + (xp_new - xp) * self.axis)
+        };
+        match self.after {
+            Some(r) => Event::new(e.t, r * e.x),
+            None => e,
         }
-        let xp = e.x.dot(self.axis);
-        let u = self.e_pos * (e.t - xp);
-        let w = self.e_neg * (e.t + xp);
-        let xp_new = 0.5 * (w - u);
-        Event::new(0.5 * (u + w), e.x + (xp_new - xp) * self.axis)
     }
 
     /// Transform the past-directed null vector `(−1, a)` with `a` a unit vector. Returns the
@@ -79,7 +119,7 @@ impl Boost {
     /// lookback time exceeds the original one: for a boost into a frame moving at β,
     /// `s = γ(1 + β·a)` (docs/physics.md §7.1).
     pub fn null_dir(&self, a: DVec3) -> (DVec3, f64) {
-        if self.identity {
+        if self.identity && !self.turns() {
             return (a, 1.0);
         }
         let ([x, y, z], s) = self.null_dir_lanes([a.x, a.y, a.z]);
@@ -91,6 +131,17 @@ impl Boost {
     /// scalar one to the bit.
     #[inline(always)]
     pub(crate) fn null_dir_lanes<R: Real>(&self, a: [R; 3]) -> ([R; 3], R) {
+        if !self.turns() {
+            return self.null_dir_unturned(a);
+        }
+        let a = turn_lanes(self.before, a);
+        let (d, s) = self.null_dir_unturned(a);
+        (turn_lanes(self.after, d), s)
+    }
+
+    /// [`Boost::null_dir_lanes`] without the turns.
+    #[inline(always)]
+    fn null_dir_unturned<R: Real>(&self, a: [R; 3]) -> ([R; 3], R) {
         match self.aligned {
             // One copy per axis, so every index is a constant: a copy indexing by a run-time
             // axis wrote d[k] to the stack and read d back whole, a store the load could not
@@ -161,19 +212,29 @@ impl Boost {
         self.e_pos.max(self.e_neg)
     }
 
-    /// Whether this boost is the identity (a frame at rest relative to the one it starts from).
+    /// Whether this boost is the identity (a frame at rest relative to the one it starts from,
+    /// its axes not turned).
     pub fn is_identity(&self) -> bool {
-        self.identity
+        self.identity && !self.turns()
     }
 
     /// The unit direction of a null ray after the boost, and the factor `s` of [`Boost::null_dir`].
     pub fn view_dir(&self, a: DVec3) -> (DVec3, f64) {
-        if self.identity {
+        if self.identity && !self.turns() {
             return (a, 1.0);
         }
         let (d, s) = self.null_dir(a);
         (d / s, s)
     }
+}
+
+/// The lanes of a direction turned by `r`, if there is one.
+#[inline(always)]
+fn turn_lanes<R: Real>(r: Option<DMat3>, a: [R; 3]) -> [R; 3] {
+    let Some(r) = r else { return a };
+    let m = |i: usize, j: usize| R::splat(r.col(j)[i]);
+    let row = |i: usize| m(i, 0) * a[0] + m(i, 1) * a[1] + m(i, 2) * a[2];
+    [row(0), row(1), row(2)]
 }
 
 /// `Some((k, σ))` where `axis` is σ e_k exactly.

@@ -67,6 +67,16 @@ impl Hyperbola {
         Velocity::from_rapidity(u.x, gb.asinh()).unwrap_or(Velocity::ZERO)
     }
 
+    /// The turn of the axes (from the plain boost's to its velocity) that the motion to
+    /// rapidity θ brings: the Thomas-Wigner rotation of v₀ and the velocity tanh θ â added in
+    /// S' (docs/physics.md §1.4, §12.7); the identity along v₀.
+    pub fn wigner(&self, theta: f64) -> glam::DMat3 {
+        match Velocity::from_rapidity(self.axis, theta) {
+            Ok(u) => super::wigner_rotation(&self.v0, &u),
+            Err(_) => glam::DMat3::IDENTITY,
+        }
+    }
+
     /// The rapidity at which its world time is `t`: with b = β₀·â and k = a (t − t₀)/γ₀,
     /// `sinh θ + b (cosh θ − 1) = k`, a quadratic in e^θ; e^θ − 1 is formed without
     /// cancellation, so tiny accelerations keep their digits.

@@ -11,6 +11,7 @@ mod null_ray;
 mod pinhole;
 mod retarded;
 mod velocity;
+mod wigner;
 mod window;
 
 pub use boost::Boost;
@@ -20,4 +21,5 @@ pub use null_ray::NullRay;
 pub use pinhole::Pinhole;
 pub use retarded::{retarded_delay, retarded_position};
 pub use velocity::{Velocity, VelocityError};
+pub use wigner::wigner_rotation;
 pub use window::{Slice, Window};

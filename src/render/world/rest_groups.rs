@@ -15,6 +15,9 @@ pub(super) struct RestGroup {
     pub velocity: Velocity,
     pub boost: Boost,
     pub bounds: Aabb,
+    /// The bounds in the axes of the plain boost to `velocity` (`bounds` but for a group
+    /// whose axes are turned, `Group::turn`).
+    pub plain_bounds: Aabb,
     pub geometry: Arc<Geometry>,
     pub accel: Option<Arc<dyn Accelerator>>,
     pub epsilon: f64,
@@ -56,7 +59,7 @@ impl RestGroups {
             let key = (
                 v.identity_key(),
                 g.window.map(|w| w.key()),
-                (g.accelerated.is_some() || g.geometry.turns()).then_some(i),
+                (g.accelerated.is_some() || g.geometry.turns() || g.turn.is_some()).then_some(i),
             );
             match index.get(&key).filter(|_| options.merge_equal_velocities) {
                 Some(&k) => sets[k].2.push(i),
@@ -77,7 +80,10 @@ impl RestGroups {
                 // best; large ones stay themselves, to be instanced.
                 geometry = Arc::new(geometry.listing(options.instance_over));
             }
-            let accelerated = scene.groups[members[0]].accelerated;
+            let (accelerated, turn) = (
+                scene.groups[members[0]].accelerated,
+                scene.groups[members[0]].turn,
+            );
             let own = geometry.bounds();
             let turning: Option<Arc<[super::TurningPart]>> = geometry
                 .turns()
@@ -106,8 +112,9 @@ impl RestGroups {
             let spins = geometry.spins();
             groups.push(RestGroup {
                 velocity,
-                boost: Boost::to_rest(&velocity),
+                boost: scene.groups[members[0]].to_rest(),
                 bounds,
+                plain_bounds: turn.map_or(bounds, |r| bounds.turned(r.transpose())),
                 geometry,
                 accel,
                 // Relative to the group's size and place alone, so that a scene scaled as a
