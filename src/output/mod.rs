@@ -9,7 +9,7 @@ pub mod file;
 mod finished;
 pub use finished::finished;
 pub mod header;
-mod png_out;
+pub(crate) mod png_out;
 mod srgb8;
 pub(crate) use srgb8::srgb8;
 

@@ -62,23 +62,7 @@ pub(crate) fn write_strips(
     let mut rows = 0u64;
     fill(&mut |strip: &Frame| {
         debug_assert_eq!(strip.width, width);
-        // Encoded in parallel: the deflate after it is the only serial part.
-        let channels = if alpha { 4 } else { 3 };
-        let mut data = vec![0u8; strip.pixels.len() * channels];
-        data.par_chunks_mut(channels * 1024)
-            .zip(strip.pixels.par_chunks(1024))
-            .for_each(|(out, pixels)| {
-                for (o, p) in out.chunks_exact_mut(channels).zip(pixels) {
-                    if alpha {
-                        let a = p.alpha;
-                        let straight = p.color.map(|c| if a > 0.0 { c / a } else { 0.0 });
-                        o[..3].copy_from_slice(&straight.map(srgb8));
-                        o[3] = (a.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-                    } else {
-                        o.copy_from_slice(&p.color.map(srgb8));
-                    }
-                }
-            });
+        let data = srgb_bytes(&strip.pixels, alpha);
         rows += u64::from(strip.height);
         stream.write_all(&data).map_err(cause)
     })?;
@@ -88,4 +72,41 @@ pub(crate) fn write_strips(
     }
     stream.finish().map_err(cause)?;
     w.finish().map_err(cause)
+}
+
+/// The 8-bit sRGB bytes of pixels as a PNG holds them: RGB, or RGBA with straight alpha (the
+/// premultiplied colour divided by it). Encoded in parallel: the deflate after it is the only
+/// serial part.
+pub(crate) fn srgb_bytes(pixels: &[crate::render::PixelValue], alpha: bool) -> Vec<u8> {
+    let channels = if alpha { 4 } else { 3 };
+    let mut data = vec![0u8; pixels.len() * channels];
+    data.par_chunks_mut(channels * 1024)
+        .zip(pixels.par_chunks(1024))
+        .for_each(|(out, pixels)| {
+            for (o, p) in out.chunks_exact_mut(channels).zip(pixels) {
+                if alpha {
+                    let a = p.alpha;
+                    let straight = p.color.map(|c| if a > 0.0 { c / a } else { 0.0 });
+                    o[..3].copy_from_slice(&straight.map(srgb8));
+                    o[3] = (a.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+                } else {
+                    o.copy_from_slice(&p.color.map(srgb8));
+                }
+            }
+        });
+    data
+}
+
+/// An 8-bit RGB image as PNG bytes in memory (fast compression: for a screen, not a file).
+pub(crate) fn rgb_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, Cause> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, width, height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_compression(png::Compression::Fast);
+    enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    let mut w = enc.write_header().map_err(cause)?;
+    w.write_image_data(rgb).map_err(cause)?;
+    w.finish().map_err(cause)?;
+    Ok(out)
 }

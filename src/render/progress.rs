@@ -33,6 +33,19 @@ impl Progress {
         }
     }
 
+    /// Progress counted but never drawn (the viewer shows its own bar).
+    pub fn silent(pixels: u64) -> Progress {
+        let p = Progress::new(pixels);
+        p.shown.store(true, Ordering::Relaxed);
+        p
+    }
+
+    /// The share of the pixels done, 0 to 1.
+    pub fn fraction(&self) -> f64 {
+        let total = self.bar.length().unwrap_or(0).max(1);
+        self.bar.position() as f64 / total as f64
+    }
+
     /// `pixels` more are done.
     pub fn add(&self, pixels: u64) {
         self.bar.inc(pixels);

@@ -141,7 +141,7 @@ fn load_str_as(
 
 /// The keys an override replaces in its table: the other ways of giving the same setting, so
 /// `--set group.cube.one_minus_beta=1e-9` works on a file that says `velocity = [...]`.
-fn superseded(table: &[&str], key: &str) -> &'static [&'static str] {
+pub(crate) fn superseded(table: &[&str], key: &str) -> &'static [&'static str] {
     let in_group = table.first() == Some(&"group") && table.len() == 2;
     let in_camera = table == ["camera"];
     match key {

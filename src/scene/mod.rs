@@ -26,8 +26,8 @@ mod transform;
 mod worldline;
 
 pub use crate::error::SceneError;
-pub(crate) use load::load_file_as;
 pub use load::{load_file, load_str, FrameSize};
+pub(crate) use load::{load_file_as, superseded};
 pub(crate) use model::MAX_FRAME_PIXELS;
 pub use model::{
     Accelerated, Camera, Clock, Film, Fog, FrameSpacing, Group, ImageSettings, Integrator, Light,

@@ -1,0 +1,297 @@
+//! The view's values, as the page's controls set them, checked and written as edits of the
+//! scene file: the scene the viewer renders is the user's file with those edits (and without
+//! its film: the viewer shows one instant), and "render this view" saves exactly that text, so
+//! `rest-embree render` of it gives the viewer's final frame.
+
+use serde_json::Value;
+use toml_edit::{DocumentMut, Item, Table};
+
+/// The most a coordinate or a time may be (the scene loader refuses more anyway).
+const MAX_MAGNITUDE: f64 = 1e12;
+
+/// Where an edit goes.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Place {
+    Camera,
+    Render,
+    /// The `[[group]]` of this name.
+    Group(String),
+}
+
+/// One value of the file set by the view: `key = value` (a TOML literal) in `place`.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Edit {
+    pub place: Place,
+    pub key: &'static str,
+    pub value: String,
+}
+
+/// What the viewer may change of the scene it was started on.
+#[derive(Clone, Debug)]
+pub(crate) struct Editable {
+    /// Groups that move uniformly and are named once: their velocity may be set.
+    pub groups: Vec<String>,
+    /// Whether the camera is a pinhole (its field of view may be set).
+    pub pinhole: bool,
+}
+
+/// A view's values checked, as edits; an error names the value and says why.
+pub(crate) fn edits(view: &Value, editable: &Editable) -> Result<Vec<Edit>, String> {
+    let view = view.as_object().ok_or("the view must be a JSON object")?;
+    let mut out = Vec::new();
+    for (key, value) in view {
+        match key.as_str() {
+            "groups" => {
+                let groups = value
+                    .as_object()
+                    .ok_or("`groups` must map names to velocities")?;
+                for (name, v) in groups {
+                    if !editable.groups.contains(name) {
+                        return Err(format!(
+                            "group `{}`: no uniformly moving group of that name",
+                            clip(name)
+                        ));
+                    }
+                    let b = vec3(v, &format!("groups.{name}"))?;
+                    let speed = b.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    if speed.is_nan() || speed >= 1.0 {
+                        return Err(format!(
+                            "groups.{name}: the speed |β| = {speed} must be below 1 (the speed of light)"
+                        ));
+                    }
+                    out.push(Edit {
+                        place: Place::Group(name.clone()),
+                        key: "velocity",
+                        value: literal3(b),
+                    });
+                }
+            }
+            "camera" => out.extend(camera(value, editable)?),
+            "doppler" | "searchlight" => {
+                let on = value
+                    .as_bool()
+                    .ok_or_else(|| format!("`{key}` must be true or false"))?;
+                out.push(Edit {
+                    place: Place::Render,
+                    key: if key == "doppler" {
+                        "doppler"
+                    } else {
+                        "searchlight"
+                    },
+                    value: on.to_string(),
+                });
+            }
+            other => return Err(format!("unknown view value `{}`", clip(other))),
+        }
+    }
+    Ok(out)
+}
+
+fn camera(value: &Value, editable: &Editable) -> Result<Vec<Edit>, String> {
+    let cam = value.as_object().ok_or("`camera` must be an object")?;
+    let mut out = Vec::new();
+    for (key, v) in cam {
+        let shown = format!("camera.{key}");
+        let (key, value) = match key.as_str() {
+            "position" => ("position", literal3(vec3(v, &shown)?)),
+            "direction" | "up" => {
+                let d = vec3(v, &shown)?;
+                if d.iter().all(|&x| x == 0.0) {
+                    return Err(format!("{shown} must not be zero"));
+                }
+                (if key == "up" { "up" } else { "direction" }, literal3(d))
+            }
+            "time" => ("time", literal(number(v, &shown)?)),
+            "fov_y" => {
+                let f = number(v, &shown)?;
+                if !editable.pinhole {
+                    return Err(format!("{shown}: the camera is not a pinhole"));
+                }
+                if !(1e-6..180.0).contains(&f) {
+                    return Err(format!(
+                        "{shown} = {f}: at least 1e-6 and below 180 degrees"
+                    ));
+                }
+                ("fov_y", literal(f))
+            }
+            other => return Err(format!("unknown camera value `{}`", clip(other))),
+        };
+        out.push(Edit {
+            place: Place::Camera,
+            key,
+            value,
+        });
+    }
+    Ok(out)
+}
+
+/// A finite number of moderate size.
+fn number(v: &Value, shown: &str) -> Result<f64, String> {
+    let x = v
+        .as_f64()
+        .ok_or_else(|| format!("{shown} must be a number"))?;
+    if !x.is_finite() || x.abs() > MAX_MAGNITUDE {
+        return Err(format!(
+            "{shown} = {x}: must be finite and at most {MAX_MAGNITUDE:e} in size"
+        ));
+    }
+    Ok(x)
+}
+
+fn vec3(v: &Value, shown: &str) -> Result<[f64; 3], String> {
+    let a = v
+        .as_array()
+        .filter(|a| a.len() == 3)
+        .ok_or_else(|| format!("{shown} must be three numbers"))?;
+    let mut out = [0.0; 3];
+    for (o, x) in out.iter_mut().zip(a) {
+        *o = number(x, shown)?;
+    }
+    Ok(out)
+}
+
+/// A TOML float that reads back as the same f64 (Rust's shortest round-trip form).
+fn literal(x: f64) -> String {
+    // `1e-7` and `1e20` are TOML floats too; never `inf` or `NaN` here (checked finite).
+    format!("{x:?}")
+}
+
+fn literal3(v: [f64; 3]) -> String {
+    format!("[{}, {}, {}]", literal(v[0]), literal(v[1]), literal(v[2]))
+}
+
+/// At most 40 characters of a name the request gave, for an error.
+fn clip(s: &str) -> String {
+    s.chars().take(40).collect()
+}
+
+/// The scene text with `edits` made (each edit's other ways of giving the same setting taken
+/// out, as `--set` does), without its `[film]`, and a first line saying where it came from.
+pub(crate) fn saved_text(original: &str, source: &str, edits: &[Edit]) -> Result<String, String> {
+    let mut doc: DocumentMut = original
+        .parse()
+        .map_err(|e| format!("{source} is not TOML the viewer can edit: {e}"))?;
+    doc.remove("film");
+    for e in edits {
+        let value: toml_edit::Value = e.value.parse().map_err(|err| format!("{}: {err}", e.key))?;
+        let (path, table): (Vec<&str>, &mut Table) = match &e.place {
+            Place::Camera => (vec!["camera"], table_in(&mut doc, "camera")),
+            Place::Render => (vec!["render"], table_in(&mut doc, "render")),
+            Place::Group(name) => (vec!["group", name.as_str()], group_in(&mut doc, name)?),
+        };
+        for gone in crate::scene::superseded(&path, e.key) {
+            table.remove(gone);
+        }
+        table.insert(e.key, Item::Value(value));
+    }
+    Ok(format!(
+        "# The view saved by `rest-embree view` from {source}: render it with `rest-embree render`\n# (file paths in it are relative to the folder of {source}).\n{doc}"
+    ))
+}
+
+/// The table `[name]`, made if the file has none.
+fn table_in<'a>(doc: &'a mut DocumentMut, name: &str) -> &'a mut Table {
+    let item = doc.entry(name).or_insert_with(|| Item::Table(Table::new()));
+    if !item.is_table() {
+        *item = Item::Table(Table::new());
+    }
+    item.as_table_mut().expect("made a table")
+}
+
+/// The `[[group]]` named `name`.
+fn group_in<'a>(doc: &'a mut DocumentMut, name: &str) -> Result<&'a mut Table, String> {
+    doc.get_mut("group")
+        .and_then(|g| g.as_array_of_tables_mut())
+        .and_then(|groups| {
+            groups
+                .iter_mut()
+                .find(|t| t.get("name").and_then(|n| n.as_str()) == Some(name))
+        })
+        .ok_or_else(|| format!("no [[group]] named `{}` in the file", clip(name)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn editable() -> Editable {
+        Editable {
+            groups: vec!["lattice".into()],
+            pinhole: true,
+        }
+    }
+
+    const TEXT: &str = "# top\n[camera]\nposition = [0, 0, 0]\nlook_at = [1, 0, 0] # aim\nfov_y = 60\n\n[[group]]\nname = \"lattice\"\ndirection = [1, 0, 0]\nbeta = 0.5\n[[group.object]]\ntype = \"sphere\"\n\n[film]\nframes = 3\n";
+
+    #[test]
+    fn edits_replace_the_other_ways_of_giving_a_value_and_keep_the_rest() {
+        let view = json!({
+            "groups": { "lattice": [-0.9, 0.0, 1e-7] },
+            "camera": { "direction": [0.0, 1.0, 0.0], "time": 2.5, "fov_y": 45.0 },
+            "doppler": true
+        });
+        let e = edits(&view, &editable()).unwrap();
+        let text = saved_text(TEXT, "a.toml", &e).unwrap();
+        assert!(text.contains("# top"), "{text}");
+        assert!(text.contains("velocity = [-0.9, 0.0, 1e-7]"), "{text}");
+        assert!(
+            !text.contains("beta") && !text.contains("look_at"),
+            "{text}"
+        );
+        assert!(text.contains("direction = [0.0, 1.0, 0.0]"), "{text}");
+        assert!(
+            text.contains("time = 2.5") && text.contains("fov_y = 45.0"),
+            "{text}"
+        );
+        assert!(
+            text.contains("[render]") && text.contains("doppler = true"),
+            "{text}"
+        );
+        assert!(!text.contains("[film]"), "{text}");
+        let back: DocumentMut = text.parse().unwrap();
+        assert_eq!(back["group"][0]["velocity"][2].as_float(), Some(1e-7));
+    }
+
+    #[test]
+    fn bad_values_are_refused_with_their_name() {
+        let bad = [
+            (
+                json!({ "groups": { "lattice": [1.0, 0.0, 0.0] } }),
+                "must be below 1",
+            ),
+            (
+                json!({ "groups": { "lattice": [0.6, 0.6, 0.6] } }),
+                "must be below 1",
+            ),
+            (
+                json!({ "groups": { "lattice": [0.1, 0.0] } }),
+                "three numbers",
+            ),
+            (
+                json!({ "groups": { "lattice": ["0.1", 0.0, 0.0] } }),
+                "must be a number",
+            ),
+            (
+                json!({ "groups": { "other": [0.1, 0.0, 0.0] } }),
+                "group `other`",
+            ),
+            (
+                json!({ "camera": { "position": [1e300, 0.0, 0.0] } }),
+                "must be finite and at most",
+            ),
+            (
+                json!({ "camera": { "direction": [0.0, 0.0, 0.0] } }),
+                "must not be zero",
+            ),
+            (json!({ "camera": { "fov_y": 180.0 } }), "below 180"),
+            (json!({ "camera": { "zoom": 1.0 } }), "unknown camera value"),
+            (json!({ "width": 100000 }), "unknown view value"),
+            (json!([1, 2]), "JSON object"),
+        ];
+        for (view, needle) in bad {
+            let e = edits(&view, &editable()).unwrap_err();
+            assert!(e.contains(needle), "{view}: {e}");
+        }
+    }
+}

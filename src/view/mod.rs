@@ -1,0 +1,278 @@
+//! `rest-embree view SCENE`: the scene in the browser, its velocities, camera and passes on
+//! controls, refined while nothing changes (docs/viewer.md). A local web server (tiny_http)
+//! on 127.0.0.1 by default, behind a random token, the Host and the Origin (`access.rs`); the
+//! view's values become edits of the scene file (`edits.rs`), rendered at a ladder of levels
+//! and cancelled by a newer view (`frames.rs`), or saved and rendered to an EXR in the
+//! background (`jobs.rs`); the page is one file of HTML, style and script in the binary.
+
+mod access;
+mod edits;
+mod frames;
+mod jobs;
+mod routes;
+
+use crate::accel::Backend;
+use crate::render::Frame;
+use crate::scene::Scene;
+use std::collections::HashMap;
+use std::net::{IpAddr, SocketAddr};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Instant;
+
+/// How the viewer is started (`rest-embree view`'s flags).
+#[derive(Clone, Debug)]
+pub(crate) struct Config {
+    pub scene: PathBuf,
+    pub bind: IpAddr,
+    pub port: u16,
+    pub backend: String,
+    pub out: PathBuf,
+    pub allow_hosts: Vec<String>,
+    pub open_browser: bool,
+}
+
+/// The most clients whose last frame is kept (the oldest is forgotten first).
+const MAX_CLIENTS: usize = 16;
+/// The most requests handled at once; more are answered 503.
+const MAX_HANDLERS: usize = 256;
+
+/// One page's state: its newest view's number, the switch that stops the render of the one
+/// before, and its last frame (for clicks).
+struct Client {
+    generation: u64,
+    cancel: Arc<AtomicBool>,
+    shown: Option<Arc<(Scene, Frame)>>,
+    seen: Instant,
+}
+
+/// What every request handler shares.
+pub(crate) struct Viewer {
+    access: access::Access,
+    /// The scene file as given, for errors and for the folder its file paths lead from.
+    source: String,
+    text: String,
+    editable: edits::Editable,
+    info: serde_json::Value,
+    levels: Vec<frames::Level>,
+    backend: Box<dyn Backend>,
+    backend_name: String,
+    clients: Mutex<HashMap<String, Client>>,
+    /// One frame renders at a time (it uses every core).
+    render_lock: Mutex<()>,
+    rendering: AtomicUsize,
+    waiting: AtomicUsize,
+    handlers: AtomicUsize,
+    jobs: jobs::Jobs,
+}
+
+/// The running server, for Ctrl-C to stop.
+static SERVER: OnceLock<Arc<tiny_http::Server>> = OnceLock::new();
+static STOPPING: AtomicBool = AtomicBool::new(false);
+
+/// Ctrl-C while a viewer runs: stop serving and let `run` return (true); false if none runs.
+pub(crate) fn interrupt() -> bool {
+    match SERVER.get() {
+        Some(s) => {
+            STOPPING.store(true, Ordering::Release);
+            s.unblock();
+            true
+        }
+        None => false,
+    }
+}
+
+/// Serve the scene until Ctrl-C.
+pub(crate) fn run(config: &Config) -> crate::Result<()> {
+    let viewer = Arc::new(Viewer::new(config)?);
+    let addr = SocketAddr::new(config.bind, config.port);
+    let server = tiny_http::Server::http(addr)
+        .map_err(|e| crate::Error::flag("--port", format!("cannot listen on {addr}: {e}")))?;
+    let server = Arc::new(server);
+    let port = server
+        .server_addr()
+        .to_ip()
+        .map(|a| a.port())
+        .unwrap_or(config.port);
+    let _ = SERVER.set(server.clone());
+    let host = match config.bind {
+        IpAddr::V6(a) if !a.is_unspecified() => format!("[{a}]"),
+        a if a.is_unspecified() => "127.0.0.1".to_string(),
+        a => a.to_string(),
+    };
+    let url = format!("http://{host}:{port}/?token={}", viewer.access.token());
+    crate::cli::say(format_args!(
+        "rest-embree view: {} at\n  {url}",
+        config.scene.display()
+    ));
+    if !config.bind.is_loopback() {
+        crate::cli::say(format_args!(
+            "From another machine, through an SSH tunnel: ssh -N -L {port}:localhost:{port} THIS-HOST, then open\n  http://localhost:{port}/?token={}",
+            viewer.access.token()
+        ));
+    }
+    crate::cli::say("Ctrl-C stops it.");
+    if config.open_browser {
+        open_browser(&url);
+    }
+    let handlers = &viewer.handlers;
+    loop {
+        let request = match server.recv() {
+            Ok(r) => r,
+            Err(_) if STOPPING.load(Ordering::Acquire) => break,
+            Err(e) => {
+                eprintln!("rest-embree view: {e}");
+                std::thread::sleep(std::time::Duration::from_millis(10));
+                continue;
+            }
+        };
+        if handlers.fetch_add(1, Ordering::AcqRel) >= MAX_HANDLERS {
+            handlers.fetch_sub(1, Ordering::AcqRel);
+            let _ = request.respond(routes::text(503, "busy: too many requests at once"));
+            continue;
+        }
+        let v = viewer.clone();
+        std::thread::spawn(move || {
+            routes::handle(&v, request);
+            v.handlers.fetch_sub(1, Ordering::AcqRel);
+        });
+    }
+    // Stop every render, and leave no half-written file.
+    for c in viewer.clients.lock().expect("not poisoned").values() {
+        c.cancel.store(true, Ordering::Relaxed);
+    }
+    crate::output::file::remove_partial_files();
+    crate::cli::say("rest-embree view: stopped");
+    Ok(())
+}
+
+/// Ask the desktop to open `url`; where it cannot, the printed URL is there to copy.
+fn open_browser(url: &str) {
+    let opener = if cfg!(target_os = "macos") {
+        "open"
+    } else {
+        "xdg-open"
+    };
+    let spawned = std::process::Command::new(opener)
+        .arg(url)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn();
+    if spawned.is_err() {
+        eprintln!("(could not start {opener}: open the URL above in a browser)");
+    }
+}
+
+impl Viewer {
+    fn new(config: &Config) -> crate::Result<Viewer> {
+        let source = config.scene.display().to_string();
+        let text = std::fs::read_to_string(&config.scene)
+            .map_err(|e| crate::Error::flag("view", format!("cannot read {source}: {e}")))?;
+        // The scene as the viewer will render it: loaded now so that a bad file is said at once.
+        let base =
+            edits::saved_text(&text, &source, &[]).map_err(|e| crate::Error::flag("view", e))?;
+        let mut scene = crate::scene::load_str(&source, &base, &[])?;
+        scene.film = None;
+        let backend =
+            crate::accel::backend_by_name(&config.backend).map_err(|e| e.on_flag("--backend"))?;
+        let editable = editable(&scene);
+        let levels = frames::levels(&scene.image);
+        let info = info(&scene, &editable, &levels, &source);
+        let mut names = config.allow_hosts.clone();
+        if let Some(h) = hostname() {
+            names.push(h);
+        }
+        Ok(Viewer {
+            access: access::Access::new(access::new_token()?, names),
+            source,
+            text,
+            editable,
+            info,
+            levels,
+            backend,
+            backend_name: config.backend.clone(),
+            clients: Mutex::new(HashMap::new()),
+            render_lock: Mutex::new(()),
+            rendering: AtomicUsize::new(0),
+            waiting: AtomicUsize::new(0),
+            handlers: AtomicUsize::new(0),
+            jobs: jobs::Jobs::new(config.out.clone()),
+        })
+    }
+}
+
+/// This machine's name, which Host may name (a cluster node reached by its name).
+fn hostname() -> Option<String> {
+    let name = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .or_else(|_| std::fs::read_to_string("/etc/hostname"))
+        .ok()?;
+    let name = name.trim().to_string();
+    (!name.is_empty()).then_some(name)
+}
+
+/// The groups whose velocity the page may set: moving uniformly, one group of their name.
+fn editable(scene: &Scene) -> edits::Editable {
+    let mut count: HashMap<&str, usize> = HashMap::new();
+    for g in &scene.groups {
+        *count.entry(g.name.as_str()).or_default() += 1;
+    }
+    let groups = scene
+        .groups
+        .iter()
+        .filter(|g| count[g.name.as_str()] == 1 && g.window.is_none() && g.accelerated.is_none())
+        .map(|g| g.name.clone())
+        .collect();
+    edits::Editable {
+        groups,
+        pinhole: matches!(
+            scene.camera.projection,
+            crate::scene::Projection::Pinhole { .. }
+        ),
+    }
+}
+
+/// What the page needs to draw its controls.
+fn info(
+    scene: &Scene,
+    editable: &edits::Editable,
+    levels: &[frames::Level],
+    source: &str,
+) -> serde_json::Value {
+    use serde_json::json;
+    let c = &scene.camera;
+    let v3 = |v: glam::DVec3| [v.x, v.y, v.z];
+    let mut seen = std::collections::HashSet::new();
+    let groups: Vec<_> = scene
+        .groups
+        .iter()
+        .filter(|g| seen.insert(g.name.clone()))
+        .map(|g| {
+            json!({
+                "name": g.name,
+                "velocity": v3(g.velocity.beta_vec()),
+                "editable": editable.groups.contains(&g.name),
+            })
+        })
+        .collect();
+    let fov = match c.projection {
+        crate::scene::Projection::Pinhole { fov_y } => Some(fov_y.to_degrees()),
+        _ => None,
+    };
+    json!({
+        "file": source,
+        "levels": levels.iter().map(|l| json!({"width": l.width, "height": l.height, "samples": l.samples})).collect::<Vec<_>>(),
+        "passes": frames::PASSES,
+        "groups": groups,
+        "camera": {
+            "position": v3(c.position),
+            "direction": v3(c.forward),
+            "up": v3(c.up),
+            "fov_y": fov,
+            "time": c.time,
+        },
+        "doppler": scene.render.doppler,
+        "searchlight": scene.render.searchlight,
+    })
+}

@@ -1,0 +1,363 @@
+//! The viewer's endpoints. Every request passes `access` first (403 otherwise, before any
+//! work); bodies are JSON of at most 64 KiB; every error is a 4xx or 5xx with a line of text.
+//!
+//! - `GET /` the page; `GET /api/scene` what its controls start from; `GET /api/status` the
+//!   work running;
+//! - `POST /api/frame` `{client, level, pass, view}`: the view rendered at a level, as PNG;
+//! - `GET /api/probe?client&x&y`: what a pixel of the client's last frame shows;
+//! - `POST /api/save` `{view}`: the view as a scene file; `POST /api/render` `{view}`: that
+//!   file rendered to an EXR in the background; `GET /api/job?id`: how far it is;
+//! - `GET /files/NAME`: a file a render of a view wrote.
+
+use super::{edits, frames, jobs, Client, Viewer, MAX_CLIENTS};
+use serde_json::{json, Value};
+use std::io::Read;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+use tiny_http::{Header, Method, Request, Response, ResponseBox};
+
+const MAX_BODY: usize = 64 * 1024;
+
+/// The page: its HTML with its style and script, all from the binary.
+fn page() -> String {
+    include_str!("page/index.html")
+        .replace("/*STYLE*/", include_str!("page/style.css"))
+        .replace("/*SCRIPT*/", include_str!("page/app.js"))
+}
+
+fn header(name: &str, value: &str) -> Header {
+    Header::from_bytes(name.as_bytes(), value.as_bytes()).expect("a valid header")
+}
+
+fn reply(code: u16, mime: &str, data: Vec<u8>) -> ResponseBox {
+    Response::from_data(data)
+        .with_status_code(code)
+        .with_header(header("Content-Type", mime))
+        .with_header(header("Cache-Control", "no-store"))
+        .with_header(header("X-Content-Type-Options", "nosniff"))
+        .boxed()
+}
+
+/// A line of text with a status.
+pub(super) fn text(code: u16, message: &str) -> ResponseBox {
+    reply(
+        code,
+        "text/plain; charset=utf-8",
+        format!("{message}\n").into_bytes(),
+    )
+}
+
+fn json_reply(code: u16, v: &Value) -> ResponseBox {
+    reply(code, "application/json", v.to_string().into_bytes())
+}
+
+fn header_value<'a>(rq: &'a Request, name: &str) -> Option<&'a str> {
+    rq.headers()
+        .iter()
+        .find(|h| h.field.as_str().as_str().eq_ignore_ascii_case(name))
+        .map(|h| h.value.as_str())
+}
+
+pub(super) fn handle(v: &Viewer, mut rq: Request) {
+    let url = rq.url().to_string();
+    let (path, query) = url.split_once('?').unwrap_or((url.as_str(), ""));
+    let allowed = v.access.check(
+        query,
+        header_value(&rq, "Host"),
+        header_value(&rq, "Origin"),
+    );
+    let response = match allowed {
+        Err(why) => text(403, why),
+        Ok(()) => route(v, &mut rq, path, query),
+    };
+    // A client that has gone is no error of ours.
+    let _ = rq.respond(response);
+}
+
+fn route(v: &Viewer, rq: &mut Request, path: &str, query: &str) -> ResponseBox {
+    let method = rq.method().clone();
+    let result = match (&method, path) {
+        (Method::Get, "/") => Ok(reply(200, "text/html; charset=utf-8", page().into_bytes())
+            .with_header(header("X-Frame-Options", "DENY"))
+            .with_header(header("Referrer-Policy", "no-referrer"))
+            .with_header(header(
+                "Content-Security-Policy",
+                "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; img-src blob:; connect-src 'self'; frame-ancestors 'none'",
+            ))),
+        (Method::Get, "/api/scene") => Ok(json_reply(200, &v.info)),
+        (Method::Get, "/api/status") => Ok(status(v)),
+        (Method::Post, "/api/frame") => body(rq).and_then(|b| frame(v, &b)),
+        (Method::Get, "/api/probe") => probe(v, query),
+        (Method::Post, "/api/save") => body(rq).and_then(|b| save(v, &b)),
+        (Method::Post, "/api/render") => body(rq).and_then(|b| start_render(v, &b)),
+        (Method::Get, "/api/job") => job(v, query),
+        (Method::Get, p) if p.starts_with("/files/") => file(v, &p["/files/".len()..]),
+        (_, "/" | "/api/scene" | "/api/status" | "/api/frame" | "/api/probe" | "/api/save"
+        | "/api/render" | "/api/job") => Err((405, "method not allowed here".into())),
+        _ => Err((404, "no such page".into())),
+    };
+    result.unwrap_or_else(|(code, message)| text(code, &message))
+}
+
+type Answer = Result<ResponseBox, (u16, String)>;
+
+/// The request's body as JSON.
+fn body(rq: &mut Request) -> Result<Value, (u16, String)> {
+    if rq.body_length().is_some_and(|n| n > MAX_BODY) {
+        return Err((413, format!("the body is larger than {MAX_BODY} bytes")));
+    }
+    let mut bytes = Vec::new();
+    rq.as_reader()
+        .take(MAX_BODY as u64 + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| (400, format!("cannot read the body: {e}")))?;
+    if bytes.len() > MAX_BODY {
+        return Err((413, format!("the body is larger than {MAX_BODY} bytes")));
+    }
+    serde_json::from_slice(&bytes).map_err(|e| (400, format!("the body is not JSON: {e}")))
+}
+
+fn status(v: &Viewer) -> ResponseBox {
+    let clients = v.clients.lock().expect("not poisoned").len();
+    json_reply(
+        200,
+        &json!({
+            "rendering": v.rendering.load(Ordering::Acquire),
+            "waiting": v.waiting.load(Ordering::Acquire),
+            "clients": clients,
+        }),
+    )
+}
+
+/// A client's name: the page's random one.
+fn client_id(x: Option<&Value>) -> Result<String, (u16, String)> {
+    let id = x.and_then(|c| c.as_str()).unwrap_or("");
+    let ok = (1..=64).contains(&id.len())
+        && id
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_');
+    ok.then(|| id.to_string()).ok_or((
+        400,
+        "`client` must be 1 to 64 letters, digits, - or _".into(),
+    ))
+}
+
+/// The view's text: the scene file with the view's edits.
+fn view_text(v: &Viewer, body: &Value) -> Result<String, (u16, String)> {
+    let view = body.get("view").ok_or((400, "no `view`".to_string()))?;
+    let edits = edits::edits(view, &v.editable).map_err(|e| (400, e))?;
+    edits::saved_text(&v.text, &v.source, &edits).map_err(|e| (400, e))
+}
+
+fn frame(v: &Viewer, body: &Value) -> Answer {
+    let client = client_id(body.get("client"))?;
+    let n = v.levels.len();
+    let level = body
+        .get("level")
+        .and_then(|l| l.as_u64())
+        .filter(|&l| (l as usize) < n)
+        .ok_or((400, format!("`level` must be 0 to {}", n - 1)))? as usize;
+    let pass = body
+        .get("pass")
+        .and_then(|p| p.as_str())
+        .unwrap_or("colour");
+    if !frames::PASSES.contains(&pass) {
+        return Err((
+            400,
+            format!("`pass` must be one of {}", frames::PASSES.join(", ")),
+        ));
+    }
+    let text = view_text(v, body)?;
+    let l = v.levels[level];
+    let last = level + 1 == n;
+    let overrides: Vec<(String, String)> = if last {
+        Vec::new()
+    } else {
+        ["width", "height", "samples"]
+            .iter()
+            .zip([l.width, l.height, l.samples])
+            .map(|(k, x)| {
+                (
+                    format!("the viewer's level {level}"),
+                    format!("image.{k}={x}"),
+                )
+            })
+            .collect()
+    };
+    let mut scene =
+        crate::scene::load_str(&v.source, &text, &overrides).map_err(|e| (400, e.to_string()))?;
+    // This view supersedes the client's last: its render stops at its next strip.
+    let (generation, cancel) = register(v, &client);
+    let current = || {
+        v.clients
+            .lock()
+            .expect("not poisoned")
+            .get(&client)
+            .is_some_and(|c| c.generation == generation)
+    };
+    v.waiting.fetch_add(1, Ordering::AcqRel);
+    let turn = v.render_lock.lock().unwrap_or_else(|p| p.into_inner());
+    v.waiting.fetch_sub(1, Ordering::AcqRel);
+    if !current() {
+        return Err((409, "superseded by a newer view".into()));
+    }
+    v.rendering.fetch_add(1, Ordering::AcqRel);
+    let t0 = Instant::now();
+    let rendered = frames::render(&mut scene, v.backend.as_ref(), &cancel);
+    let ms = t0.elapsed().as_secs_f64() * 1e3;
+    v.rendering.fetch_sub(1, Ordering::AcqRel);
+    drop(turn);
+    let frame = match rendered {
+        Ok(f) => f,
+        Err(frames::Stopped::Superseded) => return Err((409, "superseded by a newer view".into())),
+        Err(frames::Stopped::Failed(e)) => return Err((500, e.to_string())),
+    };
+    let rgb = frames::pass_rgb(&frame, pass).expect("a pass checked above");
+    let png = crate::output::png_out::rgb_png(frame.width, frame.height, &rgb)
+        .map_err(|e| (500, format!("encoding the frame: {e}")))?;
+    let (w, h) = (frame.width, frame.height);
+    {
+        let mut clients = v.clients.lock().expect("not poisoned");
+        match clients.get_mut(&client) {
+            Some(c) if c.generation == generation => c.shown = Some(Arc::new((scene, frame))),
+            _ => return Err((409, "superseded by a newer view".into())),
+        }
+    }
+    Ok(reply(200, "image/png", png)
+        .with_header(header("X-Level", &level.to_string()))
+        .with_header(header("X-Final", if last { "true" } else { "false" }))
+        .with_header(header("X-Width", &w.to_string()))
+        .with_header(header("X-Height", &h.to_string()))
+        .with_header(header("X-Samples", &l.samples.to_string()))
+        .with_header(header("X-Render-Ms", &format!("{ms:.1}"))))
+}
+
+/// Make `client`'s newest view this one: stop the render of its last, and forget the client
+/// seen longest ago when there are too many.
+fn register(v: &Viewer, client: &str) -> (u64, Arc<AtomicBool>) {
+    let mut clients = v.clients.lock().expect("not poisoned");
+    if !clients.contains_key(client) && clients.len() >= MAX_CLIENTS {
+        let oldest = clients
+            .iter()
+            .min_by_key(|(_, c)| c.seen)
+            .map(|(k, _)| k.clone());
+        if let Some(k) = oldest {
+            if let Some(c) = clients.remove(&k) {
+                c.cancel.store(true, Ordering::Relaxed);
+            }
+        }
+    }
+    let c = clients.entry(client.to_string()).or_insert_with(|| Client {
+        generation: 0,
+        cancel: Arc::new(AtomicBool::new(false)),
+        shown: None,
+        seen: Instant::now(),
+    });
+    c.cancel.store(true, Ordering::Relaxed);
+    c.generation += 1;
+    c.cancel = Arc::new(AtomicBool::new(false));
+    c.seen = Instant::now();
+    (c.generation, c.cancel.clone())
+}
+
+fn query_u32(query: &str, key: &str) -> Result<u32, (u16, String)> {
+    super::access::query_value(query, key)
+        .and_then(|x| x.parse().ok())
+        .ok_or((400, format!("`{key}` must be a whole number")))
+}
+
+fn probe(v: &Viewer, query: &str) -> Answer {
+    let client = client_id(
+        super::access::query_value(query, "client")
+            .map(Value::String)
+            .as_ref(),
+    )?;
+    let (x, y) = (query_u32(query, "x")?, query_u32(query, "y")?);
+    let shown = v
+        .clients
+        .lock()
+        .expect("not poisoned")
+        .get(&client)
+        .and_then(|c| c.shown.clone())
+        .ok_or((404, "no frame shown to this client yet".to_string()))?;
+    let (scene, frame) = &*shown;
+    if x >= frame.width || y >= frame.height {
+        return Err((
+            400,
+            format!("the frame is {}x{}", frame.width, frame.height),
+        ));
+    }
+    Ok(json_reply(200, &frames::probe(frame, scene, x, y)))
+}
+
+/// The view's scene, checked by loading it, as a file to download.
+fn save(v: &Viewer, body: &Value) -> Answer {
+    let text = view_text(v, body)?;
+    crate::scene::load_str(&v.source, &text, &[]).map_err(|e| (400, e.to_string()))?;
+    let stem: String = std::path::Path::new(&v.source)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+        .chars()
+        .filter(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_')
+        .take(40)
+        .collect();
+    Ok(
+        reply(200, "application/toml", text.into_bytes()).with_header(header(
+            "Content-Disposition",
+            &format!("attachment; filename=\"{stem}-view.toml\""),
+        )),
+    )
+}
+
+fn start_render(v: &Viewer, body: &Value) -> Answer {
+    let text = view_text(v, body)?;
+    crate::scene::load_str(&v.source, &text, &[]).map_err(|e| (400, e.to_string()))?;
+    let job = v.jobs.start(text, &v.source, &v.backend_name)?;
+    Ok(json_reply(200, &job_json(&job)))
+}
+
+fn job_json(job: &jobs::Job) -> Value {
+    let (state, error) = match job.state() {
+        jobs::State::Running => ("running", None),
+        jobs::State::Done => ("done", None),
+        jobs::State::Failed(e) => ("failed", Some(e)),
+    };
+    json!({
+        "id": job.id,
+        "state": state,
+        "progress": job.fraction(),
+        "error": error,
+        "toml": format!("{}.toml", job.name()),
+        "exr": format!("{}.exr", job.name()),
+    })
+}
+
+fn job(v: &Viewer, query: &str) -> Answer {
+    let id = query_u32(query, "id")?;
+    let job = v
+        .jobs
+        .get(u64::from(id))
+        .ok_or((404, format!("no render {id}")))?;
+    Ok(json_reply(200, &job_json(&job)))
+}
+
+fn file(v: &Viewer, name: &str) -> Answer {
+    let name =
+        super::access::percent_decode(name).ok_or((400, "a badly escaped name".to_string()))?;
+    let path = v.jobs.file(&name)?;
+    let f = std::fs::File::open(&path).map_err(|e| (404, format!("{name}: {e}")))?;
+    let mime = if name.ends_with(".exr") {
+        "image/x-exr"
+    } else {
+        "application/toml"
+    };
+    Ok(Response::from_file(f)
+        .with_header(header("Content-Type", mime))
+        .with_header(header(
+            "Content-Disposition",
+            &format!("attachment; filename=\"{name}\""),
+        ))
+        .boxed())
+}

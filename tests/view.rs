@@ -1,0 +1,597 @@
+//! `rest-embree view` for real: the binary started as a user starts it, spoken to over HTTP
+//! (docs/viewer.md). Every endpoint refuses requests without the token, from another Host or
+//! another Origin; hostile requests get a clear 4xx and the server goes on; the final frame is,
+//! pixel for pixel, `rest-embree render` of the view it saves; a hundred rapid changes leave one
+//! frame of work; Ctrl-C stops it cleanly.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+struct Viewer {
+    child: Child,
+    port: u16,
+    token: String,
+    out: PathBuf,
+    stdout: BufReader<std::process::ChildStdout>,
+}
+
+impl Drop for Viewer {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// A reply: status, headers (lower-case names) and body.
+struct Reply {
+    status: u16,
+    headers: Vec<(String, String)>,
+    body: Vec<u8>,
+}
+
+impl Reply {
+    fn header(&self, name: &str) -> Option<&str> {
+        self.headers
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v.as_str())
+    }
+    fn text(&self) -> String {
+        String::from_utf8_lossy(&self.body).into_owned()
+    }
+    fn json(&self) -> serde_json::Value {
+        serde_json::from_slice(&self.body).unwrap_or_else(|e| panic!("{e}: {}", self.text()))
+    }
+}
+
+fn start(scene: &str, name: &str) -> Viewer {
+    let out = std::env::temp_dir().join(format!("rest-embree-view-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args(["view", scene, "--no-browser", "--backend", "bvh", "--out"])
+        .arg(&out)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("the binary starts");
+    let mut stdout = BufReader::new(child.stdout.take().expect("piped"));
+    let mut url = String::new();
+    for _ in 0..3 {
+        let mut line = String::new();
+        stdout.read_line(&mut line).expect("a line");
+        if let Some(at) = line.find("http://") {
+            url = line[at..].trim().to_string();
+            break;
+        }
+    }
+    assert!(url.starts_with("http://127.0.0.1:"), "printed: {url}");
+    let rest = &url["http://127.0.0.1:".len()..];
+    let (port, token) = rest.split_once("/?token=").expect("a token in the URL");
+    assert_eq!(token.len(), 32, "128 random bits in hex");
+    Viewer {
+        child,
+        port: port.parse().unwrap(),
+        token: token.to_string(),
+        out,
+        stdout,
+    }
+}
+
+impl Viewer {
+    /// A raw HTTP/1.0 request (so the reply is not chunked), with the Host the browser sends
+    /// unless `host` says otherwise, and `extra` headers.
+    fn raw(
+        &self,
+        method: &str,
+        target: &str,
+        host: Option<&str>,
+        extra: &[(&str, &str)],
+        body: &[u8],
+    ) -> Reply {
+        let mut s = TcpStream::connect(("127.0.0.1", self.port)).expect("connects");
+        s.set_read_timeout(Some(Duration::from_secs(120))).unwrap();
+        let host = host.map_or(format!("127.0.0.1:{}", self.port), str::to_string);
+        let mut head = format!(
+            "{method} {target} HTTP/1.0\r\nHost: {host}\r\nContent-Length: {}\r\n",
+            body.len()
+        );
+        for (k, v) in extra {
+            head.push_str(&format!("{k}: {v}\r\n"));
+        }
+        head.push_str("\r\n");
+        s.write_all(head.as_bytes()).unwrap();
+        s.write_all(body).unwrap();
+        let mut all = Vec::new();
+        s.read_to_end(&mut all).expect("a reply");
+        let split = all
+            .windows(4)
+            .position(|w| w == b"\r\n\r\n")
+            .expect("headers end");
+        let head = String::from_utf8_lossy(&all[..split]).into_owned();
+        let mut lines = head.lines();
+        let status = lines
+            .next()
+            .unwrap()
+            .split(' ')
+            .nth(1)
+            .unwrap()
+            .parse()
+            .unwrap();
+        let headers = lines
+            .filter_map(|l| l.split_once(':'))
+            .map(|(k, v)| (k.trim().to_ascii_lowercase(), v.trim().to_string()))
+            .collect();
+        Reply {
+            status,
+            headers,
+            body: all[split + 4..].to_vec(),
+        }
+    }
+
+    fn with_token(&self, path: &str) -> String {
+        let sep = if path.contains('?') { '&' } else { '?' };
+        format!("{path}{sep}token={}", self.token)
+    }
+
+    fn get(&self, path: &str) -> Reply {
+        self.raw("GET", &self.with_token(path), None, &[], b"")
+    }
+
+    fn post(&self, path: &str, body: &serde_json::Value) -> Reply {
+        let origin = format!("http://127.0.0.1:{}", self.port);
+        self.raw(
+            "POST",
+            &self.with_token(path),
+            None,
+            &[("Origin", &origin), ("Content-Type", "application/json")],
+            body.to_string().as_bytes(),
+        )
+    }
+
+    fn status(&self) -> serde_json::Value {
+        self.get("/api/status").json()
+    }
+}
+
+fn frame_request(level: u64, view: serde_json::Value) -> serde_json::Value {
+    serde_json::json!({ "client": "test", "level": level, "pass": "colour", "view": view })
+}
+
+fn decode_png(bytes: &[u8]) -> (u32, u32, Vec<u8>) {
+    let mut r = png::Decoder::new(std::io::Cursor::new(bytes))
+        .read_info()
+        .unwrap();
+    let mut buf = vec![0; r.output_buffer_size()];
+    let info = r.next_frame(&mut buf).unwrap();
+    buf.truncate(info.buffer_size());
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    (info.width, info.height, buf)
+}
+
+/// A request target, a Host header (None: this server's) and more headers.
+type Attempt<'a> = (String, Option<&'a str>, Vec<(&'a str, &'a str)>);
+
+const ENDPOINTS: [(&str, &str); 9] = [
+    ("GET", "/"),
+    ("GET", "/api/scene"),
+    ("GET", "/api/status"),
+    ("GET", "/api/probe?client=test&x=1&y=1"),
+    ("GET", "/api/job?id=1"),
+    ("GET", "/files/view-1.toml"),
+    ("POST", "/api/frame"),
+    ("POST", "/api/save"),
+    ("POST", "/api/render"),
+];
+
+/// Without the token, with a wrong one, from another Host (DNS rebinding) or another Origin,
+/// every endpoint answers 403 and nothing is rendered or written.
+#[test]
+fn only_the_token_holder_on_this_host_is_answered() {
+    let v = start("scenes/lattice.toml", "access");
+    let body = frame_request(0, serde_json::json!({})).to_string();
+    let here = format!("http://127.0.0.1:{}", v.port);
+    for (method, path) in ENDPOINTS {
+        let sep = if path.contains('?') { '&' } else { '?' };
+        let cases: [Attempt; 5] = [
+            (path.to_string(), None, vec![]),
+            (
+                format!("{path}{sep}token=0123456789abcdef0123456789abcdef"),
+                None,
+                vec![],
+            ),
+            (v.with_token(path), Some("attacker.example:80"), vec![]),
+            (
+                v.with_token(path),
+                None,
+                vec![("Origin", "http://attacker.example")],
+            ),
+            (
+                v.with_token(path),
+                Some("localhost.attacker.example"),
+                vec![("Origin", here.as_str())],
+            ),
+        ];
+        for (target, host, extra) in cases {
+            let r = v.raw(method, &target, host, &extra, body.as_bytes());
+            assert_eq!(
+                r.status,
+                403,
+                "{method} {target} {host:?} {extra:?}: {}",
+                r.text()
+            );
+        }
+    }
+    let s = v.status();
+    assert_eq!(
+        (s["rendering"].as_u64(), s["clients"].as_u64()),
+        (Some(0), Some(0)),
+        "{s}"
+    );
+    assert!(!v.out.exists(), "nothing written");
+    // The same requests with the token, from here, are answered.
+    assert_eq!(v.get("/").status, 200);
+    assert_eq!(
+        v.raw(
+            "GET",
+            &v.with_token("/api/scene"),
+            Some(&format!("localhost:{}", v.port)),
+            &[],
+            b""
+        )
+        .status,
+        200
+    );
+}
+
+/// Malformed and hostile requests get a clear 4xx, and the server goes on serving.
+#[test]
+fn hostile_requests_get_a_clear_4xx_and_no_panic() {
+    let v = start("scenes/lattice.toml", "hostile");
+    let view = |x: serde_json::Value| frame_request(0, x);
+    let cases: Vec<(Reply, u16, &str)> = vec![
+        (
+            v.post(
+                "/api/frame",
+                &view(serde_json::json!({ "groups": { "lattice": [1.0, 0.0, 0.0] } })),
+            ),
+            400,
+            "must be below 1",
+        ),
+        (
+            v.post(
+                "/api/frame",
+                &view(serde_json::json!({ "groups": { "lattice": [-0.99999999, 0.01, 0.0] } })),
+            ),
+            400,
+            "must be below 1",
+        ),
+        (
+            v.post(
+                "/api/frame",
+                &view(serde_json::json!({ "groups": { "nothing": [0.1, 0.0, 0.0] } })),
+            ),
+            400,
+            "group `nothing`",
+        ),
+        (
+            v.post(
+                "/api/frame",
+                &view(serde_json::json!({ "camera": { "position": [0.0, 0.0] } })),
+            ),
+            400,
+            "three numbers",
+        ),
+        (
+            v.post(
+                "/api/frame",
+                &view(serde_json::json!({ "camera": { "fov_y": 0.0 } })),
+            ),
+            400,
+            "fov_y",
+        ),
+        (
+            v.post(
+                "/api/frame",
+                &view(serde_json::json!({ "width": 1_000_000 })),
+            ),
+            400,
+            "unknown view value",
+        ),
+        (
+            v.post(
+                "/api/frame",
+                &serde_json::json!({ "client": "t", "level": 99, "view": {} }),
+            ),
+            400,
+            "`level` must be 0 to 2",
+        ),
+        (
+            v.post(
+                "/api/frame",
+                &serde_json::json!({ "client": "../x", "level": 0, "view": {} }),
+            ),
+            400,
+            "`client`",
+        ),
+        (
+            v.post(
+                "/api/frame",
+                &serde_json::json!({ "client": "t", "level": 0, "pass": "secrets", "view": {} }),
+            ),
+            400,
+            "`pass`",
+        ),
+        (
+            v.raw(
+                "POST",
+                &v.with_token("/api/frame"),
+                None,
+                &[],
+                br#"{"client":"t","level":0,"view":{"groups":{"lattice":[NaN,0,0]}}}"#,
+            ),
+            400,
+            "not JSON",
+        ),
+        (
+            v.raw(
+                "POST",
+                &v.with_token("/api/frame"),
+                None,
+                &[],
+                br#"{"client":"t","level":0,"view":{"groups":{"lattice":[1e400,0,0]}}}"#,
+            ),
+            400,
+            "not JSON",
+        ),
+        (
+            v.raw(
+                "POST",
+                &v.with_token("/api/frame"),
+                None,
+                &[],
+                &vec![b' '; 70_000],
+            ),
+            413,
+            "larger than",
+        ),
+        (
+            v.get("/files/..%2F..%2Fetc%2Fpasswd"),
+            400,
+            "a file name, not a path",
+        ),
+        (v.get("/files/%2e%2e"), 400, "a file name, not a path"),
+        (v.get("/files/view-1.exr"), 404, "no file"),
+        (v.get("/files/Cargo.toml"), 404, "no file"),
+        (v.get("/api/probe?client=test&x=0&y=0"), 404, "no frame"),
+        (
+            v.get("/api/probe?client=test&x=-1&y=0"),
+            400,
+            "whole number",
+        ),
+        (v.get("/api/job?id=7"), 404, "no render 7"),
+        (v.get("/api/nothing"), 404, "no such page"),
+        (
+            v.raw("DELETE", &v.with_token("/api/frame"), None, &[], b""),
+            405,
+            "method",
+        ),
+    ];
+    for (r, status, needle) in cases {
+        assert_eq!(r.status, status, "{}", r.text());
+        assert!(r.text().contains(needle), "{status}: {}", r.text());
+    }
+    // A line that is no HTTP at all, and a connection that says nothing.
+    let mut s = TcpStream::connect(("127.0.0.1", v.port)).unwrap();
+    s.write_all(b"\x00\xffnot http\r\n\r\n").unwrap();
+    drop(s);
+    drop(TcpStream::connect(("127.0.0.1", v.port)).unwrap());
+    let s = v.status();
+    assert_eq!(s["rendering"], 0, "{s}");
+    assert_eq!(v.get("/api/scene").status, 200, "still serving");
+}
+
+/// The ladder of frames ends at the render of the saved view, pixel for pixel; a click asks the
+/// last frame what it shows, which the EXR of the background render holds too.
+#[test]
+fn the_final_frame_is_rest_embree_render_of_the_saved_view() {
+    let v = start("scenes/lattice.toml", "frames");
+    let info = v.get("/api/scene").json();
+    let levels = info["levels"].as_array().unwrap().len() as u64;
+    assert_eq!(levels, 3, "{info}");
+    let view = serde_json::json!({
+        "groups": { "lattice": [-0.9, 0.0, 0.0] },
+        "camera": { "time": 3.5, "position": [-3.0, 0.3, 0.2], "direction": [1.0, -0.1, 0.0] },
+        "doppler": true,
+        "searchlight": true
+    });
+    let mut last = None;
+    for level in 0..levels {
+        let r = v.post("/api/frame", &frame_request(level, view.clone()));
+        assert_eq!(r.status, 200, "{}", r.text());
+        assert_eq!(r.header("content-type"), Some("image/png"));
+        let (w, h, px) = decode_png(&r.body);
+        let want = if level == 0 { 256 } else { 512 };
+        assert_eq!((w, h), (want, want));
+        assert_eq!(
+            r.header("x-final"),
+            Some(if level + 1 == levels { "true" } else { "false" })
+        );
+        last = Some(px);
+    }
+    let saved = v.post("/api/save", &serde_json::json!({ "view": view }));
+    assert_eq!(saved.status, 200, "{}", saved.text());
+    assert!(saved
+        .header("content-disposition")
+        .unwrap()
+        .contains("lattice-view.toml"));
+    let dir = std::env::temp_dir().join(format!("rest-embree-view-saved-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = dir.join("view.toml");
+    std::fs::write(&toml, &saved.body).unwrap();
+    let png = dir.join("view.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args(["render", "--backend", "bvh", "-q"])
+        .arg(&toml)
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (_, _, rendered) = decode_png(&std::fs::read(&png).unwrap());
+    let last = last.unwrap();
+    let differ = last.iter().zip(&rendered).filter(|(a, b)| a != b).count();
+    assert_eq!(
+        differ, 0,
+        "the final frame differs from the render of the saved view in {differ} bytes"
+    );
+    // The click: what the last frame shows at pixels across the middle row, as the library
+    // renders the saved file.
+    let scene = rest_embree::scene::load_file(&toml, &[]).unwrap();
+    let backend = rest_embree::accel::backend_by_name("bvh").unwrap();
+    let (frame, _) = rest_embree::render(&scene, backend.as_ref(), &Default::default()).unwrap();
+    let lookback = frame.channel("lookback.V").unwrap();
+    let mut hits = 0;
+    for x in (0..512).step_by(16) {
+        let p = v.get(&format!("/api/probe?client=test&x={x}&y=256")).json();
+        let i = 256 * 512 + x;
+        assert_eq!(
+            p["hit"].as_bool(),
+            Some(frame.pixels[i].object_id != 0),
+            "{p}"
+        );
+        if p["hit"] == true {
+            hits += 1;
+            assert_eq!(p["lookback"].as_f64().unwrap() as f32, lookback[i], "{p}");
+            let t = p["emission"]["t"].as_f64().unwrap();
+            assert!((t - (3.5 - f64::from(lookback[i]))).abs() < 1e-6, "{p}");
+            assert_eq!(p["object"], "lattice");
+            assert_eq!(p["group"], "lattice");
+        }
+    }
+    assert!(hits > 5, "the middle row sees the lattice ({hits} probes)");
+    // Render this view: the scene file and an EXR, offered by name.
+    let job = v
+        .post("/api/render", &serde_json::json!({ "view": view }))
+        .json();
+    let id = job["id"].as_u64().unwrap();
+    let t0 = Instant::now();
+    loop {
+        let j = v.get(&format!("/api/job?id={id}")).json();
+        match j["state"].as_str() {
+            Some("done") => break,
+            Some("running") => assert!(t0.elapsed() < Duration::from_secs(120), "{j}"),
+            _ => panic!("{j}"),
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let toml_back = v.get(&format!("/files/view-{id}.toml"));
+    assert_eq!(toml_back.status, 200);
+    assert_eq!(
+        toml_back.body, saved.body,
+        "the file rendered is the file saved"
+    );
+    let exr = v.get(&format!("/files/view-{id}.exr"));
+    assert_eq!(exr.status, 200);
+    assert_eq!(
+        exr.body,
+        std::fs::read(v.out.join(format!("view-{id}.exr"))).unwrap()
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A hundred changes as fast as a slider sends them: every superseded view's work stops, at no
+/// time does more than one frame render, and the newest view is the one drawn.
+#[test]
+fn a_hundred_rapid_changes_leave_one_frame_of_work() {
+    let v = std::sync::Arc::new(start("scenes/lattice.toml", "rapid"));
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let watcher = {
+        let (v, stop) = (v.clone(), stop.clone());
+        std::thread::spawn(move || {
+            let mut most = 0;
+            while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                most = most.max(v.status()["rendering"].as_u64().unwrap());
+                std::thread::sleep(Duration::from_millis(2));
+            }
+            most
+        })
+    };
+    let senders: Vec<_> = (0..100)
+        .map(|k| {
+            let v = v.clone();
+            std::thread::sleep(Duration::from_millis(3));
+            std::thread::spawn(move || {
+                let beta = -0.5 - 0.004 * k as f64;
+                let r = v.post(
+                    "/api/frame",
+                    &frame_request(
+                        2,
+                        serde_json::json!({ "groups": { "lattice": [beta, 0.0, 0.0] } }),
+                    ),
+                );
+                (k, r.status)
+            })
+        })
+        .collect();
+    let statuses: Vec<(usize, u16)> = senders.into_iter().map(|s| s.join().unwrap()).collect();
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    let most = watcher.join().unwrap();
+    assert!(most <= 1, "{most} frames rendered at once");
+    let ok: Vec<usize> = statuses
+        .iter()
+        .filter(|s| s.1 == 200)
+        .map(|s| s.0)
+        .collect();
+    assert!(
+        statuses.iter().all(|s| s.1 == 200 || s.1 == 409),
+        "{statuses:?}"
+    );
+    assert!(
+        !ok.is_empty() && ok.len() < 10,
+        "most were superseded: {} drawn",
+        ok.len()
+    );
+    let s = v.status();
+    assert_eq!(
+        (s["rendering"].as_u64(), s["waiting"].as_u64()),
+        (Some(0), Some(0)),
+        "{s}"
+    );
+}
+
+/// Ctrl-C (SIGINT) stops the server: it says so and exits 0.
+#[test]
+fn ctrl_c_stops_it_cleanly() {
+    let mut v = start("scenes/lattice.toml", "stop");
+    assert_eq!(v.get("/api/status").status, 200);
+    let pid = v.child.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-INT", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let t0 = Instant::now();
+    let status = loop {
+        if let Some(s) = v.child.try_wait().unwrap() {
+            break s;
+        }
+        assert!(t0.elapsed() < Duration::from_secs(10), "still running");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert!(status.success(), "{status:?}");
+    let mut rest = String::new();
+    v.stdout.read_to_string(&mut rest).unwrap();
+    assert!(rest.contains("stopped"), "{rest}");
+    assert!(
+        TcpStream::connect(("127.0.0.1", v.port)).is_err(),
+        "no longer listening"
+    );
+}
