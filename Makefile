@@ -27,7 +27,8 @@ demo: setup
 # everything, not a second one in target/debug with full debug info. The build without Embree
 # goes first, so the binary left in target/release is the one with it. Blender 5 (bpy, from
 # PyPI) downloads in the background meanwhile, for the last check: every documented pass as
-# Blender's compositor takes it (scripts/blender-test.sh).
+# Blender's compositor takes it (scripts/blender-test.sh). Before it, headless Chromium drives
+# the viewer's page: a slider moved, a frame awaited, a pixel clicked (scripts/browser-test.sh).
 test: setup
 	@mkdir -p target && (scripts/blender-test.sh --install >target/bpy-install.log 2>&1 &)
 	@# The code as the house keeps it: formatted, and no lint in either build.
@@ -47,6 +48,7 @@ test: setup
 	  fi; \
 	done
 	scripts/slurm-test.sh target/release/rest-embree
+	scripts/browser-test.sh target/release/rest-embree
 	scripts/blender-test.sh target/release/rest-embree
 
 # A film's frames as an MP4 (ffmpeg): make film FRAMES='film/frame-%04d.png' FPS=24 MP4=film.mp4

@@ -68,4 +68,6 @@ rm -r "$film"
 # The spoked wheel, still and with its rim at 0.9c.
 $r render scenes/spoked_wheel.toml -o "$o/wheel-0.png" --width 320 --height 240 --quiet --set 'group.wheel.object.wheel.spin.omega=0'
 $r render scenes/spoked_wheel.toml -o "$o/wheel-0.9.png" --width 320 --height 240 --quiet
+# The viewer's page in headless Chromium, after the browser test's slider move and click.
+"$(dirname "$0")/browser-test.sh" "$r" "$o/viewer.png"
 echo "wrote $(ls "$o" | wc -l) images to $o"

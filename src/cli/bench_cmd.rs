@@ -125,6 +125,9 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         for b in accel::backend_names() {
             summary.push_str(&bench::film_cost(args.quick, b)?);
         }
+        for b in accel::backend_names() {
+            summary.push_str(&crate::view::latency(args.quick, b)?);
+        }
         summary.push_str(&bench_lattice::summary(args.quick, &accel::backend_names()));
         summary.push_str(&bench::path_noise(args.quick, &accel::backend_names())?);
         summary.push_str(&bench::exr_writing(

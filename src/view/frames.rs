@@ -164,6 +164,13 @@ pub(crate) fn pass_rgb(frame: &Frame, pass: &str) -> Option<Vec<u8>> {
     Some(rgb.into_iter().flatten().collect())
 }
 
+/// One pass of a frame as PNG bytes; an error names an unknown pass.
+pub(crate) fn png(frame: &Frame, pass: &str) -> Result<Vec<u8>, String> {
+    let rgb = pass_rgb(frame, pass).ok_or_else(|| format!("no pass `{pass}`"))?;
+    crate::output::png_out::rgb_png(frame.width, frame.height, &rgb)
+        .map_err(|e| format!("encoding the frame: {e}"))
+}
+
 /// What a pixel shows, for the page's click: the object, its emission event, lookback,
 /// Doppler factor and the point on the object in its rest frame.
 pub(crate) fn probe(frame: &Frame, scene: &Scene, x: u32, y: u32) -> serde_json::Value {

@@ -170,17 +170,34 @@ impl Viewer {
         let source = config.scene.display().to_string();
         let text = std::fs::read_to_string(&config.scene)
             .map_err(|e| crate::Error::flag("view", format!("cannot read {source}: {e}")))?;
+        Viewer::from_text(
+            source,
+            text,
+            &config.backend,
+            config.out.clone(),
+            config.allow_hosts.clone(),
+        )
+    }
+
+    /// The viewer of the scene file `source` whose text is `text`.
+    fn from_text(
+        source: String,
+        text: String,
+        backend_name: &str,
+        out: PathBuf,
+        allow_hosts: Vec<String>,
+    ) -> crate::Result<Viewer> {
         // The scene as the viewer will render it: loaded now so that a bad file is said at once.
         let base =
             edits::saved_text(&text, &source, &[]).map_err(|e| crate::Error::flag("view", e))?;
         let mut scene = crate::scene::load_str(&source, &base, &[])?;
         scene.film = None;
         let backend =
-            crate::accel::backend_by_name(&config.backend).map_err(|e| e.on_flag("--backend"))?;
+            crate::accel::backend_by_name(backend_name).map_err(|e| e.on_flag("--backend"))?;
         let editable = editable(&scene);
         let levels = frames::levels(&scene.image);
         let info = info(&scene, &editable, &levels, &source);
-        let mut names = config.allow_hosts.clone();
+        let mut names = allow_hosts;
         if let Some(h) = hostname() {
             names.push(h);
         }
@@ -192,15 +209,83 @@ impl Viewer {
             info,
             levels,
             backend,
-            backend_name: config.backend.clone(),
+            backend_name: backend_name.to_string(),
             clients: Mutex::new(HashMap::new()),
             render_lock: Mutex::new(()),
             rendering: AtomicUsize::new(0),
             waiting: AtomicUsize::new(0),
             handlers: AtomicUsize::new(0),
-            jobs: jobs::Jobs::new(config.out.clone()),
+            jobs: jobs::Jobs::new(out),
         })
     }
+
+    /// The scene a view's values make, at level `level` of the ladder (the last: the scene
+    /// file the view saves, as it is). Errors are the 400 a request gets.
+    fn scene_for(&self, view: &serde_json::Value, level: usize) -> Result<Scene, (u16, String)> {
+        let text = self.view_text(view)?;
+        let l = self.levels[level];
+        let overrides: Vec<(String, String)> = if level + 1 == self.levels.len() {
+            Vec::new()
+        } else {
+            ["width", "height", "samples"]
+                .iter()
+                .zip([l.width, l.height, l.samples])
+                .map(|(k, x)| {
+                    (
+                        format!("the viewer's level {level}"),
+                        format!("image.{k}={x}"),
+                    )
+                })
+                .collect()
+        };
+        crate::scene::load_str(&self.source, &text, &overrides).map_err(|e| (400, e.to_string()))
+    }
+
+    /// The scene file a view's values make: the user's file with their edits.
+    fn view_text(&self, view: &serde_json::Value) -> Result<String, (u16, String)> {
+        let edits = edits::edits(view, &self.editable).map_err(|e| (400, e))?;
+        edits::saved_text(&self.text, &self.source, &edits).map_err(|e| (400, e))
+    }
+}
+
+/// A Markdown line for the bench: how long the viewer takes from a change of the lattice's β
+/// to the first frame of the new view as PNG bytes, on the server (the same steps as a
+/// request: the edits, the scene file read, the world built, the frame rendered and encoded;
+/// not the HTTP exchange).
+pub(crate) fn latency(quick: bool, backend: &str) -> crate::Result<String> {
+    let viewer = Viewer::from_text(
+        "scenes/lattice.toml".into(),
+        include_str!("../../scenes/lattice.toml").into(),
+        backend,
+        std::env::temp_dir(),
+        Vec::new(),
+    )?;
+    let n = if quick { 20 } else { 100 };
+    let mut ms = Vec::with_capacity(n);
+    let (mut w, mut h) = (0, 0);
+    for k in 0..n {
+        let beta = 0.5 + 0.45 * k as f64 / n as f64;
+        let view = serde_json::json!({ "groups": { "lattice": [-beta, 0.0, 0.0] } });
+        let t = Instant::now();
+        let mut scene = viewer
+            .scene_for(&view, 0)
+            .map_err(|(_, e)| crate::Error::flag("bench", e))?;
+        let frame = frames::render(&mut scene, viewer.backend.as_ref(), &AtomicBool::new(false))
+            .map_err(|e| match e {
+                frames::Stopped::Failed(e) => e,
+                frames::Stopped::Superseded => crate::Error::flag("bench", "stopped"),
+            })?;
+        let png = frames::png(&frame, "colour").map_err(|e| crate::Error::flag("bench", e))?;
+        ms.push(t.elapsed().as_secs_f64() * 1e3);
+        std::hint::black_box(png);
+        (w, h) = (frame.width, frame.height);
+    }
+    ms.sort_by(f64::total_cmp);
+    Ok(format!(
+        "- viewer, a change of the lattice's β to the first frame of the new view ({w}x{h}, 1 spp, as PNG, on the server; {backend}): median {:.1} ms, slowest {:.1} ms of {n} changes\n",
+        ms[n / 2],
+        ms[n - 1]
+    ))
 }
 
 /// This machine's name, which Host may name (a cluster node reached by its name).

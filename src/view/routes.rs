@@ -9,7 +9,7 @@
 //!   file rendered to an EXR in the background; `GET /api/job?id`: how far it is;
 //! - `GET /files/NAME`: a file a render of a view wrote.
 
-use super::{edits, frames, jobs, Client, Viewer, MAX_CLIENTS};
+use super::{frames, jobs, Client, Viewer, MAX_CLIENTS};
 use serde_json::{json, Value};
 use std::io::Read;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -145,9 +145,7 @@ fn client_id(x: Option<&Value>) -> Result<String, (u16, String)> {
 
 /// The view's text: the scene file with the view's edits.
 fn view_text(v: &Viewer, body: &Value) -> Result<String, (u16, String)> {
-    let view = body.get("view").ok_or((400, "no `view`".to_string()))?;
-    let edits = edits::edits(view, &v.editable).map_err(|e| (400, e))?;
-    edits::saved_text(&v.text, &v.source, &edits).map_err(|e| (400, e))
+    v.view_text(body.get("view").ok_or((400, "no `view`".to_string()))?)
 }
 
 fn frame(v: &Viewer, body: &Value) -> Answer {
@@ -168,25 +166,9 @@ fn frame(v: &Viewer, body: &Value) -> Answer {
             format!("`pass` must be one of {}", frames::PASSES.join(", ")),
         ));
     }
-    let text = view_text(v, body)?;
-    let l = v.levels[level];
-    let last = level + 1 == n;
-    let overrides: Vec<(String, String)> = if last {
-        Vec::new()
-    } else {
-        ["width", "height", "samples"]
-            .iter()
-            .zip([l.width, l.height, l.samples])
-            .map(|(k, x)| {
-                (
-                    format!("the viewer's level {level}"),
-                    format!("image.{k}={x}"),
-                )
-            })
-            .collect()
-    };
-    let mut scene =
-        crate::scene::load_str(&v.source, &text, &overrides).map_err(|e| (400, e.to_string()))?;
+    let view = body.get("view").ok_or((400, "no `view`".to_string()))?;
+    let mut scene = v.scene_for(view, level)?;
+    let (l, last) = (v.levels[level], level + 1 == n);
     // This view supersedes the client's last: its render stops at its next strip.
     let (generation, cancel) = register(v, &client);
     let current = || {
@@ -213,9 +195,7 @@ fn frame(v: &Viewer, body: &Value) -> Answer {
         Err(frames::Stopped::Superseded) => return Err((409, "superseded by a newer view".into())),
         Err(frames::Stopped::Failed(e)) => return Err((500, e.to_string())),
     };
-    let rgb = frames::pass_rgb(&frame, pass).expect("a pass checked above");
-    let png = crate::output::png_out::rgb_png(frame.width, frame.height, &rgb)
-        .map_err(|e| (500, format!("encoding the frame: {e}")))?;
+    let png = frames::png(&frame, pass).map_err(|e| (500, e))?;
     let (w, h) = (frame.width, frame.height);
     {
         let mut clients = v.clients.lock().expect("not poisoned");

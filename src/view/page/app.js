@@ -232,9 +232,14 @@ async function probe(e) {
   const img = $('frame');
   const s = viewer.shown;
   if (!s) return;
+  // The picture inside the element's box (object-fit: contain centres it).
   const rect = img.getBoundingClientRect();
-  const x = Math.min(s.width - 1, Math.max(0, Math.floor((e.clientX - rect.left) / rect.width * s.width)));
-  const y = Math.min(s.height - 1, Math.max(0, Math.floor((e.clientY - rect.top) / rect.height * s.height)));
+  const k = Math.min(rect.width / s.width, rect.height / s.height);
+  const left = rect.left + (rect.width - k * s.width) / 2;
+  const top = rect.top + (rect.height - k * s.height) / 2;
+  const x = Math.floor((e.clientX - left) / k);
+  const y = Math.floor((e.clientY - top) / k);
+  if (x < 0 || y < 0 || x >= s.width || y >= s.height) return;
   const m = $('marker');
   m.hidden = false;
   m.style.left = `${e.clientX - rect.left}px`;
