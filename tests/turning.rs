@@ -220,3 +220,30 @@ fn a_bar_a_million_units_of_time_later_is_the_same_bar() {
         assert!(worst < 1e-4, "{backend}: lookbacks differ by {worst}");
     }
 }
+
+/// A spacetime translation of the whole scene leaves the picture of a turning bar, at rest and
+/// in a moving group: the body's epoch moves with the group's time, so it stands at the same
+/// angle at the moved events (before, it showed turned by ω Δt).
+#[test]
+fn a_translated_scene_with_a_turning_bar_renders_the_same() {
+    use rest_embree::spacetime::Event;
+    let still = view(&bar(OMEGA), 10.0, 120, 41, 100.0);
+    let moving = still.replace(
+        "name = \"spinner\"",
+        "name = \"spinner\"\nvelocity = [0.3, 0, 0.2]",
+    );
+    assert_ne!(still, moving);
+    for text in [still, moving] {
+        let s = scene(&text);
+        for backend in backends() {
+            let a = render_with(&s, backend);
+            for shift in [
+                Event::new(3.7, DVec3::new(1.0, -2.0, 0.5)),
+                Event::new(-250.0, DVec3::new(0.0, 40.0, -3.0)),
+            ] {
+                let b = render_with(&s.translated(shift), backend);
+                same_picture(&a, &b, "translated", 2.0 / (120.0 * 41.0), 1e-3);
+            }
+        }
+    }
+}

@@ -26,7 +26,8 @@ pub struct Part {
 /// A rigid rotation in the group's frame: at `omega` radians per unit of the group's time,
 /// counter-clockwise about `axis` (unit) through `centre`. A body of revolution about the axis
 /// keeps its shape in the group's frame while every point of its surface moves along it;
-/// any other body (`turning`) is where its shape at time 0 turned by ω t puts it.
+/// any other body (`turning`) is where its shape at time `epoch` turned by ω (t − epoch) puts
+/// it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spin {
     /// A point of the axis.
@@ -38,6 +39,9 @@ pub struct Spin {
     /// Whether its shape turns (it is not a body of revolution about the axis): its rays are
     /// then followed to the turning shape (render/world/turning.rs).
     pub turning: bool,
+    /// The group time at which the body stands as the scene file gives it: 0 from a file, moved
+    /// by a spacetime translation of the scene (`Geometry::moved`).
+    pub epoch: f64,
 }
 
 impl Spin {
@@ -52,16 +56,16 @@ impl Spin {
         Some(crate::spacetime::Boost::to_rest(&v))
     }
 
-    /// Where the body's point now at `p` was at the group's time 0, by which textures stay
-    /// painted on the turning body: `p` turned back by ω t.
+    /// Where the body's point now (group time `t`) at `p` was at its epoch, by which textures
+    /// stay painted on the turning body: `p` turned back by ω (t − epoch).
     pub fn unturned(&self, p: DVec3, t: f64) -> DVec3 {
-        let back = glam::DQuat::from_axis_angle(self.axis, -self.omega * t);
+        let back = glam::DQuat::from_axis_angle(self.axis, -self.omega * (t - self.epoch));
         self.centre + back * (p - self.centre)
     }
 
-    /// A direction of the shape at time 0 as it points at time `t`.
+    /// A direction of the shape at its epoch as it points at group time `t`.
     pub fn turned_dir(&self, d: DVec3, t: f64) -> DVec3 {
-        glam::DQuat::from_axis_angle(self.axis, self.omega * t) * d
+        glam::DQuat::from_axis_angle(self.axis, self.omega * (t - self.epoch)) * d
     }
 }
 
@@ -464,6 +468,14 @@ impl Geometry {
 
     /// The same geometry moved by `d`.
     pub fn translated(&self, d: DVec3) -> Geometry {
+        self.moved(crate::spacetime::Event::new(0.0, d))
+    }
+
+    /// The same geometry moved by the spacetime translation `by` of its group's frame: in
+    /// space by `by.x`, and its spinning bodies' epochs by `by.t`, so that a body turns to the
+    /// same angle at the moved events.
+    pub fn moved(&self, by: crate::spacetime::Event) -> Geometry {
+        let d = by.x;
         Geometry {
             prims: self.prims.iter().map(|p| p.translated(d)).collect(),
             parts: self
@@ -472,6 +484,7 @@ impl Geometry {
                 .map(|p| Part {
                     spin: p.spin.map(|s| Spin {
                         centre: s.centre + d,
+                        epoch: s.epoch + by.t,
                         ..s
                     }),
                     placement: p.placement.as_ref().map(|x| {

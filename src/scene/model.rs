@@ -480,7 +480,7 @@ impl Scene {
             match &mut g.accelerated {
                 // Its shape is in the frame moving with it: its start moves instead.
                 Some(acc) => acc.start = acc.start + own,
-                None => g.geometry = Arc::new(g.geometry.translated(own.x)),
+                None => g.geometry = Arc::new(g.geometry.moved(own)),
             }
         }
         s

@@ -73,5 +73,6 @@ pub(super) fn read_spin(
         axis,
         omega,
         turning,
+        epoch: 0.0,
     })
 }

@@ -271,6 +271,7 @@ mod tests {
             axis: DVec3::Z,
             omega: 0.4,
             turning: true,
+            epoch: 0.0,
         };
         let mut g = Geometry::default();
         g.push_part(
