@@ -507,6 +507,83 @@ fn the_final_frame_is_rest_embree_render_of_the_saved_view() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A view of a scene that names files (an OBJ mesh, a texture image) saved and rendered from
+/// another folder is still the viewer's final frame: the saved file names them by full path.
+#[test]
+fn a_saved_view_with_files_renders_the_same_from_anywhere() {
+    let v = start("scenes/rocket.toml", "files");
+    let levels = v.get("/api/scene").json()["levels"]
+        .as_array()
+        .unwrap()
+        .len() as u64;
+    let view =
+        serde_json::json!({ "groups": { "rocket": [0.6, 0.0, 0.1] }, "camera": { "time": 1.5 } });
+    let r = v.post("/api/frame", &frame_request(levels - 1, view.clone()));
+    assert_eq!(r.status, 200, "{}", r.text());
+    let (_, _, shown) = decode_png(&r.body);
+    let saved = v.post("/api/save", &serde_json::json!({ "view": view }));
+    assert_eq!(saved.status, 200, "{}", saved.text());
+    let text = saved.text();
+    assert!(
+        text.contains("rocket.obj\"") && !text.contains("file = \"rocket.obj\""),
+        "{text}"
+    );
+    let dir =
+        std::env::temp_dir().join(format!("rest-embree-view-elsewhere-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("rocket-view.toml"), &saved.body).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args([
+            "render",
+            "--backend",
+            "bvh",
+            "-q",
+            "rocket-view.toml",
+            "-o",
+            "rocket-view.png",
+        ])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (_, _, rendered) = decode_png(&std::fs::read(dir.join("rocket-view.png")).unwrap());
+    assert!(
+        shown == rendered,
+        "the render of the saved view differs from the final frame"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Requests arrive out of order: one older than the newest the page sent is refused, and a
+/// click on a frame that has been replaced is refused, so the page never shows or reads a
+/// view it has moved past.
+#[test]
+fn an_older_request_never_supersedes_a_newer_one() {
+    let v = start("scenes/lattice.toml", "order");
+    let ask = |seq: u64, beta: f64| {
+        v.post(
+            "/api/frame",
+            &serde_json::json!({ "client": "p", "seq": seq, "level": 0, "view": { "groups": { "lattice": [beta, 0.0, 0.0] } } }),
+        )
+    };
+    assert_eq!(ask(10, -0.5).status, 200);
+    let stale = ask(9, -0.1);
+    assert_eq!(stale.status, 409, "{}", stale.text());
+    assert_eq!(ask(10, -0.1).status, 409, "the same number again");
+    assert_eq!(ask(11, -0.6).status, 200);
+    assert_eq!(v.get("/api/probe?client=p&seq=10&x=1&y=1").status, 409);
+    assert_eq!(v.get("/api/probe?client=p&seq=11&x=1&y=1").status, 200);
+    let bad = v.post(
+        "/api/frame",
+        &serde_json::json!({ "client": "p", "seq": -1, "level": 0, "view": {} }),
+    );
+    assert_eq!(bad.status, 400, "{}", bad.text());
+}
+
 /// A hundred changes as fast as a slider sends them: every superseded view's work stops, at no
 /// time does more than one frame render, and the newest view is the one drawn.
 #[test]

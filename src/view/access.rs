@@ -99,7 +99,11 @@ pub(crate) fn percent_decode(s: &str) -> Option<String> {
     while i < b.len() {
         match b[i] {
             b'%' => {
-                let hex = std::str::from_utf8(b.get(i + 1..i + 3)?).ok()?;
+                let hex = b.get(i + 1..i + 3)?;
+                if !hex.iter().all(u8::is_ascii_hexdigit) {
+                    return None;
+                }
+                let hex = std::str::from_utf8(hex).ok()?;
                 out.push(u8::from_str_radix(hex, 16).ok()?);
                 i += 3;
             }
@@ -187,6 +191,7 @@ mod tests {
         assert_eq!(query_value("a=1", "b"), None);
         assert_eq!(query_value("b=%zz", "b"), None);
         assert_eq!(query_value("b=%ff", "b"), None);
+        assert_eq!(query_value("b=%+f", "b"), None);
         assert_eq!(new_token().unwrap().len(), 32);
         assert_ne!(new_token().unwrap(), new_token().unwrap());
     }

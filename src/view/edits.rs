@@ -125,6 +125,27 @@ fn camera(value: &Value, editable: &Editable) -> Result<Vec<Edit>, String> {
     Ok(out)
 }
 
+/// A new view time for a camera that moves, its position not given: the camera moves along its
+/// worldline to that time (as a film's frames do), rather than jumping to another worldline
+/// through its old place.
+pub(crate) fn follow_worldline(edits: &mut Vec<Edit>, camera: &crate::scene::Camera) {
+    let on_camera = |e: &&Edit, key: &str| e.place == Place::Camera && e.key == key;
+    let time = edits
+        .iter()
+        .find(|e| on_camera(e, "time"))
+        .and_then(|e| e.value.parse::<f64>().ok());
+    let placed = edits.iter().any(|e| on_camera(&e, "position"));
+    let moves = !camera.velocity.is_zero() || camera.worldline.is_some();
+    if let (Some(t), false, true) = (time, placed, moves) {
+        let p = camera.at_time(t).position;
+        edits.push(Edit {
+            place: Place::Camera,
+            key: "position",
+            value: literal3([p.x, p.y, p.z]),
+        });
+    }
+}
+
 /// A finite number of moderate size.
 fn number(v: &Value, shown: &str) -> Result<f64, String> {
     let x = v
@@ -182,11 +203,63 @@ pub(crate) fn saved_text(original: &str, source: &str, edits: &[Edit]) -> Result
         for gone in crate::scene::superseded(&path, e.key) {
             table.remove(gone);
         }
+        // A group's velocity replaces a worldline of one segment (the only kind it may edit).
+        if matches!(e.place, Place::Group(_)) && e.key == "velocity" {
+            table.remove("worldline");
+        }
         table.insert(e.key, Item::Value(value));
     }
+    absolute_paths(&mut doc, source);
     Ok(format!(
-        "# The view saved by `rest-embree view` from {source}: render it with `rest-embree render`\n# (file paths in it are relative to the folder of {source}).\n{doc}"
+        "# The view saved by `rest-embree view` from {source}: render it with `rest-embree render`\n# from anywhere (the files it names are given by their full paths).\n{doc}"
     ))
+}
+
+/// The files a scene names (a mesh's `file`, a texture's `image`, the sky's `map`) relative to
+/// its folder, given instead by their full paths: the saved view renders the same wherever it
+/// is kept.
+fn absolute_paths(doc: &mut DocumentMut, source: &str) {
+    let folder = std::path::Path::new(source)
+        .parent()
+        .unwrap_or(std::path::Path::new(""));
+    let folder = std::fs::canonicalize(if folder.as_os_str().is_empty() {
+        std::path::Path::new(".")
+    } else {
+        folder
+    });
+    let Ok(folder) = folder else { return };
+    let fix = |item: Option<&mut Item>| {
+        let Some(item) = item else { return };
+        let Some(name) = item.as_str() else { return };
+        let path = std::path::Path::new(name);
+        if path.is_relative() {
+            let full = folder.join(path).to_string_lossy().into_owned();
+            *item = toml_edit::value(full);
+        }
+    };
+    if let Some(textures) = doc
+        .get_mut("texture")
+        .and_then(|t| t.as_array_of_tables_mut())
+    {
+        for t in textures.iter_mut() {
+            fix(t.get_mut("image"));
+        }
+    }
+    if let Some(sky) = doc.get_mut("sky").and_then(|t| t.as_table_like_mut()) {
+        fix(sky.get_mut("map"));
+    }
+    if let Some(groups) = doc
+        .get_mut("group")
+        .and_then(|t| t.as_array_of_tables_mut())
+    {
+        for g in groups.iter_mut() {
+            if let Some(objects) = g.get_mut("object").and_then(|t| t.as_array_of_tables_mut()) {
+                for o in objects.iter_mut() {
+                    fix(o.get_mut("file"));
+                }
+            }
+        }
+    }
 }
 
 /// The table `[name]`, made if the file has none.
@@ -251,6 +324,57 @@ mod tests {
         assert!(!text.contains("[film]"), "{text}");
         let back: DocumentMut = text.parse().unwrap();
         assert_eq!(back["group"][0]["velocity"][2].as_float(), Some(1e-7));
+    }
+
+    /// A velocity replaces a group's worldline of one segment; the files a scene names are
+    /// given by full path, so the saved view renders the same from any folder.
+    #[test]
+    fn a_velocity_replaces_a_worldline_and_files_get_full_paths() {
+        let text = "[camera]\nposition = [0, 0, 0]\ndirection = [1, 0, 0]\n[[texture]]\nname = \"t\"\nimage = \"paint.png\"\n[sky]\nmap = \"/abs/sky.exr\"\n[[group]]\nname = \"g\"\nworldline = [{ velocity = [0.1, 0, 0] }]\n[[group.object]]\ntype = \"mesh\"\nfile = \"m.obj\"\n";
+        let e = edits(
+            &json!({ "groups": { "g": [0.2, 0.0, 0.0] } }),
+            &Editable {
+                groups: vec!["g".into()],
+                pinhole: true,
+            },
+        )
+        .unwrap();
+        let saved = saved_text(text, "scenes/x.toml", &e).unwrap();
+        let doc: DocumentMut = saved.parse().unwrap();
+        let g = &doc["group"][0];
+        assert!(
+            g.get("worldline").is_none() && g.get("velocity").is_some(),
+            "{saved}"
+        );
+        let here = std::fs::canonicalize("scenes").unwrap();
+        assert_eq!(
+            doc["texture"][0]["image"].as_str(),
+            Some(here.join("paint.png").to_str().unwrap())
+        );
+        assert_eq!(
+            g["object"][0]["file"].as_str(),
+            Some(here.join("m.obj").to_str().unwrap())
+        );
+        assert_eq!(doc["sky"]["map"].as_str(), Some("/abs/sky.exr"));
+    }
+
+    /// A moving camera given a new view time moves along its worldline to it.
+    #[test]
+    fn a_moving_camera_follows_its_worldline_to_a_new_time() {
+        let text = "[camera]\nposition = [1, 0, 0]\ndirection = [0, 1, 0]\nvelocity = [0.5, 0, 0]\ntime = 2\n[[group]]\nname = \"g\"\n[[group.object]]\ntype = \"sphere\"\ncenter = [0, 5, 0]\nradius = 1\n";
+        let camera = crate::scene::load_str("t.toml", text, &[]).unwrap().camera;
+        let mut e = edits(&json!({ "camera": { "time": 6.0 } }), &editable()).unwrap();
+        follow_worldline(&mut e, &camera);
+        let saved = saved_text(text, "t.toml", &e).unwrap();
+        assert!(saved.contains("position = [3.0, 0.0, 0.0]"), "{saved}");
+        // Given a position, or at rest, the camera stays where it is told.
+        let mut e = edits(
+            &json!({ "camera": { "time": 6.0, "position": [0.0, 0.0, 0.0] } }),
+            &editable(),
+        )
+        .unwrap();
+        follow_worldline(&mut e, &camera);
+        assert_eq!(e.iter().filter(|e| e.key == "position").count(), 1);
     }
 
     #[test]

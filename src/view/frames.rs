@@ -88,6 +88,8 @@ pub(crate) fn render(
         frame.mattes.extend_from_slice(&s.mattes);
         Ok(())
     })?;
+    // A fault the backend recorded fails the frame, as it fails `rest-embree render`.
+    world.check()?;
     Ok(frame)
 }
 
@@ -164,17 +166,24 @@ pub(crate) fn pass_rgb(frame: &Frame, pass: &str) -> Option<Vec<u8>> {
     Some(rgb.into_iter().flatten().collect())
 }
 
-/// One pass of a frame as PNG bytes; an error names an unknown pass.
-pub(crate) fn png(frame: &Frame, pass: &str) -> Result<Vec<u8>, String> {
-    let rgb = pass_rgb(frame, pass).ok_or_else(|| format!("no pass `{pass}`"))?;
-    crate::output::png_out::rgb_png(frame.width, frame.height, &rgb)
-        .map_err(|e| format!("encoding the frame: {e}"))
+/// One pass of a frame as PNG bytes; an error names an unknown pass. The colour of a
+/// transparent scene is RGBA with straight alpha, as `rest-embree render` writes it.
+pub(crate) fn png(frame: &Frame, pass: &str, transparent: bool) -> Result<Vec<u8>, String> {
+    let encoded = if pass == "colour" && transparent {
+        let rgba = crate::output::png_out::srgb_bytes(&frame.pixels, true);
+        crate::output::png_out::rgba_png(frame.width, frame.height, &rgba)
+    } else {
+        let rgb = pass_rgb(frame, pass).ok_or_else(|| format!("no pass `{pass}`"))?;
+        crate::output::png_out::rgb_png(frame.width, frame.height, &rgb)
+    };
+    encoded.map_err(|e| format!("encoding the frame: {e}"))
 }
 
 /// What a pixel shows, for the page's click: the object, its emission event, lookback,
 /// Doppler factor and the point on the object in its rest frame.
-pub(crate) fn probe(frame: &Frame, scene: &Scene, x: u32, y: u32) -> serde_json::Value {
+pub(crate) fn probe(shown: &super::Shown, x: u32, y: u32) -> serde_json::Value {
     use serde_json::json;
+    let frame = &shown.frame;
     let i = y as usize * frame.width as usize + x as usize;
     let Some(p) = frame.pixels.get(i) else {
         return json!({ "hit": false });
@@ -182,17 +191,17 @@ pub(crate) fn probe(frame: &Frame, scene: &Scene, x: u32, y: u32) -> serde_json:
     if p.object_id == 0 {
         return json!({ "hit": false, "pixel": [x, y] });
     }
-    let object = scene.objects.get(p.object_id as usize - 1);
-    let group = object.and_then(|o| scene.groups.get(o.group));
+    let object = shown.objects.get(p.object_id as usize - 1);
+    let group = object.and_then(|o| shown.groups.get(o.group));
     json!({
         "hit": true,
         "pixel": [x, y],
         "object": object.and_then(|o| o.name.clone()),
         "kind": object.map(|o| o.kind.clone()),
-        "group": group.map(|g| g.name.clone()),
+        "group": group,
         "object_id": p.object_id,
         "emission": {
-            "t": scene.camera.time - f64::from(p.lookback),
+            "t": shown.time - f64::from(p.lookback),
             "x": p.position,
         },
         "lookback": p.lookback,

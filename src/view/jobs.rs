@@ -121,7 +121,7 @@ impl Jobs {
         let exr = self.dir.join(format!("{}.exr", job.name()));
         let (j, source, busy) = (job.clone(), source.to_string(), self.busy.clone());
         std::thread::spawn(move || {
-            let result = (|| -> crate::Result<()> {
+            let render = || -> crate::Result<()> {
                 let mut scene = crate::scene::load_str(&source, &text, &[])?;
                 scene.film = None;
                 let (w, h) = scene.image.frame_size();
@@ -136,7 +136,15 @@ impl Jobs {
                 );
                 world.check()?;
                 crate::output::write(&frame, &exr)
-            })();
+            };
+            // A bug that panics fails the job rather than leaving it running for ever.
+            let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(render))
+                .unwrap_or_else(|_| {
+                    Err(crate::Error::flag(
+                        "view",
+                        "the render failed inside (a bug: please report it)",
+                    ))
+                });
             *j.state.lock().expect("not poisoned") = match result {
                 Ok(()) => State::Done,
                 Err(e) => State::Failed(e.to_string()),

@@ -38,13 +38,35 @@ const MAX_CLIENTS: usize = 16;
 /// The most requests handled at once; more are answered 503.
 const MAX_HANDLERS: usize = 256;
 
-/// One page's state: its newest view's number, the switch that stops the render of the one
-/// before, and its last frame (for clicks).
+/// One page's state: its newest request's number, the switch that stops that request's
+/// render, and its last frame (for clicks).
 struct Client {
-    generation: u64,
+    latest: u64,
     cancel: Arc<AtomicBool>,
-    shown: Option<Arc<(Scene, Frame)>>,
+    shown: Option<Arc<Shown>>,
     seen: Instant,
+}
+
+/// A frame as a click asks it: its pixels, and of its scene the view time and the objects'
+/// and groups' names (not the geometry).
+pub(crate) struct Shown {
+    pub seq: u64,
+    pub frame: Frame,
+    pub time: f64,
+    pub objects: Vec<crate::scene::ObjectInfo>,
+    pub groups: Vec<String>,
+}
+
+impl Shown {
+    fn new(seq: u64, scene: &Scene, frame: Frame) -> Shown {
+        Shown {
+            seq,
+            frame,
+            time: scene.camera.time,
+            objects: scene.objects.clone(),
+            groups: scene.groups.iter().map(|g| g.name.clone()).collect(),
+        }
+    }
 }
 
 /// What every request handler shares.
@@ -54,6 +76,8 @@ pub(crate) struct Viewer {
     source: String,
     text: String,
     editable: edits::Editable,
+    /// The file's camera, which a new view time moves along its worldline.
+    camera: crate::scene::Camera,
     info: serde_json::Value,
     levels: Vec<frames::Level>,
     backend: Box<dyn Backend>,
@@ -206,6 +230,7 @@ impl Viewer {
             source,
             text,
             editable,
+            camera: scene.camera.clone(),
             info,
             levels,
             backend,
@@ -243,7 +268,8 @@ impl Viewer {
 
     /// The scene file a view's values make: the user's file with their edits.
     fn view_text(&self, view: &serde_json::Value) -> Result<String, (u16, String)> {
-        let edits = edits::edits(view, &self.editable).map_err(|e| (400, e))?;
+        let mut edits = edits::edits(view, &self.editable).map_err(|e| (400, e))?;
+        edits::follow_worldline(&mut edits, &self.camera);
         edits::saved_text(&self.text, &self.source, &edits).map_err(|e| (400, e))
     }
 }
@@ -275,7 +301,8 @@ pub(crate) fn latency(quick: bool, backend: &str) -> crate::Result<String> {
                 frames::Stopped::Failed(e) => e,
                 frames::Stopped::Superseded => crate::Error::flag("bench", "stopped"),
             })?;
-        let png = frames::png(&frame, "colour").map_err(|e| crate::Error::flag("bench", e))?;
+        let png =
+            frames::png(&frame, "colour", false).map_err(|e| crate::Error::flag("bench", e))?;
         ms.push(t.elapsed().as_secs_f64() * 1e3);
         std::hint::black_box(png);
         (w, h) = (frame.width, frame.height);

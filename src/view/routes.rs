@@ -12,7 +12,7 @@
 use super::{frames, jobs, Client, Viewer, MAX_CLIENTS};
 use serde_json::{json, Value};
 use std::io::Read;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 use tiny_http::{Header, Method, Request, Response, ResponseBox};
@@ -69,7 +69,16 @@ pub(super) fn handle(v: &Viewer, mut rq: Request) {
     );
     let response = match allowed {
         Err(why) => text(403, why),
-        Ok(()) => route(v, &mut rq, path, query),
+        // A bug that panics answers 500; the server goes on (the panic is printed on stderr).
+        Ok(()) => std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            route(v, &mut rq, path, query)
+        }))
+        .unwrap_or_else(|_| {
+            text(
+                500,
+                "internal error: this request failed (a bug: please report it)",
+            )
+        }),
     };
     // A client that has gone is no error of ours.
     let _ = rq.respond(response);
@@ -166,45 +175,62 @@ fn frame(v: &Viewer, body: &Value) -> Answer {
             format!("`pass` must be one of {}", frames::PASSES.join(", ")),
         ));
     }
+    // The page numbers its requests; one without a number counts as the newest.
+    let seq = match body.get("seq") {
+        None => None,
+        Some(x) => Some(
+            x.as_u64()
+                .ok_or((400, "`seq` must be a whole number".to_string()))?,
+        ),
+    };
     let view = body.get("view").ok_or((400, "no `view`".to_string()))?;
-    let mut scene = v.scene_for(view, level)?;
-    let (l, last) = (v.levels[level], level + 1 == n);
-    // This view supersedes the client's last: its render stops at its next strip.
-    let (generation, cancel) = register(v, &client);
+    // The view's values checked before it supersedes anything (the scene is read later).
+    v.view_text(view)?;
+    // This request supersedes the client's earlier ones: their renders stop at their next
+    // strip; an earlier one arriving late is refused here.
+    let (seq, cancel) = register(v, &client, seq)?;
     let current = || {
         v.clients
             .lock()
             .expect("not poisoned")
             .get(&client)
-            .is_some_and(|c| c.generation == generation)
+            .is_some_and(|c| c.latest == seq)
     };
-    v.waiting.fetch_add(1, Ordering::AcqRel);
-    let turn = v.render_lock.lock().unwrap_or_else(|p| p.into_inner());
-    v.waiting.fetch_sub(1, Ordering::AcqRel);
+    let superseded = || (409, "superseded by a newer view".to_string());
+    let turn = {
+        let _waiting = Count::new(&v.waiting);
+        v.render_lock.lock().unwrap_or_else(|p| p.into_inner())
+    };
     if !current() {
-        return Err((409, "superseded by a newer view".into()));
+        return Err(superseded());
     }
-    v.rendering.fetch_add(1, Ordering::AcqRel);
+    // Read only now, one at a time: a drag's many requests never hold many scenes.
+    let mut scene = v.scene_for(view, level)?;
     let t0 = Instant::now();
-    let rendered = frames::render(&mut scene, v.backend.as_ref(), &cancel);
+    let rendered = {
+        let _rendering = Count::new(&v.rendering);
+        frames::render(&mut scene, v.backend.as_ref(), &cancel)
+    };
     let ms = t0.elapsed().as_secs_f64() * 1e3;
-    v.rendering.fetch_sub(1, Ordering::AcqRel);
     drop(turn);
     let frame = match rendered {
         Ok(f) => f,
-        Err(frames::Stopped::Superseded) => return Err((409, "superseded by a newer view".into())),
+        Err(frames::Stopped::Superseded) => return Err(superseded()),
         Err(frames::Stopped::Failed(e)) => return Err((500, e.to_string())),
     };
-    let png = frames::png(&frame, pass).map_err(|e| (500, e))?;
-    let (w, h) = (frame.width, frame.height);
+    let png = frames::png(&frame, pass, scene.image.is_transparent()).map_err(|e| (500, e))?;
+    let (w, h, l, last) = (frame.width, frame.height, v.levels[level], level + 1 == n);
     {
         let mut clients = v.clients.lock().expect("not poisoned");
         match clients.get_mut(&client) {
-            Some(c) if c.generation == generation => c.shown = Some(Arc::new((scene, frame))),
-            _ => return Err((409, "superseded by a newer view".into())),
+            Some(c) if c.latest == seq => {
+                c.shown = Some(Arc::new(super::Shown::new(seq, &scene, frame)));
+            }
+            _ => return Err(superseded()),
         }
     }
     Ok(reply(200, "image/png", png)
+        .with_header(header("X-Seq", &seq.to_string()))
         .with_header(header("X-Level", &level.to_string()))
         .with_header(header("X-Final", if last { "true" } else { "false" }))
         .with_header(header("X-Width", &w.to_string()))
@@ -213,9 +239,30 @@ fn frame(v: &Viewer, body: &Value) -> Answer {
         .with_header(header("X-Render-Ms", &format!("{ms:.1}"))))
 }
 
-/// Make `client`'s newest view this one: stop the render of its last, and forget the client
-/// seen longest ago when there are too many.
-fn register(v: &Viewer, client: &str) -> (u64, Arc<AtomicBool>) {
+/// A count of work in progress, held up while the guard lives (a panic lowers it too).
+pub(super) struct Count<'a>(&'a AtomicUsize);
+
+impl<'a> Count<'a> {
+    pub(super) fn new(c: &'a AtomicUsize) -> Count<'a> {
+        c.fetch_add(1, Ordering::AcqRel);
+        Count(c)
+    }
+}
+
+impl Drop for Count<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+/// Make request `seq` the client's newest (None: one past its newest): stop the render of the
+/// one before, and forget the client seen longest ago when there are too many. A request older
+/// than the client's newest is refused (409).
+fn register(
+    v: &Viewer,
+    client: &str,
+    seq: Option<u64>,
+) -> Result<(u64, Arc<AtomicBool>), (u16, String)> {
     let mut clients = v.clients.lock().expect("not poisoned");
     if !clients.contains_key(client) && clients.len() >= MAX_CLIENTS {
         let oldest = clients
@@ -229,16 +276,20 @@ fn register(v: &Viewer, client: &str) -> (u64, Arc<AtomicBool>) {
         }
     }
     let c = clients.entry(client.to_string()).or_insert_with(|| Client {
-        generation: 0,
+        latest: 0,
         cancel: Arc::new(AtomicBool::new(false)),
         shown: None,
         seen: Instant::now(),
     });
+    let seq = seq.unwrap_or(c.latest.saturating_add(1));
+    if seq <= c.latest {
+        return Err((409, "superseded by a newer view".into()));
+    }
     c.cancel.store(true, Ordering::Relaxed);
-    c.generation += 1;
+    c.latest = seq;
     c.cancel = Arc::new(AtomicBool::new(false));
     c.seen = Instant::now();
-    (c.generation, c.cancel.clone())
+    Ok((seq, c.cancel.clone()))
 }
 
 fn query_u32(query: &str, key: &str) -> Result<u32, (u16, String)> {
@@ -261,14 +312,20 @@ fn probe(v: &Viewer, query: &str) -> Answer {
         .get(&client)
         .and_then(|c| c.shown.clone())
         .ok_or((404, "no frame shown to this client yet".to_string()))?;
-    let (scene, frame) = &*shown;
+    // The frame the page shows, if it says which: a newer one may have been rendered since.
+    if let Some(seq) = super::access::query_value(query, "seq") {
+        if seq.parse::<u64>().ok() != Some(shown.seq) {
+            return Err((409, "that frame has been replaced: click again".into()));
+        }
+    }
+    let frame = &shown.frame;
     if x >= frame.width || y >= frame.height {
         return Err((
             400,
             format!("the frame is {}x{}", frame.width, frame.height),
         ));
     }
-    Ok(json_reply(200, &frames::probe(frame, scene, x, y)))
+    Ok(json_reply(200, &frames::probe(&shown, x, y)))
 }
 
 /// The view's scene, checked by loading it, as a file to download.
@@ -335,6 +392,8 @@ fn file(v: &Viewer, name: &str) -> Answer {
     };
     Ok(Response::from_file(f)
         .with_header(header("Content-Type", mime))
+        .with_header(header("Cache-Control", "no-store"))
+        .with_header(header("X-Content-Type-Options", "nosniff"))
         .with_header(header(
             "Content-Disposition",
             &format!("attachment; filename=\"{name}\""),

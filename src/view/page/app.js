@@ -12,6 +12,8 @@ const viewer = { client, info: null, state: null, version: 0, shown: null, lastP
 window.viewer = viewer;
 let inflight = null;
 let scheduled = false;
+// Every frame request is numbered: the server refuses one older than the newest it has seen.
+let seq = 0;
 
 const add = (a, b) => a.map((x, i) => x + b[i]);
 const sub = (a, b) => a.map((x, i) => x - b[i]);
@@ -67,35 +69,42 @@ function changed() {
   requestAnimationFrame(() => { scheduled = false; request(0); });
 }
 
-async function request(level) {
+async function request(level, retries = 3) {
   if (inflight) inflight.abort();
   const ctrl = new AbortController();
   inflight = ctrl;
   const version = viewer.version;
-  let r;
+  seq += 1;
+  let r, blob;
   try {
     r = await fetch(api('api/frame'), {
       method: 'POST',
       headers: { 'Content-Type': 'application/json' },
-      body: JSON.stringify({ client, level, pass: viewer.state.pass, view: view() }),
+      body: JSON.stringify({ client, seq, level, pass: viewer.state.pass, view: view() }),
       signal: ctrl.signal,
     });
+    if (version !== viewer.version || inflight !== ctrl) return;
+    if (r.status === 409) {
+      // Superseded without a newer request from this page (the server forgot it, say):
+      // ask again, a few times.
+      if (retries > 0) setTimeout(() => { if (inflight === ctrl) request(level, retries - 1); }, 100);
+      return;
+    }
+    if (!r.ok) {
+      setError(await r.text());
+      inflight = null;
+      return;
+    }
+    blob = await r.blob();
   } catch (e) {
     if (e.name !== 'AbortError') setError(String(e));
     return;
   }
-  if (r.status === 409 || version !== viewer.version) return;
-  if (!r.ok) {
-    setError(await r.text());
-    inflight = null;
-    return;
-  }
-  const blob = await r.blob();
-  if (version !== viewer.version) return;
+  if (version !== viewer.version || inflight !== ctrl) return;
   inflight = null;
   setError('');
   const h = (k) => r.headers.get(k);
-  const shown = { level, final: h('X-Final') === 'true', width: +h('X-Width'), height: +h('X-Height'), samples: +h('X-Samples'), ms: +h('X-Render-Ms') };
+  const shown = { seq: +h('X-Seq'), level, final: h('X-Final') === 'true', width: +h('X-Width'), height: +h('X-Height'), samples: +h('X-Samples'), ms: +h('X-Render-Ms') };
   const img = $('frame');
   const old = img.src;
   img.src = URL.createObjectURL(blob);
@@ -244,7 +253,7 @@ async function probe(e) {
   m.hidden = false;
   m.style.left = `${e.clientX - rect.left}px`;
   m.style.top = `${e.clientY - rect.top}px`;
-  const r = await fetch(api('api/probe', `&client=${client}&x=${x}&y=${y}`));
+  const r = await fetch(api('api/probe', `&client=${client}&seq=${s.seq}&x=${x}&y=${y}`));
   if (!r.ok) { setError(await r.text()); return; }
   const p = await r.json();
   viewer.lastProbe = p;
