@@ -8,8 +8,9 @@ use glam::{DMat3, DVec3};
 /// The rotation R with Λ(β2) Λ(β1) = R Λ(β1 ⊕ β2), β2 measured in the frame moving at β1 (as
 /// passive maps; `Boost::to_rest(v2)` after `Boost::to_rest(v1)` is
 /// `Boost::to_rest(v1 ⊕ v2).turned(R)`). With t_i = tanh(θ_i/2) of the rapidities and φ the
-/// angle between the directions, tan(ω/2) = t1 t2 sin φ / (1 + t1 t2 cos φ): a ratio of sums
-/// with no cancellation, exact for small and for ultra-relativistic speeds alike.
+/// angle between the directions, tan(ω/2) = t1 t2 sin φ / (1 + t1 t2 cos φ): no cancellation
+/// but in the denominator when both speeds near c and the directions near opposite (there
+/// 1 − t1 t2 loses digits), exact for small and for most ultra-relativistic speeds.
 pub fn wigner_rotation(v1: &Velocity, v2: &Velocity) -> DMat3 {
     if v1.is_zero() || v2.is_zero() {
         return DMat3::IDENTITY;
