@@ -8,6 +8,7 @@ mod farm;
 mod film;
 mod hints;
 mod tiles;
+mod view_cmd;
 
 use crate::render::Passes;
 use crate::{accel, bench, memory, output, render, scene, Error};
@@ -32,7 +33,7 @@ pub(crate) enum Command {
     Render(RenderArgs),
     /// Explore a scene in the browser: velocities, camera and passes on controls, refined while
     /// nothing changes; save the view as a scene file or render it to an EXR.
-    View(ViewArgs),
+    View(view_cmd::ViewArgs),
     /// Measure each backend's speed and error on the same scenes (default: the paper's lattice).
     Bench(BenchArgs),
     /// List the intersection backends of this build, and the instruction set Embree runs here.
@@ -101,35 +102,6 @@ pub(crate) enum Command {
         #[arg(default_value_t = 1)]
         threads: usize,
     },
-}
-
-#[derive(clap::Args, Debug)]
-pub(crate) struct ViewArgs {
-    /// The scene file (TOML).
-    pub scene: PathBuf,
-    /// The port to listen on (default: a free one).
-    #[arg(long, default_value_t = 0)]
-    pub port: u16,
-    /// The address to listen on: 127.0.0.1 (the default) serves this machine alone; another
-    /// (e.g. 0.0.0.0 on a cluster node) serves others, still only with the token.
-    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1")]
-    pub bind: std::net::IpAddr,
-    /// A host name the browser may reach the server by besides IP addresses, localhost and this
-    /// machine's name (repeatable); requests naming any other Host are refused.
-    #[arg(long = "allow-host", value_name = "NAME")]
-    pub allow_hosts: Vec<String>,
-    /// Print the URL without opening a browser.
-    #[arg(long)]
-    pub no_browser: bool,
-    /// Where "render this view" writes its scene file and EXR.
-    #[arg(long, value_name = "DIR", default_value = ".")]
-    pub out: PathBuf,
-    /// Intersection backend (see `rest-embree backends`).
-    #[arg(long)]
-    pub backend: Option<String>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
 }
 
 #[derive(clap::Args, Debug)]
@@ -348,7 +320,7 @@ fn run(cli: Cli) -> ExitCode {
             }
         })),
         Command::Render(args) => report(run_render(&args)),
-        Command::View(args) => report(run_view(&args)),
+        Command::View(args) => report(view_cmd::run_view(&args)),
         Command::Bench(args) => report(bench_cmd::run_bench(&args)),
         Command::Assemble {
             output,
@@ -699,23 +671,6 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         );
     }
     Ok(())
-}
-
-fn run_view(args: &ViewArgs) -> crate::Result<()> {
-    set_threads(args.threads)?;
-    let backend = args
-        .backend
-        .clone()
-        .unwrap_or_else(|| accel::default_backend_name().to_string());
-    crate::view::run(&crate::view::Config {
-        scene: args.scene.clone(),
-        bind: args.bind,
-        port: args.port,
-        backend,
-        out: args.out.clone(),
-        allow_hosts: args.allow_hosts.clone(),
-        open_browser: !args.no_browser,
-    })
 }
 
 fn run_assemble(output: &Path, tiles: &[PathBuf]) -> crate::Result<()> {
