@@ -22,15 +22,18 @@ mod rest_groups;
 pub use rest_groups::RestGroups;
 mod primary_hits;
 mod shadows;
-use crate::accel::{Accelerator, Backend, Faults, Hit, Ray};
-use crate::geometry::{Aabb, Geometry, PACKET};
+mod world_group;
+use crate::accel::{Backend, Faults, Hit, Ray};
+use crate::geometry::{Aabb, PACKET};
 use crate::scene::Scene;
-use crate::spacetime::{Boost, Event, NullRay, Velocity, Window};
+use crate::spacetime::{NullRay, Velocity};
 use glam::DVec3;
 use moving_bounds::MovingBounds;
 pub use primary_hits::PrimaryHits;
 pub(crate) use shadows::ShadowBuffers;
 use std::sync::{Arc, OnceLock};
+pub(crate) use world_group::surface_normal;
+pub use world_group::WorldGroup;
 
 /// From this many groups on, rays find their groups through the group tree.
 pub(crate) const GROUP_TREE_MIN: usize = 8;
@@ -84,141 +87,6 @@ impl Default for WorldOptions {
             fused_primary: true,
             instance_over: INSTANCE_OVER,
         }
-    }
-}
-
-pub struct WorldGroup {
-    /// The imaging event's position in this group's rest frame.
-    pub event_rest: DVec3,
-    pub velocity: Velocity,
-    /// Into the group's rest frame (its inverse leads out).
-    pub boost: Boost,
-    pub bounds: Aabb,
-    /// The bounds in the axes of the plain boost to its velocity (`bounds` unless its axes are
-    /// turned, `scene::Group::turn`): for the tests before the boost.
-    pub plain_bounds: Aabb,
-    pub geometry: Arc<Geometry>,
-    /// None for groups intersected directly; shared by every frame of a film.
-    pub accel: Option<Arc<dyn Accelerator>>,
-    /// Offset for spawning secondary rays off surfaces, in rest-frame length.
-    pub epsilon: f64,
-    /// The bounds as they move through the world frame: a test before the boost.
-    moving: MovingBounds,
-    /// The emission events it is seen at (a worldline's segment); None: all.
-    pub window: Option<Window>,
-    /// Whether anything in it spins.
-    pub spins: bool,
-    /// Its hyperbolic motion, for a segment of constant proper acceleration (its rays start
-    /// on the segment's start hyperplane, `World::rest_ray`).
-    pub accelerated: Option<crate::scene::Accelerated>,
-    /// Its spinning bodies whose shape turns (not of revolution), if any: the group is then
-    /// intersected directly, its rays starting on its hyperplane of time `turn_time`.
-    pub turning: Option<Arc<[TurningPart]>>,
-    /// The group's time of the imaging event, where a turning group's rays are made to start
-    /// (near the events they meet, so that their lookbacks stay small).
-    pub turn_time: f64,
-}
-
-impl WorldGroup {
-    /// The group's time at which its rays are made to start (`World::rest_ray`), where its
-    /// intersection needs the time along them: an accelerated segment's start, or 0 for
-    /// turning bodies.
-    fn time_origin(&self) -> Option<f64> {
-        match (&self.accelerated, &self.turning) {
-            (Some(acc), _) => Some(acc.start.t),
-            (None, Some(_)) => Some(self.turn_time),
-            (None, None) => None,
-        }
-    }
-
-    /// Whether the group is seen at emission event `e` (always, but for a worldline's
-    /// segment); `World::rest_ray` keeps rays to the same events.
-    pub fn shows_at(&self, e: Event) -> bool {
-        self.window.is_none_or(|w| w.contains(e))
-    }
-
-    /// The closest hit of each ray in this group (None for inactive rays): through the
-    /// accelerator, or the primitives one by one for a group without one.
-    fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        if let Some(parts) = &self.turning {
-            for (r, h) in rays.iter().zip(hits.iter_mut()) {
-                *h = turning::intersect(&self.geometry, parts, r, self.turn_time);
-            }
-            return;
-        }
-        if let Some(acc) = &self.accelerated {
-            for (r, h) in rays.iter().zip(hits.iter_mut()) {
-                *h = accelerated::intersect(acc, &self.geometry, r);
-            }
-            return;
-        }
-        if let Some(accel) = &self.accel {
-            return accel.intersect(rays, hits);
-        }
-        for (r, h) in rays.iter().zip(hits.iter_mut()) {
-            *h = None;
-            if !r.is_active() {
-                continue;
-            }
-            for i in 0..self.geometry.len() {
-                let tmax = h.map_or(r.tmax, |b| b.t);
-                let p = self.geometry.prim(i);
-                if let Some(t) = p.intersect(r.origin, r.dir, r.tmin, tmax) {
-                    *h = Some(Hit { t, prim: i });
-                }
-            }
-        }
-    }
-
-    /// Whether anything of this group lies on each ray (false for inactive rays).
-    fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
-        if let Some(parts) = &self.turning {
-            for (r, o) in rays.iter().zip(out.iter_mut()) {
-                *o = turning::intersect(&self.geometry, parts, r, self.turn_time).is_some();
-            }
-            return;
-        }
-        if let Some(acc) = &self.accelerated {
-            for (r, o) in rays.iter().zip(out.iter_mut()) {
-                *o = accelerated::occluded(acc, &self.geometry, r);
-            }
-            return;
-        }
-        if let Some(accel) = &self.accel {
-            return accel.occluded(rays, out);
-        }
-        for (r, o) in rays.iter().zip(out.iter_mut()) {
-            *o = r.is_active()
-                && (0..self.geometry.len()).any(|i| {
-                    let p = self.geometry.prim(i);
-                    p.intersect(r.origin, r.dir, r.tmin, r.tmax).is_some()
-                });
-        }
-    }
-
-    fn intersect1(&self, r: &Ray) -> Option<Hit> {
-        let mut h = [None];
-        self.intersect(std::slice::from_ref(r), &mut h);
-        h[0]
-    }
-
-    fn occluded1(&self, r: &Ray) -> bool {
-        let mut o = [false];
-        self.occluded(std::slice::from_ref(r), &mut o);
-        o[0]
-    }
-}
-
-/// The outward normal (rest frame) at a hit seen at world event `event`: a turning body's is
-/// its shape's at time 0 at the point turned back, turned as the body is.
-pub(crate) fn surface_normal(g: &WorldGroup, hit: &SurfaceHit, event: Event) -> DVec3 {
-    let prim = g.geometry.prim(hit.prim);
-    match &g.geometry.part_of(hit.prim).spin {
-        Some(sp) if sp.turning => {
-            let t = g.boost.event(event).t;
-            sp.turned_dir(prim.normal(sp.unturned(hit.point, t)), t)
-        }
-        _ => prim.normal(hit.point),
     }
 }
 
