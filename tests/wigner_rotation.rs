@@ -6,6 +6,7 @@
 mod common;
 use common::*;
 use glam::DVec3;
+use rest_embree::spacetime::cosh_m1;
 
 const W: u32 = 600;
 const H: u32 = 41;
@@ -306,9 +307,4 @@ fn a_second_acceleration_starts_from_the_turned_body() {
         pieces[2] > 20 && pieces[3] > 20,
         "the second segment and the coast are both seen: {pieces:?}"
     );
-}
-
-/// cosh θ − 1 without cancellation.
-fn cosh_m1(theta: f64) -> f64 {
-    2.0 * (0.5 * theta).sinh().powi(2)
 }

@@ -99,28 +99,28 @@ pub(crate) fn srgb_bytes(pixels: &[crate::render::PixelValue], alpha: bool) -> V
 
 /// An 8-bit RGB image as PNG bytes in memory (fast compression: for a screen, not a file).
 pub(crate) fn rgb_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, Cause> {
-    let mut out = Vec::new();
-    let mut enc = png::Encoder::new(&mut out, width, height);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    enc.set_compression(png::Compression::Fast);
-    enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    let mut w = enc.write_header().map_err(cause)?;
-    w.write_image_data(rgb).map_err(cause)?;
-    w.finish().map_err(cause)?;
-    Ok(out)
+    png_bytes(width, height, png::ColorType::Rgb, rgb)
 }
 
 /// An 8-bit RGBA image (straight alpha) as PNG bytes in memory.
 pub(crate) fn rgba_png(width: u32, height: u32, rgba: &[u8]) -> Result<Vec<u8>, Cause> {
+    png_bytes(width, height, png::ColorType::Rgba, rgba)
+}
+
+fn png_bytes(
+    width: u32,
+    height: u32,
+    colour: png::ColorType,
+    data: &[u8],
+) -> Result<Vec<u8>, Cause> {
     let mut out = Vec::new();
     let mut enc = png::Encoder::new(&mut out, width, height);
-    enc.set_color(png::ColorType::Rgba);
+    enc.set_color(colour);
     enc.set_depth(png::BitDepth::Eight);
     enc.set_compression(png::Compression::Fast);
     enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
     let mut w = enc.write_header().map_err(cause)?;
-    w.write_image_data(rgba).map_err(cause)?;
+    w.write_image_data(data).map_err(cause)?;
     w.finish().map_err(cause)?;
     Ok(out)
 }
