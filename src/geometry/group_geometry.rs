@@ -357,8 +357,19 @@ impl Geometry {
     /// At rest-frame point `p` of held triangle `prim`: its interpolated vertex normal and
     /// texture coordinates, where its mesh has them (None for other primitives).
     pub fn corners_at(&self, prim: u32, p: DVec3) -> (Option<DVec3>, Option<[f64; 2]>) {
-        let part = self.part_of(prim);
-        let (Some(c), Primitive::Triangle { v }) = (&part.corners, self.prim(prim)) else {
+        Self::corners_of(self.part_of(prim), &self.prim(prim), prim, p)
+    }
+
+    /// [`Geometry::corners_at`] of primitive number `prim` of `part`, `shape` (made by the
+    /// caller, who has it already).
+    #[inline]
+    pub fn corners_of(
+        part: &Part,
+        shape: &Primitive,
+        prim: u32,
+        p: DVec3,
+    ) -> (Option<DVec3>, Option<[f64; 2]>) {
+        let (Some(c), Primitive::Triangle { v }) = (&part.corners, *shape) else {
             return (None, None);
         };
         let i = (prim - part.start) as usize;

@@ -242,6 +242,9 @@ impl<'a, B: Band> Shader<'a, B> {
     /// secondary ray of the hit starts.
     pub(super) fn pushed_off(&self, group: usize, hit_event: Event, side: DVec3) -> Event {
         let g = &self.world.groups[group];
+        if g.boost.is_identity() {
+            return hit_event + Event::new(0.0, g.epsilon * side);
+        }
         hit_event + g.boost.inverse().event(Event::new(0.0, g.epsilon * side))
     }
 
@@ -385,11 +388,12 @@ impl<'a, B: Band> Shader<'a, B> {
         let part = g.geometry.part_of(hit.prim);
         let mat = &self.scene.materials[part.material as usize];
         let v = hit.dir / hit.s;
-        let n = crate::render::world::surface_normal(g, hit, event);
+        let n = crate::render::world::surface_normal_of(g, &prim, part, hit, event);
         let inside = n.dot(v) > 0.0;
         let faced = if inside { -n } else { n };
         // A mesh's vertex normals shade it smoothly, turned to the side the ray sees.
-        let (smooth, corner_uv) = g.geometry.corners_at(hit.prim, hit.point);
+        let (smooth, corner_uv) =
+            crate::geometry::Geometry::corners_of(part, &prim, hit.prim, hit.point);
         let nf = smooth.map_or(faced, |s| if s.dot(faced) < 0.0 { -s } else { s });
         // Textures are laid out in the object's own coordinates, on its shape before any
         // transform placed it.

@@ -32,8 +32,8 @@ use moving_bounds::MovingBounds;
 pub use primary_hits::PrimaryHits;
 pub(crate) use shadows::ShadowBuffers;
 use std::sync::{Arc, OnceLock};
-pub(crate) use world_group::surface_normal;
 pub use world_group::WorldGroup;
+pub(crate) use world_group::{surface_normal, surface_normal_of};
 
 /// From this many groups on, rays find their groups through the group tree.
 pub(crate) const GROUP_TREE_MIN: usize = 8;

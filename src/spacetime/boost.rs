@@ -94,7 +94,12 @@ impl Boost {
     }
 
     /// Transform an event (or any 4-vector).
+    #[inline]
     pub fn event(&self, e: Event) -> Event {
+        // The frame at rest: the same event (the common case of a scene at rest).
+        if self.is_identity() {
+            return e;
+        }
         let e = match self.before {
             Some(r) => Event::new(e.t, r * e.x),
             None => e,
@@ -214,6 +219,7 @@ impl Boost {
 
     /// Whether this boost is the identity (a frame at rest relative to the one it starts from,
     /// its axes not turned).
+    #[inline]
     pub fn is_identity(&self) -> bool {
         self.identity && !self.turns()
     }

@@ -22,6 +22,8 @@ pub struct Emitters {
     cdf: Vec<f64>,
     /// Per world group, its listed runs: (first primitive, end, index of the first in `items`).
     runs: Vec<Vec<(u32, u32, u32)>>,
+    /// Per world group, the material of each of its listed runs (as `runs`).
+    materials: Vec<Vec<u32>>,
 }
 
 /// A point drawn on an emitter, in its rest frame.
@@ -34,6 +36,7 @@ impl Emitters {
     pub fn new(scene: &Scene, world: &World) -> Emitters {
         let mut e = Emitters {
             runs: vec![Vec::new(); world.groups.len()],
+            materials: vec![Vec::new(); world.groups.len()],
             ..Default::default()
         };
         let mut weights = Vec::new();
@@ -54,6 +57,7 @@ impl Emitters {
                 // A texture's brightness varies: its first colour stands for it.
                 let bright = if bright > 0.0 { bright } else { 1.0 };
                 e.runs[gi].push((part.start, part.end, e.items.len() as u32));
+                e.materials[gi].push(part.material);
                 for p in part.start..part.end {
                     e.items.push((gi as u32, p));
                     weights.push(area(&g.geometry.prim(p)) * bright);
@@ -90,6 +94,14 @@ impl Emitters {
 
     fn prob(&self, i: usize) -> f64 {
         self.cdf[i] - if i == 0 { 0.0 } else { self.cdf[i - 1] }
+    }
+
+    /// The material of listed emitter `prim` of group `group` (as [`Emitters::pick`] gives
+    /// them).
+    pub fn material_of(&self, group: usize, prim: u32) -> u32 {
+        let runs = &self.runs[group];
+        let i = runs.partition_point(|r| r.1 <= prim);
+        self.materials[group][i]
     }
 
     /// The probability that [`Emitters::pick`] chooses primitive `prim` of group `group` (0

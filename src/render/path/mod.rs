@@ -178,8 +178,14 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
                     receiver_s,
                 };
             };
-            let part = world.groups[h.group].geometry.part_of(h.prim);
-            if !sh.scene.materials[part.material as usize].is_invisible() {
+            // Only the boundaries of media are invisible: without any, every hit is a surface.
+            let part = match sh.has_invisible() {
+                true => Some(world.groups[h.group].geometry.part_of(h.prim)),
+                false => None,
+            };
+            let Some(part) =
+                part.filter(|p| sh.scene.materials[p.material as usize].is_invisible())
+            else {
                 let (shift_h, k) = sh.arriving(receiver_s, h.s, path.shift);
                 path.beta = path.beta * k;
                 path.shift = shift_h;
@@ -188,7 +194,7 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
                     event: ray.at(h.lambda),
                     within,
                 };
-            }
+            };
             let g = &world.groups[h.group];
             let exiting = g.geometry.prim(h.prim).normal(h.point).dot(h.dir) > 0.0;
             within = if exiting {

@@ -188,20 +188,27 @@ impl<B: Band> PathTracer<'_, '_, B> {
         let pdf_e = emitters::pdf_point(&prim_e, x, pt.point);
         let p_light = p_pick * pdf_e * d * d;
         let (shift_e, k) = sh.seen.radiance(d, here.shift);
-        let on = SurfaceHit {
-            group: eg,
-            prim,
-            lambda: 0.0,
-            point: pt.point,
-            dir: look_e,
-            s: 1.0,
-        };
-        let elit = sh.lit_at(&on, here.event, shift_e);
-        let Some(e) = &elit.mat.emission else {
+        let at = B::at(shift_e);
+        let mat = &sh.scene.materials[self.emitters.material_of(eg, prim) as usize];
+        let Some(e) = &mat.emission else {
             return;
         };
-        let at = B::at(shift_e);
-        let mut c = surface_colour::<B>(e, elit.mat.emission_texture.as_deref(), &elit, at);
+        // A texture is read where the point lies on the object; a colour is the same all over.
+        let mut c = match mat.emission_texture.as_deref() {
+            None => B::of(e, at),
+            Some(texture) => {
+                let on = SurfaceHit {
+                    group: eg,
+                    prim,
+                    lambda: 0.0,
+                    point: pt.point,
+                    dir: look_e,
+                    s: 1.0,
+                };
+                let elit = sh.lit_at(&on, here.event, shift_e);
+                surface_colour::<B>(e, Some(texture), &elit, at)
+            }
+        };
         c.mul_by(&f);
         c.mul_by(beta);
         if let Some(t) = &through {

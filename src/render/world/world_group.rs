@@ -5,7 +5,7 @@
 use super::moving_bounds::MovingBounds;
 use super::{accelerated, turning, SurfaceHit, TurningPart};
 use crate::accel::{Accelerator, Hit, Ray};
-use crate::geometry::{Aabb, Geometry};
+use crate::geometry::{Aabb, Geometry, Part, Primitive};
 use crate::spacetime::{Boost, Event, Velocity, Window};
 use glam::DVec3;
 use std::sync::Arc;
@@ -137,7 +137,19 @@ impl WorldGroup {
 /// its shape's at time 0 at the point turned back, turned as the body is.
 pub(crate) fn surface_normal(g: &WorldGroup, hit: &SurfaceHit, event: Event) -> DVec3 {
     let prim = g.geometry.prim(hit.prim);
-    match &g.geometry.part_of(hit.prim).spin {
+    surface_normal_of(g, &prim, g.geometry.part_of(hit.prim), hit, event)
+}
+
+/// [`surface_normal`] of the hit's primitive `prim`, of part `part`, made by the caller.
+#[inline]
+pub(crate) fn surface_normal_of(
+    g: &WorldGroup,
+    prim: &Primitive,
+    part: &Part,
+    hit: &SurfaceHit,
+    event: Event,
+) -> DVec3 {
+    match &part.spin {
         Some(sp) if sp.turning => {
             let t = g.boost.event(event).t;
             sp.turned_dir(prim.normal(sp.unturned(hit.point, t)), t)
