@@ -6,7 +6,7 @@ mod gathered;
 
 use super::band::{Band, Seen};
 use super::camera::CameraRays;
-use super::path::{sample_rng, Emitters, PathTracer};
+use super::path::{sample_rng, Emitters, PathTracer, Start, WaveScratch};
 use super::sampler::{sample_offset, shutter_offset};
 use super::screen_cull::ScreenCull;
 use super::shade::{Lit, Shader, ShadowQuery, Spread};
@@ -180,6 +180,21 @@ pub struct TileScratch {
     points: ImagePoints,
     primary: PrimaryHits,
     round: RoundBuffers,
+    /// The path integrator's paths (a `WaveScratch` of the band it renders in).
+    wave: Option<Box<dyn std::any::Any + Send>>,
+}
+
+/// The path integrator's scratch in `slot`, of band `B` (made on first use, and anew if the
+/// worker renders in another band).
+fn wave_of<B: Band + Send + 'static>(
+    slot: &mut Option<Box<dyn std::any::Any + Send>>,
+) -> &mut WaveScratch<B> {
+    if !slot.as_ref().is_some_and(|w| w.is::<WaveScratch<B>>()) {
+        *slot = Some(Box::new(WaveScratch::<B>::default()));
+    }
+    slot.as_mut()
+        .and_then(|w| w.downcast_mut())
+        .expect("made above")
 }
 
 impl TileScratch {
@@ -202,6 +217,31 @@ impl TileScratch {
             &mut self.points,
             &mut self.primary,
             &mut self.round,
+        )
+    }
+
+    /// [`TileScratch::tile`], and the path integrator's scratch in band `B`.
+    #[allow(clippy::type_complexity)]
+    fn tile_with_wave<B: Band + Send + 'static>(
+        &mut self,
+        scene: &Scene,
+        cam: &CameraRays,
+        cull: Option<&ScreenCull>,
+        (x0, y0): (u32, u32),
+    ) -> (
+        &TilePixels,
+        &mut ImagePoints,
+        &mut PrimaryHits,
+        &mut RoundBuffers,
+        &mut WaveScratch<B>,
+    ) {
+        self.pixels.fill(scene, cam, cull, x0, y0);
+        (
+            &self.pixels,
+            &mut self.points,
+            &mut self.primary,
+            &mut self.round,
+            wave_of(&mut self.wave),
         )
     }
 }
@@ -396,8 +436,8 @@ fn missed<B: Band>(
 }
 
 /// The colours (linear sRGB) of primary hits by the path integrator, into `colors`: one path
-/// per hit, its random numbers those of sample `sample` of its pixel; as [`shade_hits`] where
-/// a ray meets nothing.
+/// per hit, its random numbers those of sample `sample` of its pixel, the paths of the round
+/// traced together (`PathTracer::trace_paths`); as [`shade_hits`] where a ray meets nothing.
 #[allow(clippy::too_many_arguments)]
 fn shade_paths<B: Band>(
     tracer: &PathTracer<B>,
@@ -407,38 +447,48 @@ fn shade_paths<B: Band>(
     (coords, (ox, oy)): (&[(u32, u32)], (u32, u32)),
     stars: Option<&StarPixels>,
     sample: u32,
-    colors: &mut Vec<DVec3>,
+    (colors, wave): (&mut Vec<DVec3>, &mut WaveScratch<B>),
 ) {
     let follows = shader.follows_frames();
     let black_sky = shader.primary_misses_add_nothing();
     let seed = shader.scene.render.seed;
     let spreads = shader.finds_star_cones();
+    let camera_s = |ray: &NullRay| match follows {
+        true => cam.lookback_factor_of(ray),
+        false => 1.0,
+    };
+    let starts = (0..primary.len()).filter_map(|i| {
+        let h = primary.hit(i)?;
+        let ray = primary.ray(i);
+        let (x, y) = (coords[i].0 + ox, coords[i].1 + oy);
+        // The pixel's bundle, for stars seen after mirrors and glass.
+        let spread = match spreads {
+            true => Spread {
+                sr: cam.pixel_solid_angle(x, y),
+                s: cam.lookback_factor_of(&ray),
+            },
+            false => Spread::NONE,
+        };
+        Some(Start {
+            ray,
+            hit: h,
+            camera_s: camera_s(&ray),
+            spread,
+            rng: sample_rng(seed, x, y, sample),
+        })
+    });
+    tracer.trace_paths(starts, wave);
+    let mut light = wave.light().iter();
     colors.clear();
     colors.extend((0..primary.len()).map(|i| {
         let ray = primary.ray(i);
-        let camera_s = if follows {
-            cam.lookback_factor_of(&ray)
-        } else {
-            1.0
-        };
-        let (x, y) = (coords[i].0 + ox, coords[i].1 + oy);
-        match primary.hit(i) {
-            Some(h) => {
-                let mut rng = sample_rng(seed, x, y, sample);
-                // The pixel's bundle, for stars seen after mirrors and glass.
-                let spread = match spreads {
-                    true => Spread {
-                        sr: cam.pixel_solid_angle(x, y),
-                        s: cam.lookback_factor_of(&ray),
-                    },
-                    false => Spread::NONE,
-                };
-                tracer
-                    .camera_path(&ray, &h, camera_s, spread, &mut rng)
-                    .to_rgb()
+        match primary.is_hit(i) {
+            true => light.next().expect("a path per hit").to_rgb(),
+            false if black_sky => DVec3::ZERO,
+            false => {
+                let (x, y) = (coords[i].0 + ox, coords[i].1 + oy);
+                missed(shader, camera_s(&ray), ray.dir, stars, (x, y))
             }
-            None if black_sky => DVec3::ZERO,
-            None => missed(shader, camera_s, ray.dir, stars, (x, y)),
         }
     }));
 }
@@ -466,7 +516,7 @@ pub struct TileResult {
 /// Render one tile, carrying light as `B` (RGB, or radiance at the camera's wavelengths) with
 /// changes of frame doing what `seen` says.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn render_tile<B: Band>(
+pub(crate) fn render_tile<B: Band + Send + 'static>(
     seen: Seen,
     scene: &Scene,
     world: &World,
@@ -476,7 +526,7 @@ pub(crate) fn render_tile<B: Band>(
     scratch: &mut TileScratch,
 ) -> TileResult {
     let (cam, cull) = (view.cam, view.cull);
-    let (t, px, primary, round) = scratch.tile(scene, cam, cull, (x0, y0));
+    let (t, px, primary, round, wave) = scratch.tile_with_wave::<B>(scene, cam, cull, (x0, y0));
     let (offset, live, live_coords) = (t.offset, &t.live, &t.live_coords);
     let (w, h) = scene.image.frame_size();
     let coords = tile_pixels(x0, y0, w, h);
@@ -523,7 +573,7 @@ pub(crate) fn render_tile<B: Band>(
         } else if let Some(t) = &tracer {
             let at = (live_coords.as_slice(), offset);
             let index = view.sample_base + s;
-            let colors = &mut round.colors;
+            let colors = (&mut round.colors, &mut *wave);
             shade_paths(t, &shader, cam, primary, at, view.stars, index, colors);
         } else {
             let at = (live_coords.as_slice(), offset);

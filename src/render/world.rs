@@ -75,6 +75,18 @@ pub struct WorldOptions {
     /// Lattices of more primitives than this (in one rest frame) are built from one block
     /// placed many times (instanced), not listed primitive by primitive.
     pub instance_over: u64,
+    /// The path integrator shades its commonest vertices (Lambert surfaces at rest in the
+    /// world frame) a bounce of a tile's paths at a time, in lanes.
+    pub lanes: bool,
+    /// Those lanes run in vector registers where the CPU has AVX2 or AVX-512 (else one by
+    /// one); `REST_EMBREE_SIMD=off` in the environment turns it off by default.
+    pub simd: bool,
+}
+
+/// Whether the environment leaves SIMD on (`REST_EMBREE_SIMD=off` turns it off).
+fn simd_by_default() -> bool {
+    static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ON.get_or_init(|| std::env::var("REST_EMBREE_SIMD").map_or(true, |v| v != "off"))
 }
 
 impl Default for WorldOptions {
@@ -86,6 +98,8 @@ impl Default for WorldOptions {
             direct_max: DIRECT_MAX,
             fused_primary: true,
             instance_over: INSTANCE_OVER,
+            lanes: true,
+            simd: simd_by_default(),
         }
     }
 }
@@ -421,6 +435,23 @@ impl World {
                 return;
             }
         }
+        self.closest_hits_as(rays, tmin, out, false);
+    }
+
+    /// [`World::closest_hits`] of rays from anywhere (a bounce of many paths), in lookback
+    /// (0, ∞): in packets where the backend's measure says they pay for rays that share
+    /// neither origin nor direction, else one by one.
+    pub fn closest_hits_scattered(&self, rays: &[NullRay], out: &mut [Option<SurfaceHit>]) {
+        self.closest_hits_as(rays, 0.0, out, true);
+    }
+
+    fn closest_hits_as(
+        &self,
+        rays: &[NullRay],
+        tmin: f64,
+        out: &mut [Option<SurfaceHit>],
+        scattered: bool,
+    ) {
         if self.tree.is_some() {
             for (r, o) in rays.iter().zip(out.iter_mut()) {
                 *o = self.closest_hit(r, tmin);
@@ -457,7 +488,7 @@ impl World {
                 if !any {
                     continue;
                 }
-                g.intersect(&batch[..n], &mut hits[..n]);
+                g.intersect_as(&batch[..n], &mut hits[..n], scattered);
                 for i in 0..n {
                     // Backends report no hit on inactive rays.
                     if let Some(h) = hits[i] {

@@ -6,6 +6,7 @@
 //! and both `wo` (toward the viewer) and `wi` (toward where the light comes from) point away
 //! from the surface (docs/physics.md §10).
 
+use super::draws::{cosine_dir, cosine_pdf, sincos_turn};
 use crate::render::band::Band;
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -120,8 +121,8 @@ impl Ggx {
         };
         let t2 = vh.cross(t1);
         let r = u1.sqrt();
-        let phi = 2.0 * PI * u2;
-        let (p1, mut p2) = (r * phi.cos(), r * phi.sin());
+        let (sin, cos) = sincos_turn(u2);
+        let (p1, mut p2) = (r * cos, r * sin);
         let s = 0.5 * (1.0 + vh.z);
         p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
         let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
@@ -195,6 +196,29 @@ impl<B: Band> Lobes<B> {
         }
     }
 
+    /// A Lambert surface of reflectance `diffuse` and nothing else.
+    pub fn lambert(diffuse: B) -> Lobes<B> {
+        Lobes::new(diffuse, None, 0.0, 0.0, 0.0, 1.0)
+    }
+
+    /// Whether it is a Lambert surface and nothing else.
+    pub fn lambert_only(&self) -> bool {
+        self.pick == [1.0, 0.0, 0.0, 0.0] && self.phong.is_none()
+    }
+
+    /// Its diffuse reflectance.
+    pub fn diffuse(&self) -> B {
+        self.diffuse
+    }
+
+    /// A Lambert lobe's f = ρ / π times `x`, as [`Lobes::eval`] and [`Lobes::sample`] make it
+    /// (for the lanes, which find the factor `x`).
+    pub fn lambert_f(diffuse: &B, x: f64) -> B {
+        let mut f = B::splat(0.0);
+        f.add(&(*diffuse * (1.0 / PI)));
+        f * x
+    }
+
     /// Whether it scatters no light.
     pub fn is_black(&self) -> bool {
         self.pick == [0.0; 4]
@@ -219,7 +243,7 @@ impl<B: Band> Lobes<B> {
         if wi.z > 0.0 {
             if self.pick[0] > 0.0 {
                 f.add(&(self.diffuse * (1.0 / PI)));
-                pdf += self.pick[0] * wi.z / PI;
+                pdf += self.pick[0] * cosine_pdf(wi.z);
             }
             if let Some((ks, n)) = &self.phong {
                 let r = DVec3::new(-wo.x, -wo.y, wo.z);
@@ -277,19 +301,15 @@ impl<B: Band> Lobes<B> {
         }
         let (u1, u2, u3) = (u[1], u[2], u[3]);
         let wi = match lobe {
-            0 => {
-                // Cosine-weighted on the hemisphere.
-                let r = u1.sqrt();
-                let phi = 2.0 * PI * u2;
-                DVec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u1).max(0.0).sqrt())
-            }
+            // Cosine-weighted on the hemisphere.
+            0 => cosine_dir(u1, u2),
             1 => {
                 let (_, n) = self.phong.as_ref().expect("drawn only with a Phong lobe");
                 let r = DVec3::new(-wo.x, -wo.y, wo.z);
                 let cos = u1.powf(1.0 / (n + 1.0));
                 let sin = (1.0 - cos * cos).max(0.0).sqrt();
-                let phi = 2.0 * PI * u2;
-                Basis::new(r).to_world(DVec3::new(sin * phi.cos(), sin * phi.sin(), cos))
+                let (sp, cp) = sincos_turn(u2);
+                Basis::new(r).to_world(DVec3::new(sin * cp, sin * sp, cos))
             }
             2 => match self.ggx {
                 None => {

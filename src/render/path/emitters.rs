@@ -3,6 +3,7 @@
 //! emitted value, in its rest frame), and how a point on it is drawn as seen from a receiver,
 //! with the density of that draw per solid angle in the emitter's rest frame.
 
+use super::draws::{sincos_turn, sphere_cone, sphere_point};
 use crate::geometry::Primitive;
 use crate::render::world::World;
 use crate::scene::Scene;
@@ -135,35 +136,22 @@ pub fn area(p: &Primitive) -> f64 {
     }
 }
 
-/// Whether a sphere is drawn by the cone of directions it fills seen from `x` (outside it).
+/// Whether a sphere is drawn by the cone of directions it fills seen from `x` (outside it):
+/// its centre, radius and 1 − cos θmax.
 fn cone(p: &Primitive, x: DVec3) -> Option<(DVec3, f64, f64)> {
     let Primitive::Sphere { center, radius } = *p else {
         return None;
     };
-    let d2 = (center - x).length_squared();
-    let sin2 = radius * radius / d2;
-    // 1 − cos θmax without cancellation for a far sphere.
-    let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
-    (sin2 < 1.0 && one_minus_cos > 0.0).then_some((center, radius, one_minus_cos))
+    let (one_minus_cos, outside) = sphere_cone(center, radius, x);
+    outside.then_some((center, radius, one_minus_cos))
 }
 
 /// A point drawn on `p` as seen from `x` (both in its rest frame), given three uniform numbers:
 /// a sphere by the cone it fills, every other primitive uniformly by area.
 pub(crate) fn sample_point(p: &Primitive, x: DVec3, u: [f64; 3]) -> Option<EmitterPoint> {
     if let Some((center, radius, omc)) = cone(p, x) {
-        let w = center - x;
-        let dc = w.length();
-        let basis = super::bsdf::Basis::new(w / dc);
-        let a = u[0] * omc;
-        let cos = 1.0 - a;
-        let sin = (a * (2.0 - a)).max(0.0).sqrt();
-        let phi = 2.0 * PI * u[1];
-        let dir = basis.to_world(DVec3::new(sin * phi.cos(), sin * phi.sin(), cos));
-        // The nearer crossing of the sphere (the tangent point where rounding misses it).
-        let b = dir.dot(w);
-        let closest = (w - b * dir).length_squared();
-        let t = b - (radius * radius - closest).max(0.0).sqrt();
-        return Some(EmitterPoint { point: x + t * dir });
+        let point = sphere_point(center, radius, x, omc, [u[0], u[1]]);
+        return Some(EmitterPoint { point });
     }
     let y = match *p {
         Primitive::Sphere { center, radius } => center + radius * sphere_dir(u[0], u[1]),
@@ -174,8 +162,8 @@ pub(crate) fn sample_point(p: &Primitive, x: DVec3, u: [f64; 3]) -> Option<Emitt
             let share = side / (side + 4.0 * PI * radius * radius);
             if u[0] < share && len > 0.0 {
                 let basis = super::bsdf::Basis::new(axis / len);
-                let phi = 2.0 * PI * u[2];
-                a + u[1] * axis + radius * basis.to_world(DVec3::new(phi.cos(), phi.sin(), 0.0))
+                let (sp, cp) = sincos_turn(u[2]);
+                a + u[1] * axis + radius * basis.to_world(DVec3::new(cp, sp, 0.0))
             } else {
                 // A whole sphere's directions: the half toward b is b's cap, the rest a's.
                 let d = sphere_dir(u[1], u[2]);
@@ -230,6 +218,6 @@ pub(crate) fn pdf_point(p: &Primitive, x: DVec3, y: DVec3) -> f64 {
 fn sphere_dir(u1: f64, u2: f64) -> DVec3 {
     let z = 1.0 - 2.0 * u1;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u2;
-    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sp, cp) = sincos_turn(u2);
+    DVec3::new(r * cp, r * sp, z)
 }

@@ -9,15 +9,19 @@
 //! D⁻²); then a direction drawn from the BSDF, and Russian roulette (docs/physics.md §10).
 
 mod bsdf;
+mod draws;
 mod emitters;
+mod lanes;
 mod nee;
 mod phase;
+mod wave;
 
 pub(crate) use emitters::Emitters;
+pub(crate) use wave::{Start, WaveScratch};
 
 use super::band::Band;
 use super::sampler::splitmix;
-use super::shade::{surface_colour, Shader, Spread};
+use super::shade::{surface_colour, Lit, Shader, Spread};
 use super::world::SurfaceHit;
 use crate::rng::Rng;
 use crate::spacetime::{Event, NullRay};
@@ -44,6 +48,10 @@ pub(crate) struct PathTracer<'s, 'a, B> {
     shader: &'s Shader<'a, B>,
     emitters: &'s Emitters,
     max_depth: u32,
+    /// Whether the commonest vertices go to the lanes (`wave.rs`), and whether those run in
+    /// vector registers (`WorldOptions::lanes`, `WorldOptions::simd`).
+    lanes: bool,
+    simd: bool,
 }
 
 /// What a path remembers of the vertex a BSDF draw left, to weigh an emitter the draw meets
@@ -59,73 +67,27 @@ struct Came {
 
 impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
     pub fn new(shader: &'s Shader<'a, B>, emitters: &'s Emitters) -> Self {
+        let options = shader.world.options;
         Self {
             shader,
             emitters,
             max_depth: shader.scene.render.max_depth,
+            lanes: options.lanes,
+            simd: options.simd,
         }
     }
 
-    /// The light a camera ray brings to the camera (its lookback factor `camera_s` for the
-    /// ray, as the switches have it), which first meets `first`: one path's estimate, at the
-    /// camera's wavelengths.
-    /// `spread`: the bundle the ray stands for (its pixel's, where stars are to be found after
-    /// mirror and glass bounces).
-    pub fn camera_path(
-        &self,
-        ray: &NullRay,
-        first: &SurfaceHit,
-        camera_s: f64,
-        spread: Spread,
-        rng: &mut Rng,
-    ) -> B {
-        let mut out = B::splat(0.0);
-        let mut path = Path {
-            beta: B::splat(1.0),
-            shift: 1.0,
-            came: None,
-            spread,
-        };
-        let mut leg = Leg::Null {
-            ray: *ray,
-            receiver_s: camera_s,
-            within: None,
-            first: Some(*first),
-        };
-        for depth in 0.. {
-            let reached = match leg {
-                Leg::Null {
-                    ray,
-                    receiver_s,
-                    within,
-                    first,
-                } => self.walk(&ray, receiver_s, within, first, &mut path, rng),
-                Leg::Slow(inside) => self.walk_inside(&inside, &mut path, rng),
-            };
-            let next = match reached {
-                Reached::Sky { dir, receiver_s } => {
-                    let sh = self.shader;
-                    let mut sky = sh.background_along(dir, receiver_s, path.shift);
-                    // Stars, along a path of mirrors and clear glass that keeps its bundle.
-                    if let Some(stars) = sh.stars_along(dir, receiver_s, path.shift, path.spread) {
-                        sky.add(&stars);
-                    }
-                    sky.mul_by(&path.beta);
-                    out.add(&sky);
-                    None
-                }
-                Reached::Surface { hit, event, within } => {
-                    self.at_surface(&hit, event, within, depth, &mut path, rng, &mut out)
-                }
-                Reached::Scatter(at) => self.in_medium(&at, depth, &mut path, rng, &mut out),
-                Reached::Lost => None,
-            };
-            match next {
-                Some(l) => leg = l,
-                None => break,
-            }
+    /// The light of the sky (and of the stars, along a path of mirrors and clear glass that
+    /// keeps its bundle) that a leg along world-frame `dir` brings to its receiver (lookback
+    /// factor `receiver_s`), times the path's throughput.
+    fn sky_light(&self, dir: DVec3, receiver_s: f64, path: &Path<B>) -> B {
+        let sh = self.shader;
+        let mut sky = sh.background_along(dir, receiver_s, path.shift);
+        if let Some(stars) = sh.stars_along(dir, receiver_s, path.shift, path.spread) {
+            sky.add(&stars);
         }
-        out
+        sky.mul_by(&path.beta);
+        sky
     }
 
     /// Follow a null ray from its receiver (lookback factor `receiver_s`, as the switches have
@@ -173,10 +135,7 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
                 }
             }
             let Some(h) = hit else {
-                return Reached::Sky {
-                    dir: ray.dir,
-                    receiver_s,
-                };
+                return self.reach(ray, receiver_s, None, within, path);
             };
             // Only the boundaries of media are invisible: without any, every hit is a surface.
             let part = match sh.has_invisible() {
@@ -186,14 +145,7 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             let Some(part) =
                 part.filter(|p| sh.scene.materials[p.material as usize].is_invisible())
             else {
-                let (shift_h, k) = sh.arriving(receiver_s, h.s, path.shift);
-                path.beta = path.beta * k;
-                path.shift = shift_h;
-                return Reached::Surface {
-                    hit: h,
-                    event: ray.at(h.lambda),
-                    within,
-                };
+                return self.reach(ray, receiver_s, Some(h), within, path);
             };
             let g = &world.groups[h.group];
             let exiting = g.geometry.prim(h.prim).normal(h.point).dot(h.dir) > 0.0;
@@ -204,6 +156,48 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             };
             t = h.lambda + g.epsilon / h.s;
         }
+    }
+
+    /// What a leg reaches where its last stretch (in medium `within`) ends at `hit`, a surface
+    /// that is not a medium's boundary, or nowhere: the throughput and the wavelengths carried
+    /// into the surface's frame.
+    fn reach(
+        &self,
+        ray: &NullRay,
+        receiver_s: f64,
+        hit: Option<SurfaceHit>,
+        within: Option<(usize, u32)>,
+        path: &mut Path<B>,
+    ) -> Reached {
+        let Some(h) = hit else {
+            return Reached::Sky {
+                dir: ray.dir,
+                receiver_s,
+            };
+        };
+        let (shift_h, k) = self.shader.arriving(receiver_s, h.s, path.shift);
+        path.beta = path.beta * k;
+        path.shift = shift_h;
+        Reached::Surface {
+            hit: h,
+            event: ray.at(h.lambda),
+            within,
+        }
+    }
+
+    /// Whether a leg is a plain null ray whose closest hit is what it reaches: it starts in no
+    /// medium, the scene has no fog and no medium's boundary, and its hit is not known yet.
+    fn is_plain(&self, leg: &Leg) -> bool {
+        let sh = self.shader;
+        matches!(
+            leg,
+            Leg::Null {
+                within: None,
+                first: None,
+                ..
+            }
+        ) && sh.fog.is_none()
+            && !sh.has_invisible()
     }
 
     /// Follow a ray inside a glass object (its group's frame, light at c/n, `Shader::inside_hit`)
@@ -288,19 +282,17 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         None
     }
 
-    /// Shade a surface the path met: its light if it glows, the lights it gathers, and the next
-    /// leg (None: the path ends).
-    #[allow(clippy::too_many_arguments)]
-    fn at_surface(
+    /// A surface the path met, resolved once: its light if it glows (added to `out`, and the
+    /// path ends: None), else its material's lobes in the surface's frame (None where they
+    /// scatter nothing, or past the last bounce).
+    fn meet_surface(
         &self,
         hit: &SurfaceHit,
         event: Event,
-        within: Option<(usize, u32)>,
         depth: u32,
-        path: &mut Path<B>,
-        rng: &mut Rng,
+        path: &Path<B>,
         out: &mut B,
-    ) -> Option<Leg> {
+    ) -> Option<Surface<'a, B>> {
         let sh = self.shader;
         let lit = sh.lit_at(hit, event, path.shift);
         let (mat, at) = (lit.mat, B::at(path.shift));
@@ -331,6 +323,32 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         }
         let basis = Basis::new(lit.nf);
         let wo = basis.to_local(-lit.v);
+        Some(Surface {
+            lit,
+            lobes,
+            basis,
+            wo,
+        })
+    }
+
+    /// The light a resolved surface gathers (to `out`), and the next leg its lobes draw.
+    #[allow(clippy::too_many_arguments)]
+    fn scatter_surface(
+        &self,
+        s: &Surface<'a, B>,
+        hit: &SurfaceHit,
+        within: Option<(usize, u32)>,
+        depth: u32,
+        path: &mut Path<B>,
+        rng: &mut Rng,
+        out: &mut B,
+    ) -> Option<Leg> {
+        let Surface {
+            lit,
+            lobes,
+            basis,
+            wo,
+        } = s;
         let here = Gather {
             group: lit.group,
             event: lit.event,
@@ -341,55 +359,82 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         if lobes.has_glossy() {
             let scatter = |wi: DVec3| {
                 let l = basis.to_local(wi);
-                let (f, pdf) = lobes.eval(wo, l);
+                let (f, pdf) = lobes.eval(*wo, l);
                 (f * l.z.abs(), pdf)
             };
             self.gather(&here, &scatter, &path.beta, rng, out);
         }
         let u = [rng.f(), rng.f(), rng.f(), rng.f()];
-        let bs = lobes.sample(wo, u)?;
+        let bs = lobes.sample(*wo, u)?;
         path.beta.mul_by(&bs.weight);
         self.roulette(depth, path, rng)?;
         let wi = basis.to_world(bs.wi);
-        let side = if bs.wi.z > 0.0 { lit.nf } else { -lit.nf };
+        let glass = (lit.mat.transmit > 0.0).then(|| {
+            let part = self.shader.world.groups[lit.group]
+                .geometry
+                .part_of(hit.prim);
+            (lit.n, part.material)
+        });
+        let spot = Spot {
+            group: lit.group,
+            event: lit.event,
+            nf: lit.nf,
+            glass,
+        };
         let pdf = (!bs.delta).then_some(bs.pdf);
-        let from = sh.pushed_off(lit.group, lit.event, side);
+        Some(self.leg_after(&spot, hit.s, within, wi, bs.wi.z > 0.0, pdf, path))
+    }
+
+    /// The next leg from a surface (`spot`, met by a ray whose lookback factor there was
+    /// `hit_s`) along rest-frame direction `wi`, to the side the light left toward where
+    /// `above`, drawn with density `pdf` (None: a smooth lobe's).
+    #[allow(clippy::too_many_arguments)]
+    fn leg_after(
+        &self,
+        spot: &Spot,
+        hit_s: f64,
+        within: Option<(usize, u32)>,
+        wi: DVec3,
+        above: bool,
+        pdf: Option<f64>,
+        path: &mut Path<B>,
+    ) -> Leg {
+        let sh = self.shader;
+        let side = if above { spot.nf } else { -spot.nf };
+        let from = sh.pushed_off(spot.group, spot.event, side);
         // A smooth bounce keeps the bundle's solid angle in the surface's frame (a flat
         // surface), as Whitted's rays do; any other ends it.
-        let kept = match bs.delta && path.spread.sr > 0.0 {
-            true => path.spread.into_frame(hit.s),
+        let kept = match pdf.is_none() && path.spread.sr > 0.0 {
+            true => path.spread.into_frame(hit_s),
             false => 0.0,
         };
         // Into a glass object: slower light, no change of frame, maybe a medium.
-        if mat.transmit > 0.0 && wi.dot(lit.n) < 0.0 {
+        if let Some((_, material)) = spot.glass.filter(|(n, _)| wi.dot(*n) < 0.0) {
             path.came = pdf.map(|pdf| Came { pdf, from, s: 1.0 });
             path.spread = Spread { sr: kept, s: 1.0 };
-            return Some(Leg::Slow(Inside {
-                group: lit.group,
-                event: lit.event,
+            return Leg::Slow(Inside {
+                group: spot.group,
+                event: spot.event,
                 side,
                 dir: wi,
-                material: sh.world.groups[lit.group]
-                    .geometry
-                    .part_of(hit.prim)
-                    .material,
+                material,
                 outside: within,
-            }));
+            });
         }
-        let r = sh.spawn(lit.group, lit.event, side, wi);
-        let s = sh.world.groups[lit.group].boost.null_dir(r.dir).1;
+        let r = sh.spawn(spot.group, spot.event, side, wi);
+        let s = sh.world.groups[spot.group].boost.null_dir(r.dir).1;
         path.came = pdf.map(|pdf| Came {
             pdf,
             from: r.origin,
             s,
         });
         path.spread = Spread { sr: kept, s };
-        Some(Leg::Null {
+        Leg::Null {
             ray: r,
-            receiver_s: sh.lookback_factor(lit.group, r.dir),
+            receiver_s: sh.lookback_factor(spot.group, r.dir),
             within,
             first: None,
-        })
+        }
     }
 
     /// A point where the path's light scattered in a medium: the lights it gathers there, and
@@ -472,6 +517,27 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         }
         Some(())
     }
+}
+
+/// A surface a path met, resolved once for all that is done there: the hit as shading sees
+/// it, the material's lobes, and the local frame about the shading normal with the direction
+/// toward the viewer in it.
+struct Surface<'a, B> {
+    lit: Lit<'a>,
+    lobes: Lobes<B>,
+    basis: Basis,
+    wo: DVec3,
+}
+
+/// Where a surface's next leg leaves from: its group, the hit's event and the shading normal
+/// toward the side the path came from; for a surface that lets light into glass, its outward
+/// normal and the glass's material.
+#[derive(Clone, Copy)]
+struct Spot {
+    group: usize,
+    event: Event,
+    nf: DVec3,
+    glass: Option<(DVec3, u32)>,
 }
 
 /// A path's state between vertices: its throughput, the wavelengths of the frame it is in,

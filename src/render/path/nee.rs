@@ -3,6 +3,7 @@
 //! shadow ray (attenuated through media), weighed against the vertex's own draws by the power
 //! heuristic (docs/physics.md §10.3).
 
+use super::draws::power;
 use super::emitters;
 use super::{Came, PathTracer};
 use crate::render::band::Band;
@@ -92,7 +93,7 @@ impl<B: Band> PathTracer<'_, '_, B> {
         }
     }
 
-    fn point_lights(
+    pub(super) fn point_lights(
         &self,
         here: &Gather,
         scatter: &dyn Fn(DVec3) -> (B, f64),
@@ -142,12 +143,26 @@ impl<B: Band> PathTracer<'_, '_, B> {
         rng: &mut Rng,
         out: &mut B,
     ) {
-        let sh = self.shader;
-        let world = sh.world;
-        let Some((eg, prim, p_pick)) = self.emitters.pick(rng.f()) else {
+        let Some(pick) = self.emitters.pick(rng.f()) else {
             return;
         };
         let u = [rng.f(), rng.f(), rng.f()];
+        self.emitter_light_drawn(here, scatter, beta, pick, u, out);
+    }
+
+    /// [`PathTracer::emitter_light`] with its random numbers drawn: the emitter `pick` (its
+    /// group, primitive and probability), and the three numbers of the point on it.
+    pub(super) fn emitter_light_drawn(
+        &self,
+        here: &Gather,
+        scatter: &dyn Fn(DVec3) -> (B, f64),
+        beta: &B,
+        (eg, prim, p_pick): (usize, u32, f64),
+        u: [f64; 3],
+        out: &mut B,
+    ) {
+        let sh = self.shader;
+        let world = sh.world;
         let ge = &world.groups[eg];
         let prim_e = ge.geometry.prim(prim);
         // The vertex in the emitter's frame, where the emitter is static: the event on its
@@ -188,26 +203,8 @@ impl<B: Band> PathTracer<'_, '_, B> {
         let pdf_e = emitters::pdf_point(&prim_e, x, pt.point);
         let p_light = p_pick * pdf_e * d * d;
         let (shift_e, k) = sh.seen.radiance(d, here.shift);
-        let at = B::at(shift_e);
-        let mat = &sh.scene.materials[self.emitters.material_of(eg, prim) as usize];
-        let Some(e) = &mat.emission else {
+        let Some(mut c) = self.emitted((eg, prim), pt.point, look_e, here.event, shift_e) else {
             return;
-        };
-        // A texture is read where the point lies on the object; a colour is the same all over.
-        let mut c = match mat.emission_texture.as_deref() {
-            None => B::of(e, at),
-            Some(texture) => {
-                let on = SurfaceHit {
-                    group: eg,
-                    prim,
-                    lambda: 0.0,
-                    point: pt.point,
-                    dir: look_e,
-                    s: 1.0,
-                };
-                let elit = sh.lit_at(&on, here.event, shift_e);
-                surface_colour::<B>(e, Some(texture), &elit, at)
-            }
         };
         c.mul_by(&f);
         c.mul_by(beta);
@@ -217,14 +214,37 @@ impl<B: Band> PathTracer<'_, '_, B> {
         let w = power(p_light, pdf_own);
         out.add(&(c * (k * w / p_light)));
     }
-}
 
-/// The power heuristic's weight for a strategy of density `a` against one of density `b`.
-fn power(a: f64, b: f64) -> f64 {
-    let (a2, b2) = (a * a, b * b);
-    if a2 + b2 > 0.0 {
-        a2 / (a2 + b2)
-    } else {
-        0.0
+    /// The light emitter `prim` of group `eg` sends from rest-frame point `point` (looked at
+    /// along `look`, from `event`), at wavelengths `shift` times the camera's; None where its
+    /// material does not glow.
+    pub(super) fn emitted(
+        &self,
+        (eg, prim): (usize, u32),
+        point: DVec3,
+        look: DVec3,
+        event: Event,
+        shift: f64,
+    ) -> Option<B> {
+        let sh = self.shader;
+        let at = B::at(shift);
+        let mat = &sh.scene.materials[self.emitters.material_of(eg, prim) as usize];
+        let e = mat.emission.as_ref()?;
+        // A texture is read where the point lies on the object; a colour is the same all over.
+        Some(match mat.emission_texture.as_deref() {
+            None => B::of(e, at),
+            Some(texture) => {
+                let on = SurfaceHit {
+                    group: eg,
+                    prim,
+                    lambda: 0.0,
+                    point,
+                    dir: look,
+                    s: 1.0,
+                };
+                let elit = sh.lit_at(&on, event, shift);
+                surface_colour::<B>(e, Some(texture), &elit, at)
+            }
+        })
     }
 }

@@ -39,9 +39,8 @@ impl Hg {
             ((1.0 + g * g - k * k) / (2.0 * g)).clamp(-1.0, 1.0)
         };
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
-        let phi = 2.0 * PI * u2;
-        let way_in =
-            super::bsdf::Basis::new(wo).to_world(DVec3::new(sin * phi.cos(), sin * phi.sin(), cos));
+        let (sp, cp) = super::draws::sincos_turn(u2);
+        let way_in = super::bsdf::Basis::new(wo).to_world(DVec3::new(sin * cp, sin * sp, cos));
         let wi = -way_in;
         (wi, self.eval(wo, wi))
     }

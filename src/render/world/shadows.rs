@@ -9,6 +9,16 @@ impl World {
     /// [`World::occluded`] for many rays (lookback from 0 to `tmax[i]`) at once: with few
     /// groups they go to each group's backend together (packets), as primary rays do.
     pub fn occluded_many(&self, rays: &[NullRay], tmax: &[f64], out: &mut [bool]) {
+        self.occluded_many_as(rays, tmax, out, false);
+    }
+
+    /// [`World::occluded_many`] for rays from anywhere toward anywhere (the shadow rays of a
+    /// bounce of many paths): in packets traced as scattered rays.
+    pub fn occluded_scattered(&self, rays: &[NullRay], tmax: &[f64], out: &mut [bool]) {
+        self.occluded_many_as(rays, tmax, out, true);
+    }
+
+    fn occluded_many_as(&self, rays: &[NullRay], tmax: &[f64], out: &mut [bool], scattered: bool) {
         if self.tree.is_some() {
             for ((r, &t), o) in rays.iter().zip(tmax).zip(out.iter_mut()) {
                 *o = self.occluded(r, 0.0, t);
@@ -40,7 +50,7 @@ impl World {
                 if !any {
                     continue;
                 }
-                g.occluded(&batch[..n], &mut hit[..n]);
+                g.occluded_as(&batch[..n], &mut hit[..n], scattered);
                 for i in 0..n {
                     out[i] |= batch[i].is_active() && hit[i];
                 }

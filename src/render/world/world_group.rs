@@ -64,6 +64,12 @@ impl WorldGroup {
     /// The closest hit of each ray in this group (None for inactive rays): through the
     /// accelerator, or the primitives one by one for a group without one.
     pub(super) fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        self.intersect_as(rays, hits, false);
+    }
+
+    /// [`WorldGroup::intersect`] of rays that are `scattered` (sharing neither origin nor
+    /// direction: `Accelerator::intersect_scattered`) or not.
+    pub(super) fn intersect_as(&self, rays: &[Ray], hits: &mut [Option<Hit>], scattered: bool) {
         if let Some(parts) = &self.turning {
             for (r, h) in rays.iter().zip(hits.iter_mut()) {
                 *h = turning::intersect(&self.geometry, parts, r, self.turn_time);
@@ -77,7 +83,10 @@ impl WorldGroup {
             return;
         }
         if let Some(accel) = &self.accel {
-            return accel.intersect(rays, hits);
+            return match scattered {
+                true => accel.intersect_scattered(rays, hits),
+                false => accel.intersect(rays, hits),
+            };
         }
         for (r, h) in rays.iter().zip(hits.iter_mut()) {
             *h = None;
@@ -96,6 +105,12 @@ impl WorldGroup {
 
     /// Whether anything of this group lies on each ray (false for inactive rays).
     pub(super) fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
+        self.occluded_as(rays, out, false);
+    }
+
+    /// [`WorldGroup::occluded`] of rays that are `scattered` or not (as
+    /// [`WorldGroup::intersect_as`]).
+    pub(super) fn occluded_as(&self, rays: &[Ray], out: &mut [bool], scattered: bool) {
         if let Some(parts) = &self.turning {
             for (r, o) in rays.iter().zip(out.iter_mut()) {
                 *o = turning::intersect(&self.geometry, parts, r, self.turn_time).is_some();
@@ -109,7 +124,10 @@ impl WorldGroup {
             return;
         }
         if let Some(accel) = &self.accel {
-            return accel.occluded(rays, out);
+            return match scattered {
+                true => accel.occluded_scattered(rays, out),
+                false => accel.occluded(rays, out),
+            };
         }
         for (r, o) in rays.iter().zip(out.iter_mut()) {
             *o = r.is_active()
