@@ -20,6 +20,7 @@ mod turning;
 pub(crate) use turning::TurningPart;
 mod rest_groups;
 pub use rest_groups::RestGroups;
+mod direct;
 mod primary_hits;
 mod shadows;
 mod world_group;
@@ -46,7 +47,7 @@ const LIGHT_SLICES: usize = 128;
 
 /// Groups with at most this many primitives are intersected in f64 directly: an acceleration
 /// structure (and a call into it) costs more than the primitives themselves.
-pub const DIRECT_MAX: usize = 4;
+pub const DIRECT_MAX: usize = 16;
 
 pub(crate) use crate::geometry::INSTANCE_OVER;
 
@@ -208,6 +209,8 @@ impl World {
                 accelerated: g.accelerated,
                 turning: g.turning.clone(),
                 turn_time: g.boost.event(event).t,
+                direct: g.direct.clone(),
+                simd: options.simd,
             })
             .collect();
         let (tree, primary_tree, light_trees) =

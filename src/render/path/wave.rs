@@ -262,7 +262,7 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         let mut sphere = (DVec3::ZERO, 0.0, 0.0);
         if let Some(pick) = self.emitters.pick(rng.f()) {
             let u = [rng.f(), rng.f(), rng.f()];
-            match self.sphere_in_lanes(pick, lit.event.x) {
+            match self.sphere_in_lanes(pick) {
                 Some((center, radius)) => {
                     emitter = Some((pick, u));
                     sphere = (center, radius, pick.2);
@@ -298,17 +298,16 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         None
     }
 
-    /// The centre and radius of the emitter `pick` where the lanes can draw a point on it from
-    /// `x`: a sphere, in a frame at rest in the world frame, seen at every time, from outside.
-    fn sphere_in_lanes(&self, (eg, prim, _): (usize, u32, f64), x: DVec3) -> Option<(DVec3, f64)> {
+    /// The centre and radius of the emitter `pick` where the lanes can draw a point on it: a
+    /// sphere, in a frame at rest in the world frame, seen at every time (whether the vertex
+    /// is outside it, the lanes find).
+    fn sphere_in_lanes(&self, (eg, prim, _): (usize, u32, f64)) -> Option<(DVec3, f64)> {
         let ge = &self.shader.world.groups[eg];
         if !ge.boost.is_identity() || ge.window.is_some() {
             return None;
         }
         match ge.geometry.prim(prim) {
-            Primitive::Sphere { center, radius } => super::draws::sphere_cone(center, radius, x)
-                .1
-                .then_some((center, radius)),
+            Primitive::Sphere { center, radius } => Some((center, radius)),
             _ => None,
         }
     }
@@ -330,8 +329,8 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
             let k = q.slot as usize;
             let beta = &w.paths[k].beta;
             if !o.coned {
-                // The shadow ray's start is inside the sphere (its push off the surface took it
-                // there): no cone to weigh the draw by; alone.
+                // The vertex or the shadow ray's start is inside the sphere: no cone to draw
+                // from or to weigh the draw by; alone, from the same numbers.
                 let lobes = Lobes::lambert(q.diffuse);
                 let basis = Basis::new(q.nf);
                 let wo = basis.to_local(-q.v);

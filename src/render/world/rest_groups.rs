@@ -4,7 +4,7 @@
 
 use super::WorldOptions;
 use crate::accel::{Accelerator, Backend};
-use crate::geometry::{Aabb, Geometry, ImplicitRun};
+use crate::geometry::{Aabb, Geometry, ImplicitRun, Primitive};
 use crate::scene::Scene;
 use crate::spacetime::{Boost, Velocity, Window};
 use std::sync::Arc;
@@ -29,6 +29,9 @@ pub(super) struct RestGroup {
     pub accelerated: Option<crate::scene::Accelerated>,
     /// Its turning bodies, if any (world/turning.rs).
     pub turning: Option<Arc<[super::TurningPart]>>,
+    /// Its primitives, where it has no accelerator and is intersected one primitive at a time
+    /// against lanes of rays (world/direct.rs).
+    pub direct: Option<Arc<[Primitive]>>,
 }
 
 /// The world's groups, built once: the part of a world that a film's frames share (the
@@ -110,6 +113,8 @@ impl RestGroups {
                 })?))
             };
             let spins = geometry.spins();
+            let prims = (accel.is_none() && !direct)
+                .then(|| (0..geometry.len()).map(|i| geometry.prim(i)).collect());
             groups.push(RestGroup {
                 velocity,
                 boost: scene.groups[members[0]].to_rest(),
@@ -125,6 +130,7 @@ impl RestGroups {
                 spins,
                 accelerated,
                 turning,
+                direct: prims,
             });
         }
         Ok(RestGroups { groups, options })

@@ -41,6 +41,10 @@ pub struct WorldGroup {
     /// The group's time of the imaging event, where a turning group's rays are made to start
     /// (near the events they meet, so that their lookbacks stay small).
     pub turn_time: f64,
+    /// Its primitives, where it has no accelerator (world/direct.rs), and whether their tests
+    /// run in vector registers (`WorldOptions::simd`).
+    pub direct: Option<Arc<[Primitive]>>,
+    pub simd: bool,
 }
 
 impl WorldGroup {
@@ -88,6 +92,9 @@ impl WorldGroup {
                 false => accel.intersect(rays, hits),
             };
         }
+        if let Some(prims) = &self.direct {
+            return super::direct::intersect(prims, rays, hits, self.simd);
+        }
         for (r, h) in rays.iter().zip(hits.iter_mut()) {
             *h = None;
             if !r.is_active() {
@@ -128,6 +135,9 @@ impl WorldGroup {
                 true => accel.occluded_scattered(rays, out),
                 false => accel.occluded(rays, out),
             };
+        }
+        if let Some(prims) = &self.direct {
+            return super::direct::occluded(prims, rays, out, self.simd);
         }
         for (r, o) in rays.iter().zip(out.iter_mut()) {
             *o = r.is_active()
