@@ -71,6 +71,7 @@ impl Boost {
     }
 
     /// Whether it turns the axes.
+    #[inline]
     pub fn turns(&self) -> bool {
         self.before.is_some() || self.after.is_some()
     }
@@ -81,6 +82,7 @@ impl Boost {
     }
 
     /// The boost back (into the frame this one starts from).
+    #[inline]
     pub fn inverse(&self) -> Boost {
         Boost {
             axis: self.axis,
@@ -100,6 +102,12 @@ impl Boost {
         if self.is_identity() {
             return e;
         }
+        self.event_moving(e)
+    }
+
+    /// [`Boost::event`] of a boost that is not the identity.
+    #[inline(never)]
+    fn event_moving(&self, e: Event) -> Event {
         let e = match self.before {
             Some(r) => Event::new(e.t, r * e.x),
             None => e,
@@ -123,10 +131,17 @@ impl Boost {
     /// spatial part `d'` (unnormalised) and `s = −t' = |d'|`, the factor by which the frame's
     /// lookback time exceeds the original one: for a boost into a frame moving at β,
     /// `s = γ(1 + β·a)` (docs/physics.md §7.1).
+    #[inline]
     pub fn null_dir(&self, a: DVec3) -> (DVec3, f64) {
-        if self.identity && !self.turns() {
+        if self.is_identity() {
             return (a, 1.0);
         }
+        self.null_dir_moving(a)
+    }
+
+    /// [`Boost::null_dir`] of a boost that is not the identity.
+    #[inline(never)]
+    fn null_dir_moving(&self, a: DVec3) -> (DVec3, f64) {
         let ([x, y, z], s) = self.null_dir_lanes([a.x, a.y, a.z]);
         (DVec3::new(x, y, z), s)
     }
@@ -225,8 +240,9 @@ impl Boost {
     }
 
     /// The unit direction of a null ray after the boost, and the factor `s` of [`Boost::null_dir`].
+    #[inline]
     pub fn view_dir(&self, a: DVec3) -> (DVec3, f64) {
-        if self.identity && !self.turns() {
+        if self.is_identity() {
             return (a, 1.0);
         }
         let (d, s) = self.null_dir(a);

@@ -30,7 +30,7 @@ use glam::DVec3;
 use nee::Gather;
 
 /// The bounce from which Russian roulette may end a path.
-const ROULETTE_FROM: u32 = 3;
+const ROULETTE_FROM: u32 = 5;
 
 /// The most a path's survival probability may be under roulette (so every path ends).
 const ROULETTE_MAX: f64 = 0.95;
@@ -52,6 +52,9 @@ pub(crate) struct PathTracer<'s, 'a, B> {
     /// vector registers (`WorldOptions::lanes`, `WorldOptions::simd`).
     lanes: bool,
     simd: bool,
+    /// Per material, whether it is one Lambert lobe and nothing else, untextured (such
+    /// surfaces are resolved without the rest of the hit, `plain_lambert`).
+    plain: Vec<bool>,
 }
 
 /// What a path remembers of the vertex a BSDF draw left, to weigh an emitter the draw meets
@@ -74,6 +77,20 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             max_depth: shader.scene.render.max_depth,
             lanes: options.lanes,
             simd: options.simd,
+            plain: shader
+                .scene
+                .materials
+                .iter()
+                .map(|m| {
+                    m.emission.is_none()
+                        && m.medium.is_none()
+                        && !m.is_invisible()
+                        && m.color_texture.is_none()
+                        && m.specular.is_black()
+                        && m.reflect == 0.0
+                        && m.transmit == 0.0
+                })
+                .collect(),
         }
     }
 

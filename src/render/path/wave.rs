@@ -69,6 +69,27 @@ impl<B> Queued<B> {
     }
 }
 
+/// A Lambert vertex as the lanes need it: its group and event, the shading normal toward the
+/// viewer and the direction the path looked along, the frame's wavelengths over the camera's,
+/// and its colour in that frame.
+struct Lambert<B> {
+    group: usize,
+    event: Event,
+    nf: DVec3,
+    v: DVec3,
+    shift: f64,
+    diffuse: B,
+}
+
+/// What [`PathTracer::plain_lambert`] found.
+enum Plain<B> {
+    /// Not a plain Lambert surface (resolve it whole).
+    No,
+    /// A plain Lambert surface where the path ends (past the last bounce, or black).
+    Ends,
+    Lambert(Lambert<B>),
+}
+
 /// The light a shadow ray brings if nothing is in its way.
 struct Shadow<B> {
     slot: u32,
@@ -232,32 +253,105 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         depth: u32,
         slot: u32,
         (path, rng, out): (&mut Path<B>, &mut Rng, &mut B),
-        (lanes, queued): (&mut DiffuseLanes, &mut Vec<Queued<B>>),
+        lanes: (&mut DiffuseLanes, &mut Vec<Queued<B>>),
     ) -> Option<Leg> {
-        let s = self.meet_surface(hit, event, depth, path, out)?;
+        let v = match self.plain_lambert(hit, event, depth, path) {
+            Plain::Ends => return None,
+            Plain::Lambert(v) => v,
+            Plain::No => {
+                let s = self.meet_surface(hit, event, depth, path, out)?;
+                let sh = self.shader;
+                let identity = sh.world.groups[s.lit.group].boost.is_identity();
+                if !(self.lanes && s.lobes.lambert_only() && identity && !sh.has_invisible()) {
+                    return self.scatter_surface(&s, hit, within, depth, path, rng, out);
+                }
+                let lit = &s.lit;
+                Lambert {
+                    group: lit.group,
+                    event: lit.event,
+                    nf: lit.nf,
+                    v: lit.v,
+                    shift: lit.shift,
+                    diffuse: s.lobes.diffuse(),
+                }
+            }
+        };
+        self.queue_lambert(&v, hit.s, within, slot, (path, rng, out), lanes);
+        None
+    }
+
+    /// A surface met at a bounce as the lanes take it, resolved without the rest of the hit
+    /// where that is all there is to it: a material of one Lambert lobe and no texture, on a
+    /// part without corner data or spin, in a group at rest in the world frame, in a scene
+    /// without media. The same numbers as `meet_surface` (the normal turned to the viewer,
+    /// the colour in the frame's band).
+    fn plain_lambert(&self, hit: &SurfaceHit, event: Event, depth: u32, path: &Path<B>) -> Plain<B> {
         let sh = self.shader;
-        let g = &sh.world.groups[s.lit.group];
-        if !(self.lanes && s.lobes.lambert_only() && g.boost.is_identity() && !sh.has_invisible()) {
-            return self.scatter_surface(&s, hit, within, depth, path, rng, out);
+        let g = &sh.world.groups[hit.group];
+        if !self.lanes || !g.boost.is_identity() || sh.has_invisible() {
+            return Plain::No;
         }
-        let lit = &s.lit;
+        let part = g.geometry.part_of(hit.prim);
+        if !self.plain[part.material as usize] || part.corners.is_some() || part.spin.is_some() {
+            return Plain::No;
+        }
+        // Past the last bounce a vertex only says what light it sends: none.
+        if depth > self.max_depth {
+            return Plain::Ends;
+        }
+        let mat = &sh.scene.materials[part.material as usize];
+        let diffuse = B::of(&mat.color, B::at(path.shift));
+        if !(diffuse.max_value() > 0.0) {
+            return Plain::Ends;
+        }
+        let n = match &g.direct {
+            Some(prims) => prims[hit.prim as usize].normal(hit.point),
+            None => g.geometry.prim(hit.prim).normal(hit.point),
+        };
+        let v = hit.dir / hit.s;
+        let nf = if n.dot(v) > 0.0 { -n } else { n };
+        Plain::Lambert(Lambert {
+            group: hit.group,
+            event,
+            nf,
+            v,
+            shift: path.shift,
+            diffuse,
+        })
+    }
+
+    /// A Lambert vertex into the lanes: the point lights it gathers (here), its draws, and what
+    /// the scalar code needs after the lanes.
+    fn queue_lambert(
+        &self,
+        l: &Lambert<B>,
+        hit_s: f64,
+        within: Option<(usize, u32)>,
+        slot: u32,
+        (path, rng, out): (&mut Path<B>, &mut Rng, &mut B),
+        (lanes, queued): (&mut DiffuseLanes, &mut Vec<Queued<B>>),
+    ) {
+        let sh = self.shader;
         let here = Gather {
-            group: lit.group,
-            event: lit.event,
-            shift: lit.shift,
-            nf: Some(lit.nf),
+            group: l.group,
+            event: l.event,
+            shift: l.shift,
+            nf: Some(l.nf),
             within,
         };
+        let lobes = Lobes::lambert(l.diffuse);
+        let basis = Basis::new(l.nf);
+        let wo = basis.to_local(-l.v);
         let scatter = |wi: DVec3| {
-            let l = s.basis.to_local(wi);
-            let (f, pdf) = s.lobes.eval(s.wo, l);
-            (f * l.z.abs(), pdf)
+            let w = basis.to_local(wi);
+            let (f, pdf) = lobes.eval(wo, w);
+            (f * w.z.abs(), pdf)
         };
         if !sh.lights.is_empty() {
             self.point_lights(&here, &scatter, &path.beta, out);
         }
-        // Next-event estimation's draws (`emitter_light`): a glowing sphere at rest seen from
-        // outside goes to the lanes; any other emitter is done here.
+        // Next-event estimation's draws (`emitter_light`): a glowing sphere at rest goes to
+        // the lanes; any other emitter is done here.
         let mut emitter = None;
         let mut sphere = (DVec3::ZERO, 0.0, 0.0);
         if let Some(pick) = self.emitters.pick(rng.f()) {
@@ -274,10 +368,10 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         let u = [rng.f(), rng.f(), rng.f(), rng.f()];
         let ue = emitter.map_or([0.0; 3], |(_, u)| u);
         lanes.push(&DiffuseIn {
-            nf: lit.nf,
-            v: lit.v,
-            x: lit.event.x,
-            epsilon: g.epsilon,
+            nf: l.nf,
+            v: l.v,
+            x: l.event.x,
+            epsilon: sh.world.groups[l.group].epsilon,
             u: [u[1], u[2]],
             sphere: (sphere.0, sphere.1),
             p_pick: sphere.2,
@@ -285,17 +379,16 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         });
         queued.push(Queued {
             slot,
-            group: lit.group,
-            event: lit.event,
-            nf: lit.nf,
-            v: lit.v,
-            hit_s: hit.s,
-            shift: lit.shift,
+            group: l.group,
+            event: l.event,
+            nf: l.nf,
+            v: l.v,
+            hit_s,
+            shift: l.shift,
             within,
-            diffuse: s.lobes.diffuse(),
+            diffuse: l.diffuse,
             emitter,
         });
-        None
     }
 
     /// The centre and radius of the emitter `pick` where the lanes can draw a point on it: a
