@@ -175,13 +175,17 @@ impl Primitive {
                 let h = (0.5 * (max - min)).max(DVec3::splat(f64::MIN_POSITIVE));
                 let q = (p - c) / h;
                 let aq = q.abs();
-                if aq.x >= aq.y && aq.x >= aq.z {
-                    DVec3::new(q.x.signum(), 0.0, 0.0)
-                } else if aq.y >= aq.z {
-                    DVec3::new(0.0, q.y.signum(), 0.0)
-                } else {
-                    DVec3::new(0.0, 0.0, q.z.signum())
-                }
+                // The face whose axis the point is farthest along (x before y before z on a
+                // tie), chosen without branches: which face a ray meets is a coin toss to a
+                // branch predictor.
+                let x = aq.x >= aq.y && aq.x >= aq.z;
+                let y = !x && aq.y >= aq.z;
+                let z = !x && !y;
+                DVec3::new(
+                    if x { q.x.signum() } else { 0.0 },
+                    if y { q.y.signum() } else { 0.0 },
+                    if z { q.z.signum() } else { 0.0 },
+                )
             }
             Primitive::Triangle { v } => (v[1] - v[0]).cross(v[2] - v[0]).normalize_or(DVec3::Z),
         }

@@ -203,18 +203,10 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
     }
 
     /// Whether a leg is a plain null ray whose closest hit is what it reaches: it starts in no
-    /// medium, the scene has no fog and no medium's boundary, and its hit is not known yet.
+    /// medium, and the scene has no fog and no medium's boundary.
     fn is_plain(&self, leg: &Leg) -> bool {
         let sh = self.shader;
-        matches!(
-            leg,
-            Leg::Null {
-                within: None,
-                first: None,
-                ..
-            }
-        ) && sh.fog.is_none()
-            && !sh.has_invisible()
+        matches!(leg, Leg::Null { within: None, .. }) && sh.fog.is_none() && !sh.has_invisible()
     }
 
     /// Follow a ray inside a glass object (its group's frame, light at c/n, `Shader::inside_hit`)
@@ -450,7 +442,6 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
             ray: r,
             receiver_s: sh.lookback_factor(spot.group, r.dir),
             within,
-            first: None,
         }
     }
 
@@ -516,7 +507,6 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
                     ray: r,
                     receiver_s: sh.lookback_factor(at.group, r.dir),
                     within: Some((at.group, at.material)),
-                    first: None,
                 }
             }
         })
@@ -577,8 +567,6 @@ enum Leg {
         receiver_s: f64,
         /// The medium it starts in.
         within: Option<(usize, u32)>,
-        /// Its first hit, where known (a camera ray's).
-        first: Option<SurfaceHit>,
     },
     Slow(Inside),
 }

@@ -105,6 +105,8 @@ pub(crate) struct WaveScratch<B> {
     rngs: Vec<Rng>,
     outs: Vec<B>,
     legs: Vec<Leg>,
+    /// The camera rays' hits, each path's first.
+    first: Vec<SurfaceHit>,
     active: Vec<u32>,
     next: Vec<u32>,
     lanes: DiffuseLanes,
@@ -123,6 +125,7 @@ impl<B> Default for WaveScratch<B> {
             rngs: Vec::new(),
             outs: Vec::new(),
             legs: Vec::new(),
+            first: Vec::new(),
             active: Vec::new(),
             next: Vec::new(),
             lanes: DiffuseLanes::default(),
@@ -151,6 +154,7 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         w.rngs.clear();
         w.outs.clear();
         w.legs.clear();
+        w.first.clear();
         w.active.clear();
         for (k, st) in starts.enumerate() {
             w.paths.push(Path {
@@ -165,8 +169,8 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
                 ray: st.ray,
                 receiver_s: st.camera_s,
                 within: None,
-                first: Some(st.hit),
             });
+            w.first.push(st.hit);
             w.active.push(k as u32);
         }
         for depth in 0.. {
@@ -184,14 +188,14 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         w.next.clear();
         w.lanes.clear();
         w.queued.clear();
-        // The plain legs' closest hits, traced together.
+        // The plain legs' closest hits, traced together (the camera rays' are known).
         w.rays.clear();
-        for &slot in &w.active {
-            if let (Leg::Null { ray, .. }, true) = (
-                &w.legs[slot as usize],
-                self.is_plain(&w.legs[slot as usize]),
-            ) {
-                w.rays.push(*ray);
+        if depth > 0 {
+            for &slot in &w.active {
+                let leg = &w.legs[slot as usize];
+                if let (Leg::Null { ray, .. }, true) = (leg, self.is_plain(leg)) {
+                    w.rays.push(*ray);
+                }
             }
         }
         w.hits.clear();
@@ -203,33 +207,54 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         for &slot in &w.active {
             let k = slot as usize;
             let (path, rng, out) = (&mut w.paths[k], &mut w.rngs[k], &mut w.outs[k]);
-            let plain = self.is_plain(&w.legs[k]);
-            let reached = match w.legs[k] {
-                Leg::Null {
+            let first = (depth == 0).then(|| w.first[k]);
+            let lanes = (&mut w.lanes, &mut w.queued);
+            let next = match &w.legs[k] {
+                // A plain leg reaches its closest hit (`reach`, without a `Reached` made).
+                &Leg::Null {
                     ray, receiver_s, ..
-                } if plain => {
-                    let hit = *traced.next().expect("a hit per plain leg");
-                    self.reach(&ray, receiver_s, hit, None, path)
+                } if self.is_plain(&w.legs[k]) => {
+                    let hit = match first {
+                        Some(h) => Some(h),
+                        None => *traced.next().expect("a hit per plain leg"),
+                    };
+                    match hit {
+                        None => {
+                            out.add(&self.sky_light(ray.dir, receiver_s, path));
+                            None
+                        }
+                        Some(h) => {
+                            let (shift_h, k) = self.shader.arriving(receiver_s, h.s, path.shift);
+                            path.beta = path.beta * k;
+                            path.shift = shift_h;
+                            let event = ray.at(h.lambda);
+                            let at = (path, rng, out);
+                            self.surface_in_wave(&h, event, None, depth, slot, at, lanes)
+                        }
+                    }
                 }
-                Leg::Null {
-                    ray,
-                    receiver_s,
-                    within,
-                    first,
-                } => self.walk(&ray, receiver_s, within, first, path, rng),
-                Leg::Slow(inside) => self.walk_inside(&inside, path, rng),
-            };
-            let next = match reached {
-                Reached::Sky { dir, receiver_s } => {
-                    out.add(&self.sky_light(dir, receiver_s, path));
-                    None
+                leg => {
+                    let reached = match *leg {
+                        Leg::Null {
+                            ray,
+                            receiver_s,
+                            within,
+                        } => self.walk(&ray, receiver_s, within, first, path, rng),
+                        Leg::Slow(inside) => self.walk_inside(&inside, path, rng),
+                    };
+                    match reached {
+                        Reached::Sky { dir, receiver_s } => {
+                            out.add(&self.sky_light(dir, receiver_s, path));
+                            None
+                        }
+                        Reached::Surface { hit, event, within } => {
+                            let at = (path, rng, out);
+                            self.surface_in_wave(&hit, event, within, depth, slot, at, lanes)
+                        }
+                        Reached::Scatter(at) => self.in_medium(&at, depth, path, rng, out),
+                        Reached::Lost => None,
+                    }
                 }
-                Reached::Surface { hit, event, within } => {
-                    let lanes = (&mut w.lanes, &mut w.queued);
-                    self.surface_in_wave(&hit, event, within, depth, slot, (path, rng, out), lanes)
-                }
-                Reached::Scatter(at) => self.in_medium(&at, depth, path, rng, out),
-                Reached::Lost => None,
             };
             if let Some(leg) = next {
                 w.legs[k] = leg;
@@ -285,13 +310,19 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
     /// part without corner data or spin, in a group at rest in the world frame, in a scene
     /// without media. The same numbers as `meet_surface` (the normal turned to the viewer,
     /// the colour in the frame's band).
-    fn plain_lambert(&self, hit: &SurfaceHit, event: Event, depth: u32, path: &Path<B>) -> Plain<B> {
+    fn plain_lambert(
+        &self,
+        hit: &SurfaceHit,
+        event: Event,
+        depth: u32,
+        path: &Path<B>,
+    ) -> Plain<B> {
         let sh = self.shader;
         let g = &sh.world.groups[hit.group];
         if !self.lanes || !g.boost.is_identity() || sh.has_invisible() {
             return Plain::No;
         }
-        let part = g.geometry.part_of(hit.prim);
+        let part = g.part_of(hit.prim);
         if !self.plain[part.material as usize] || part.corners.is_some() || part.spin.is_some() {
             return Plain::No;
         }
@@ -301,13 +332,11 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         }
         let mat = &sh.scene.materials[part.material as usize];
         let diffuse = B::of(&mat.color, B::at(path.shift));
-        if !(diffuse.max_value() > 0.0) {
+        // Black (or NaN) scatters nothing, as `Lobes::is_black` says.
+        if diffuse.max_value().max(0.0) <= 0.0 {
             return Plain::Ends;
         }
-        let n = match &g.direct {
-            Some(prims) => prims[hit.prim as usize].normal(hit.point),
-            None => g.geometry.prim(hit.prim).normal(hit.point),
-        };
+        let n = g.with_prim(hit.prim, |p| p.normal(hit.point));
         let v = hit.dir / hit.s;
         let nf = if n.dot(v) > 0.0 { -n } else { n };
         Plain::Lambert(Lambert {
@@ -339,12 +368,11 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
             nf: Some(l.nf),
             within,
         };
-        let lobes = Lobes::lambert(l.diffuse);
-        let basis = Basis::new(l.nf);
-        let wo = basis.to_local(-l.v);
+        // What the surface scatters toward a light, for the lights the lanes do not take.
         let scatter = |wi: DVec3| {
+            let basis = Basis::new(l.nf);
             let w = basis.to_local(wi);
-            let (f, pdf) = lobes.eval(wo, w);
+            let (f, pdf) = Lobes::lambert(l.diffuse).eval(basis.to_local(-l.v), w);
             (f * w.z.abs(), pdf)
         };
         if !sh.lights.is_empty() {
@@ -399,10 +427,10 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         if !ge.boost.is_identity() || ge.window.is_some() {
             return None;
         }
-        match ge.geometry.prim(prim) {
+        ge.with_prim(prim, |p| match *p {
             Primitive::Sphere { center, radius } => Some((center, radius)),
             _ => None,
-        }
+        })
     }
 
     /// The lanes of a bounce run, their shadow rays traced together, and each of their paths

@@ -13,6 +13,28 @@ use multiversion::multiversion;
 /// Rays tested together.
 const WIDTH: usize = 8;
 
+/// A small group's primitives as the lanes test them, and the part each belongs to (so a hit
+/// finds its material without a search).
+pub struct DirectPrims {
+    pub prims: Vec<Primitive>,
+    pub parts: Vec<u32>,
+}
+
+impl DirectPrims {
+    /// The primitives of `geometry`, made once.
+    pub fn of(geometry: &crate::geometry::Geometry) -> DirectPrims {
+        let n = geometry.len();
+        let mut parts = Vec::with_capacity(n as usize);
+        for (k, p) in geometry.parts.iter().enumerate() {
+            parts.resize(p.end as usize, k as u32);
+        }
+        DirectPrims {
+            prims: (0..n).map(|i| geometry.prim(i)).collect(),
+            parts,
+        }
+    }
+}
+
 /// A chunk of rays as columns (origin, direction, interval), on the stack.
 struct Chunk {
     o: [[f64; WIDTH]; 3],
@@ -131,7 +153,7 @@ fn test_all(p: &Primitive, i: u32, c: &mut Chunk) {
 /// Lane j's best hit becomes t (of primitive i) where t is a hit (not NaN).
 #[inline(always)]
 fn keep(c: &mut Chunk, j: usize, t: f64, i: u32) {
-    let hit = t == t;
+    let hit = !t.is_nan();
     c.best[j] = if hit { t } else { c.best[j] };
     c.prim[j] = if hit { i } else { c.prim[j] };
 }
@@ -229,7 +251,11 @@ mod tests {
         let mut rng = Rng(9);
         let mut rays = Vec::new();
         for k in 0..4000 {
-            let o = DVec3::new(rng.range(-7.0, 7.0), rng.range(-7.0, 7.0), rng.range(-7.0, 7.0));
+            let o = DVec3::new(
+                rng.range(-7.0, 7.0),
+                rng.range(-7.0, 7.0),
+                rng.range(-7.0, 7.0),
+            );
             let d = rng.unit() * rng.range(0.5, 2.0);
             let (tmin, tmax) = match k % 5 {
                 0 => (0.0, f64::INFINITY),
@@ -240,8 +266,18 @@ mod tests {
             rays.push(Ray::new(o, d, tmin, tmax));
         }
         // Axis-parallel rays (zero components, infinite inverses).
-        rays.push(Ray::new(DVec3::new(0.0, 3.0, 0.0), DVec3::NEG_Y, 0.0, f64::INFINITY));
-        rays.push(Ray::new(DVec3::new(-5.0, 0.0, 0.0), DVec3::X, 0.0, f64::INFINITY));
+        rays.push(Ray::new(
+            DVec3::new(0.0, 3.0, 0.0),
+            DVec3::NEG_Y,
+            0.0,
+            f64::INFINITY,
+        ));
+        rays.push(Ray::new(
+            DVec3::new(-5.0, 0.0, 0.0),
+            DVec3::X,
+            0.0,
+            f64::INFINITY,
+        ));
         let want: Vec<Option<Hit>> = rays
             .iter()
             .map(|r| {
@@ -266,7 +302,11 @@ mod tests {
                     (None, None) => true,
                     _ => false,
                 };
-                assert!(same, "ray {k} ({:?}), simd {simd}: {g:?} against {w:?}", rays[k]);
+                assert!(
+                    same,
+                    "ray {k} ({:?}), simd {simd}: {g:?} against {w:?}",
+                    rays[k]
+                );
             }
             let mut blocked = vec![false; rays.len()];
             occluded(&prims, &rays, &mut blocked, simd);

@@ -4,7 +4,7 @@
 
 use super::WorldOptions;
 use crate::accel::{Accelerator, Backend};
-use crate::geometry::{Aabb, Geometry, ImplicitRun, Primitive};
+use crate::geometry::{Aabb, Geometry, ImplicitRun};
 use crate::scene::Scene;
 use crate::spacetime::{Boost, Velocity, Window};
 use std::sync::Arc;
@@ -31,7 +31,7 @@ pub(super) struct RestGroup {
     pub turning: Option<Arc<[super::TurningPart]>>,
     /// Its primitives, where it has no accelerator and is intersected one primitive at a time
     /// against lanes of rays (world/direct.rs).
-    pub direct: Option<Arc<[Primitive]>>,
+    pub direct: Option<Arc<super::direct::DirectPrims>>,
 }
 
 /// The world's groups, built once: the part of a world that a film's frames share (the
@@ -114,7 +114,7 @@ impl RestGroups {
             };
             let spins = geometry.spins();
             let prims = (accel.is_none() && !direct)
-                .then(|| (0..geometry.len()).map(|i| geometry.prim(i)).collect());
+                .then(|| Arc::new(super::direct::DirectPrims::of(&geometry)));
             groups.push(RestGroup {
                 velocity,
                 boost: scene.groups[members[0]].to_rest(),

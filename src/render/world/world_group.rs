@@ -43,7 +43,7 @@ pub struct WorldGroup {
     pub turn_time: f64,
     /// Its primitives, where it has no accelerator (world/direct.rs), and whether their tests
     /// run in vector registers (`WorldOptions::simd`).
-    pub direct: Option<Arc<[Primitive]>>,
+    pub direct: Option<Arc<super::direct::DirectPrims>>,
     pub simd: bool,
 }
 
@@ -92,8 +92,8 @@ impl WorldGroup {
                 false => accel.intersect(rays, hits),
             };
         }
-        if let Some(prims) = &self.direct {
-            return super::direct::intersect(prims, rays, hits, self.simd);
+        if let Some(d) = &self.direct {
+            return super::direct::intersect(&d.prims, rays, hits, self.simd);
         }
         for (r, h) in rays.iter().zip(hits.iter_mut()) {
             *h = None;
@@ -136,8 +136,8 @@ impl WorldGroup {
                 false => accel.occluded(rays, out),
             };
         }
-        if let Some(prims) = &self.direct {
-            return super::direct::occluded(prims, rays, out, self.simd);
+        if let Some(d) = &self.direct {
+            return super::direct::occluded(&d.prims, rays, out, self.simd);
         }
         for (r, o) in rays.iter().zip(out.iter_mut()) {
             *o = r.is_active()
@@ -145,6 +145,28 @@ impl WorldGroup {
                     let p = self.geometry.prim(i);
                     p.intersect(r.origin, r.dir, r.tmin, r.tmax).is_some()
                 });
+        }
+    }
+
+    /// The part primitive `prim` belongs to (without a search in a small group).
+    #[inline]
+    pub fn part_of(&self, prim: u32) -> &Part {
+        match &self.direct {
+            Some(d) => &self.geometry.parts[d.parts[prim as usize] as usize],
+            None => self.geometry.part_of(prim),
+        }
+    }
+
+    /// `f` of primitive `prim`, by reference where it is held (a copy of a primitive read
+    /// back field by field stalls on the copy's wide stores), else made.
+    #[inline]
+    pub fn with_prim<R>(&self, prim: u32, f: impl FnOnce(&Primitive) -> R) -> R {
+        match &self.direct {
+            Some(d) => f(&d.prims[prim as usize]),
+            None => match self.geometry.prims.get(prim as usize) {
+                Some(p) => f(p),
+                None => f(&self.geometry.prim(prim)),
+            },
         }
     }
 
