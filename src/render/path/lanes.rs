@@ -64,6 +64,8 @@ pub(super) struct DiffuseOut {
     pub pdf: f64,
     pub weight: f64,
     pub wi: DVec3,
+    /// Where the next leg starts: ε off the surface on the side the light leaves toward.
+    pub next: DVec3,
     /// Next-event estimation: whether the sphere was drawn from its cone at both ends (else
     /// the scalar path draws it), whether the draw sends light that way, the point drawn, the
     /// shadow ray's start and direction and its lookback limit, |cos| at the vertex, and the
@@ -92,7 +94,8 @@ mod col_out {
     pub const TMAX: usize = 17;
     pub const COS: usize = 18;
     pub const FACTOR: usize = 19;
-    pub const COUNT: usize = 20;
+    pub const NEXT: usize = 20;
+    pub const COUNT: usize = 23;
 }
 
 /// A bounce's diffuse vertices, in and out, a row each.
@@ -129,6 +132,7 @@ impl DiffuseLanes {
             pdf: o[PDF],
             weight: o[WEIGHT],
             wi: v3(WI),
+            next: v3(NEXT),
             coned: o[CONED] != 0.0,
             lit: o[LIT] != 0.0,
             point: v3(POINT),
@@ -213,6 +217,12 @@ fn lane<const W: usize>(
     set(col_out::WI, wi_w.x);
     set(col_out::WI + 1, wi_w.y);
     set(col_out::WI + 2, wi_w.z);
+    // The next leg leaves on the normal's side (a Lambert draw is never below it), as
+    // `Shader::pushed_off` puts it in a frame at rest.
+    let next = x + cols[EPSILON][j] * nf;
+    set(col_out::NEXT, next.x);
+    set(col_out::NEXT + 1, next.y);
+    set(col_out::NEXT + 2, next.z);
     // Next-event estimation: a point on the sphere, drawn in the cone it fills from the
     // vertex; the shadow ray leaves ε off the surface on the light's side.
     let (center, radius) = (get(CENTER), cols[RADIUS][j]);

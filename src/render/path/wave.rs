@@ -17,7 +17,7 @@
 use super::bsdf::{Basis, Lobes};
 use super::lanes::{DiffuseIn, DiffuseLanes};
 use super::nee::Gather;
-use super::{Leg, Path, PathTracer, Reached, Spot};
+use super::{Came, Leg, Path, PathTracer, Reached};
 use crate::geometry::Primitive;
 use crate::render::band::Band;
 use crate::render::shade::Spread;
@@ -45,8 +45,6 @@ struct Queued<B> {
     event: Event,
     nf: DVec3,
     v: DVec3,
-    /// The lookback factor of the ray that met it, there.
-    hit_s: f64,
     /// The frame's wavelengths over the camera's.
     shift: f64,
     within: Option<(usize, u32)>,
@@ -301,7 +299,7 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
                 }
             }
         };
-        self.queue_lambert(&v, hit.s, within, slot, (path, rng, out), lanes);
+        self.queue_lambert(&v, within, slot, (path, rng, out), lanes);
         None
     }
 
@@ -354,7 +352,6 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
     fn queue_lambert(
         &self,
         l: &Lambert<B>,
-        hit_s: f64,
         within: Option<(usize, u32)>,
         slot: u32,
         (path, rng, out): (&mut Path<B>, &mut Rng, &mut B),
@@ -411,7 +408,6 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
             event: l.event,
             nf: l.nf,
             v: l.v,
-            hit_s,
             shift: l.shift,
             within,
             diffuse: l.diffuse,
@@ -502,14 +498,20 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
             if self.roulette(depth, path, &mut w.rngs[k]).is_none() {
                 continue;
             }
-            let spot = Spot {
-                group: q.group,
-                event: q.event,
-                nf: q.nf,
-                glass: None,
+            // `leg_after` in a frame at rest: the ray starts ε off the surface, its direction
+            // and lookback factors the world frame's; a diffuse bounce keeps no bundle.
+            let origin = Event::new(q.event.t + 0.0, o.next);
+            path.came = Some(Came {
+                pdf: o.pdf,
+                from: origin,
+                s: 1.0,
+            });
+            path.spread = Spread { sr: 0.0, s: 1.0 };
+            w.legs[k] = Leg::Null {
+                ray: NullRay::new(origin, o.wi),
+                receiver_s: 1.0,
+                within: q.within,
             };
-            let (pdf, wi) = (Some(o.pdf), o.wi);
-            w.legs[k] = self.leg_after(&spot, q.hit_s, q.within, wi, true, pdf, path);
             w.next.push(q.slot);
         }
     }

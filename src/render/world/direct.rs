@@ -78,12 +78,9 @@ impl Chunk {
 pub(super) fn intersect(prims: &[Primitive], rays: &[Ray], hits: &mut [Option<Hit>], simd: bool) {
     for (rs, hs) in rays.chunks(WIDTH).zip(hits.chunks_mut(WIDTH)) {
         let mut c = Chunk::of(rs);
-        for (i, p) in prims.iter().enumerate() {
-            if simd {
-                test_lanes(p, i as u32, &mut c);
-            } else {
-                test_all(p, i as u32, &mut c);
-            }
+        match simd {
+            true => test_lanes(prims, &mut c, false),
+            false => test_prims(prims, &mut c, false),
         }
         for (j, h) in hs.iter_mut().enumerate() {
             *h = (c.prim[j] != u32::MAX).then_some(Hit {
@@ -98,16 +95,11 @@ pub(super) fn intersect(prims: &[Primitive], rays: &[Ray], hits: &mut [Option<Hi
 pub(super) fn occluded(prims: &[Primitive], rays: &[Ray], out: &mut [bool], simd: bool) {
     for (rs, os) in rays.chunks(WIDTH).zip(out.chunks_mut(WIDTH)) {
         let mut c = Chunk::of(rs);
-        for (i, p) in prims.iter().enumerate() {
-            if simd {
-                test_lanes(p, i as u32, &mut c);
-            } else {
-                test_all(p, i as u32, &mut c);
-            }
-            // The rays met by then need no more tests, but the rest of the chunk does.
-            if c.prim[..rs.len()].iter().all(|&p| p != u32::MAX) {
-                break;
-            }
+        // Lanes past the rays count as met, so the chunk stops once its rays are.
+        c.prim[rs.len()..].iter_mut().for_each(|p| *p = 0);
+        match simd {
+            true => test_lanes(prims, &mut c, true),
+            false => test_prims(prims, &mut c, true),
         }
         for (j, o) in os.iter_mut().enumerate() {
             *o = c.prim[j] != u32::MAX;
@@ -115,9 +107,20 @@ pub(super) fn occluded(prims: &[Primitive], rays: &[Ray], out: &mut [bool], simd
     }
 }
 
+/// Every primitive against the chunk's lanes (`any`: until every lane has met something).
 #[multiversion(targets("x86_64+avx512f+avx512dq+avx512vl", "x86_64+avx2"))]
-fn test_lanes(p: &Primitive, i: u32, c: &mut Chunk) {
-    test_all(p, i, c);
+fn test_lanes(prims: &[Primitive], c: &mut Chunk, any: bool) {
+    test_prims(prims, c, any);
+}
+
+#[inline(always)]
+fn test_prims(prims: &[Primitive], c: &mut Chunk, any: bool) {
+    for (i, p) in prims.iter().enumerate() {
+        test_all(p, i as u32, c);
+        if any && c.prim.iter().all(|&p| p != u32::MAX) {
+            break;
+        }
+    }
 }
 
 /// Primitive `p` (number `i`) against every lane, each lane's best hit kept.
