@@ -122,6 +122,14 @@ impl DiffuseLanes {
         ]);
     }
 
+    /// Vertex i's shading normal and the direction its path looked along (as pushed).
+    pub fn normal_and_look(&self, i: usize) -> (DVec3, DVec3) {
+        use col_in::*;
+        let r = &self.ins[i];
+        let v3 = |k: usize| DVec3::new(r[k], r[k + 1], r[k + 2]);
+        (v3(NF), v3(V))
+    }
+
     /// Vertex i's results (after [`DiffuseLanes::run`]).
     pub fn out(&self, i: usize) -> DiffuseOut {
         use col_out::*;

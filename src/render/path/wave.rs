@@ -43,8 +43,6 @@ struct Queued<B> {
     slot: u32,
     group: usize,
     event: Event,
-    nf: DVec3,
-    v: DVec3,
     /// The frame's wavelengths over the camera's.
     shift: f64,
     within: Option<(usize, u32)>,
@@ -55,13 +53,13 @@ struct Queued<B> {
 }
 
 impl<B> Queued<B> {
-    /// Where next-event estimation gathers light for it.
-    fn gather(&self) -> Gather {
+    /// Where next-event estimation gathers light for it (its shading normal `nf`).
+    fn gather(&self, nf: DVec3) -> Gather {
         Gather {
             group: self.group,
             event: self.event,
             shift: self.shift,
-            nf: Some(self.nf),
+            nf: Some(nf),
             within: self.within,
         }
     }
@@ -335,7 +333,8 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
             return Plain::Ends;
         }
         let n = g.with_prim(hit.prim, |p| p.normal(hit.point));
-        let v = hit.dir / hit.s;
+        // hit.s is 1 in a frame at rest, where x / 1 is x.
+        let v = if hit.s == 1.0 { hit.dir } else { hit.dir / hit.s };
         let nf = if n.dot(v) > 0.0 { -n } else { n };
         Plain::Lambert(Lambert {
             group: hit.group,
@@ -406,8 +405,6 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
             slot,
             group: l.group,
             event: l.event,
-            nf: l.nf,
-            v: l.v,
             shift: l.shift,
             within,
             diffuse: l.diffuse,
@@ -449,14 +446,15 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
                 // The vertex or the shadow ray's start is inside the sphere: no cone to draw
                 // from or to weigh the draw by; alone, from the same numbers.
                 let lobes = Lobes::lambert(q.diffuse);
-                let basis = Basis::new(q.nf);
-                let wo = basis.to_local(-q.v);
+                let (nf, v) = lanes.normal_and_look(i);
+                let basis = Basis::new(nf);
+                let wo = basis.to_local(-v);
                 let scatter = |wi: DVec3| {
                     let l = basis.to_local(wi);
                     let (f, pdf) = lobes.eval(wo, l);
                     (f * l.z.abs(), pdf)
                 };
-                let here = q.gather();
+                let here = q.gather(nf);
                 let out = &mut w.outs[k];
                 self.emitter_light_drawn(&here, &scatter, beta, pick, u, out);
                 continue;
