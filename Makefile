@@ -45,6 +45,7 @@ test: setup
 	  if REST_EMBREE_ISA=$$isa ./target/release/rest-embree backends >/dev/null 2>&1; then \
 	    echo "conformance under REST_EMBREE_ISA=$$isa"; \
 	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test backend_conformance --test meshes --test radar --test worldline --test shutter --test spin --test acceleration --test wigner_rotation --test turning -q || exit 1; \
+	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test path the_lanes_change_no_picture -q || exit 1; \
 	  fi; \
 	done
 	scripts/slurm-test.sh target/release/rest-embree

@@ -334,7 +334,11 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
         }
         let n = g.with_prim(hit.prim, |p| p.normal(hit.point));
         // hit.s is 1 in a frame at rest, where x / 1 is x.
-        let v = if hit.s == 1.0 { hit.dir } else { hit.dir / hit.s };
+        let v = if hit.s == 1.0 {
+            hit.dir
+        } else {
+            hit.dir / hit.s
+        };
         let nf = if n.dot(v) > 0.0 { -n } else { n };
         Plain::Lambert(Lambert {
             group: hit.group,
