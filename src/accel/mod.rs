@@ -133,15 +133,6 @@ pub trait Accelerator: Send + Sync {
     fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]);
     /// For each active ray, whether anything lies at `tmin < t < tmax` (inactive: false).
     fn occluded(&self, rays: &[Ray], out: &mut [bool]);
-    /// [`Accelerator::intersect`] for rays that share neither origin nor direction (a bounce
-    /// of many paths): a backend whose packets assume coherent rays traces them otherwise.
-    fn intersect_scattered(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        self.intersect(rays, hits)
-    }
-    /// [`Accelerator::occluded`] for scattered rays (as [`Accelerator::intersect_scattered`]).
-    fn occluded_scattered(&self, rays: &[Ray], out: &mut [bool]) {
-        self.occluded(rays, out)
-    }
     /// Whether `intersect_fan` serves fans of primary rays (here, on this CPU).
     fn serves_fans(&self) -> bool {
         false
@@ -163,12 +154,6 @@ impl<A: Accelerator + ?Sized> Accelerator for Arc<A> {
     }
     fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
         (**self).occluded(rays, out)
-    }
-    fn intersect_scattered(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        (**self).intersect_scattered(rays, hits)
-    }
-    fn occluded_scattered(&self, rays: &[Ray], out: &mut [bool]) {
-        (**self).occluded_scattered(rays, out)
     }
     fn serves_fans(&self) -> bool {
         (**self).serves_fans()

@@ -333,42 +333,6 @@ impl EmbreeAccel {
         }
     }
 
-    /// Closest hits of `rays`, one by one or in packets of the backend's width, as `query`.
-    fn intersect_as(&self, rays: &[Ray], hits: &mut [Option<Hit>], query: packet::Query) {
-        packet::flush_denormals();
-        if rays.len() == 1 || self.width == 1 {
-            for (r, h) in rays.iter().zip(hits.iter_mut()) {
-                *h = self.intersect1(r);
-            }
-            return;
-        }
-        for (rs, hs) in rays.chunks(self.width).zip(hits.chunks_mut(self.width)) {
-            match self.width {
-                16 => self.intersect16(rs, hs, query),
-                8 => self.intersect8(rs, hs, query),
-                _ => self.intersect4(rs, hs, query),
-            }
-        }
-    }
-
-    /// Whether anything lies on each of `rays`, as [`EmbreeAccel::intersect_as`].
-    fn occluded_as(&self, rays: &[Ray], out: &mut [bool], query: packet::Query) {
-        packet::flush_denormals();
-        if rays.len() == 1 || self.width == 1 {
-            for (r, o) in rays.iter().zip(out.iter_mut()) {
-                *o = self.occluded1(r);
-            }
-            return;
-        }
-        for (rs, os) in rays.chunks(self.width).zip(out.chunks_mut(self.width)) {
-            match self.width {
-                16 => self.occluded16(rs, os, query),
-                8 => self.occluded8(rs, os, query),
-                _ => self.occluded4(rs, os, query),
-            }
-        }
-    }
-
     /// Embree's hit back in the caller's units: exact already for user geometry (`exact_t`,
     /// from the context), else refined in f64 on the primitive that was hit (Embree's t is
     /// t · `scale(r.len)` + `offset`, `EmbreeRay::offset`).
@@ -404,19 +368,37 @@ impl EmbreeAccel {
 
 impl Accelerator for EmbreeAccel {
     fn intersect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        self.intersect_as(rays, hits, packet::Query::Intersect);
+        packet::flush_denormals();
+        if rays.len() == 1 || self.width == 1 {
+            for (r, h) in rays.iter().zip(hits.iter_mut()) {
+                *h = self.intersect1(r);
+            }
+            return;
+        }
+        for (rs, hs) in rays.chunks(self.width).zip(hits.chunks_mut(self.width)) {
+            match self.width {
+                16 => self.intersect16(rs, hs),
+                8 => self.intersect8(rs, hs),
+                _ => self.intersect4(rs, hs),
+            }
+        }
     }
 
     fn occluded(&self, rays: &[Ray], out: &mut [bool]) {
-        self.occluded_as(rays, out, packet::Query::Occluded);
-    }
-
-    fn intersect_scattered(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        self.intersect_as(rays, hits, packet::Query::Scattered);
-    }
-
-    fn occluded_scattered(&self, rays: &[Ray], out: &mut [bool]) {
-        self.occluded_as(rays, out, packet::Query::Scattered);
+        packet::flush_denormals();
+        if rays.len() == 1 || self.width == 1 {
+            for (r, o) in rays.iter().zip(out.iter_mut()) {
+                *o = self.occluded1(r);
+            }
+            return;
+        }
+        for (rs, os) in rays.chunks(self.width).zip(out.chunks_mut(self.width)) {
+            match self.width {
+                16 => self.occluded16(rs, os),
+                8 => self.occluded8(rs, os),
+                _ => self.occluded4(rs, os),
+            }
+        }
     }
 
     fn serves_fans(&self) -> bool {

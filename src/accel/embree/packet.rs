@@ -79,7 +79,7 @@ macro_rules! packet_fns {
                 })
             }
 
-            pub(super) fn $isect(&self, rays: &[Ray], hits: &mut [Option<Hit>], query: Query) {
+            pub(super) fn $isect(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
                 $RayHitN::with(|rh| {
                     let mut valid = Valid([0i32; $n]);
                     let lanes = Lanes::<$n>::new(rays, self.pullback);
@@ -90,7 +90,7 @@ macro_rules! packet_fns {
                         rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
                     }
                     deactivate_from(&mut rh.ray, rays.len());
-                    let mut ctx = self.context(query, rays, &lanes);
+                    let mut ctx = self.context(Query::Intersect, rays, &lanes);
                     unsafe { self.scene.rtc.$isect_q(&valid, ctx.raw(), rh) };
                     self.settle(&ctx);
                     if let Some(runs) = self.scene.exact_runs {
@@ -129,7 +129,7 @@ macro_rules! packet_fns {
                 })
             }
 
-            pub(super) fn $occl(&self, rays: &[Ray], out: &mut [bool], query: Query) {
+            pub(super) fn $occl(&self, rays: &[Ray], out: &mut [bool]) {
                 $RayN::with(|ray| {
                     let mut valid = Valid([0i32; $n]);
                     let lanes = Lanes::<$n>::new(rays, self.pullback);
@@ -139,7 +139,7 @@ macro_rules! packet_fns {
                         lanes.offset[i].set(e.offset);
                     }
                     deactivate_from(ray, rays.len());
-                    let mut ctx = self.context(query, rays, &lanes);
+                    let mut ctx = self.context(Query::Occluded, rays, &lanes);
                     unsafe { self.scene.rtc.$occl_q(&valid, ctx.raw(), ray) };
                     self.settle(&ctx);
                     for i in 0..rays.len() {
@@ -271,8 +271,6 @@ pub(super) enum Query {
     Occluded,
     /// One ray, or bare rays (incoherent).
     Single,
-    /// A packet of rays that share neither origin nor direction (a bounce of many paths).
-    Scattered,
 }
 
 impl EmbreeAccel {
@@ -293,7 +291,7 @@ impl EmbreeAccel {
         let coherent = match query {
             Query::Intersect => true,
             Query::Occluded => self.scene.coherent_occlusion,
-            Query::Single | Query::Scattered => false,
+            Query::Single => false,
         };
         let inject = self.device.injection();
         ExactContext::new(coherent, rays, lanes, self.scene.center, inject)

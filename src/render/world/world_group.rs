@@ -87,10 +87,15 @@ impl WorldGroup {
             return;
         }
         if let Some(accel) = &self.accel {
-            return match scattered {
-                true => accel.intersect_scattered(rays, hits),
-                false => accel.intersect(rays, hits),
-            };
+            // Rays from anywhere go one by one: a packet of them costs an accelerator the
+            // union of their traversals (the paper's lattice on Embree: 1.25x the time).
+            if scattered {
+                for (r, h) in rays.iter().zip(hits.iter_mut()) {
+                    accel.intersect(std::slice::from_ref(r), std::slice::from_mut(h));
+                }
+                return;
+            }
+            return accel.intersect(rays, hits);
         }
         if let Some(d) = &self.direct {
             return super::direct::intersect(&d.prims, rays, hits, self.simd);
@@ -131,10 +136,13 @@ impl WorldGroup {
             return;
         }
         if let Some(accel) = &self.accel {
-            return match scattered {
-                true => accel.occluded_scattered(rays, out),
-                false => accel.occluded(rays, out),
-            };
+            if scattered {
+                for (r, o) in rays.iter().zip(out.iter_mut()) {
+                    accel.occluded(std::slice::from_ref(r), std::slice::from_mut(o));
+                }
+                return;
+            }
+            return accel.occluded(rays, out);
         }
         if let Some(d) = &self.direct {
             return super::direct::occluded(&d.prims, rays, out, self.simd);
