@@ -64,11 +64,18 @@ bench: setup
 	$(CARGO) build --release
 	./target/release/rest-embree bench --threads 2
 
-# Everything in docs/ that is generated: the bench's figures (docs/bench, docs/performance.md),
+# Everything in docs/ that is generated: the bench's figures (docs/bench, docs/performance.md,
+# with the path integrator beside Mitsuba 3 where it is installed),
 # the accuracy table (docs/ACCURACY.md) and the README's pictures (docs/img).
 docs: setup
 	$(CARGO) build --release
 	./target/release/rest-embree bench --threads 2 --out docs/bench
+	@# The path integrator beside Mitsuba 3, where it is installed (a bench, not a test).
+	@if python3 -c 'import mitsuba, OpenEXR, numpy' 2>/dev/null; then \
+	  python3 scripts/mitsuba-compare.py --out docs/bench/mitsuba.md; \
+	else \
+	  echo "docs: Mitsuba 3 not installed (pip install mitsuba==3.9.1 OpenEXR numpy; apt-get install libllvm19): docs/bench/mitsuba.md kept as it is"; \
+	fi
 	scripts/performance-doc.sh
 	scripts/accuracy-table.sh
 	scripts/readme-images.sh

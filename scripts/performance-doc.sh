@@ -81,5 +81,18 @@ HEAD
 sed -e '1{/^Measured with/d}' "$bench"
 echo
 echo '![run time against error](bench/bench.svg)'
+echo
+echo '## The path integrator beside Mitsuba 3'
+echo
+echo 'The closed room of scenes/room.toml, rendered by rest-embree and by Mitsuba 3 in one run'
+echo '(scripts/mitsuba-compare.py; `make docs` runs it where Mitsuba is installed). Targets (issue'
+echo "49): the time to Mitsuba's error at most Mitsuba's whole process, a sample at most 1.5x"
+echo "Mitsuba's warm render, the noise at equal samples within 3% of Mitsuba's."
+echo
+if [ -f docs/bench/mitsuba.md ]; then
+  cat docs/bench/mitsuba.md
+else
+  echo 'Not measured: Mitsuba 3 was not installed where `make docs` ran (`pip install mitsuba`).'
+fi
 } > docs/performance.md
 echo "performance-doc: wrote docs/performance.md"

@@ -130,6 +130,10 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         }
         summary.push_str(&bench_lattice::summary(args.quick, &accel::backend_names()));
         summary.push_str(&bench::path_noise(args.quick, &accel::backend_names())?);
+        summary.push_str(&bench::path_room(
+            args.quick,
+            accel::default_backend_name(),
+        )?);
         summary.push_str(&bench::exr_writing(
             args.quick,
             accel::default_backend_name(),
