@@ -98,7 +98,7 @@ impl Placement {
 
 /// Data at a mesh's triangles' corners, by triangle in the part's order: vertex normals (for
 /// smooth shading) and texture coordinates.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Default, PartialEq)]
 pub struct Corners {
     /// Each corner's normal (unit, outward as the file gives it).
     pub normals: Option<Vec<[DVec3; 3]>>,
@@ -107,12 +107,25 @@ pub struct Corners {
     pub uvs: Option<Vec<[[f64; 2]; 3]>>,
 }
 
+/// Its counts and a digest of its numbers, as [`Geometry`]'s.
+impl std::fmt::Debug for Corners {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut d = super::digest::Digest::new();
+        super::digest::corners(&mut d, self);
+        f.debug_struct("Corners")
+            .field("normals", &self.normals.as_ref().map(Vec::len))
+            .field("uvs", &self.uvs.as_ref().map(Vec::len))
+            .field("digest", &format_args!("{:016x}", d.finish()))
+            .finish()
+    }
+}
+
 /// The static geometry of one velocity group, in its rest frame.
 ///
 /// Primitives are numbered from 0: first those held in `prims`, then those of the objects held
 /// as themselves, each a run of numbers (`ImplicitRun`). Read one by number with
 /// [`prim`](Self::prim).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Default)]
 pub struct Geometry {
     /// The primitives held one by one: numbers 0 to `prims.len()`.
     pub prims: Vec<Primitive>,
@@ -121,6 +134,22 @@ pub struct Geometry {
     /// Objects held as themselves (lattices, bar arrays), whose primitives are made from their
     /// numbers, after `prims`, in order.
     pub implicit: Vec<ImplicitRun>,
+}
+
+/// Its counts and a digest of its numbers (`digest.rs`), not every number as text: a mesh of
+/// millions of triangles printed in full was most of the time a render took to name itself.
+impl std::fmt::Debug for Geometry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Geometry")
+            .field("prims", &self.prims.len())
+            .field("parts", &self.parts.len())
+            .field("implicit", &self.implicit.len())
+            .field(
+                "digest",
+                &format_args!("{:016x}", super::digest::geometry(self)),
+            )
+            .finish()
+    }
 }
 
 /// An object held as itself: its primitives are numbers `first ..` `first + shape.len()`.

@@ -7,11 +7,24 @@ use super::{Aabb, Primitive};
 use glam::DVec3;
 
 /// Vertices and triangles, in the group's rest frame.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct IndexedMesh {
     positions: Vec<DVec3>,
     triangles: Vec<[u32; 3]>,
     bounds: Aabb,
+}
+
+/// Its counts and a digest of its numbers, as [`Geometry`](super::Geometry)'s.
+impl std::fmt::Debug for IndexedMesh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut d = super::digest::Digest::new();
+        super::digest::mesh(&mut d, self);
+        f.debug_struct("IndexedMesh")
+            .field("positions", &self.positions.len())
+            .field("triangles", &self.triangles.len())
+            .field("digest", &format_args!("{:016x}", d.finish()))
+            .finish()
+    }
 }
 
 impl IndexedMesh {

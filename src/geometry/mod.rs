@@ -6,6 +6,7 @@
 mod aabb;
 mod bars;
 mod box_tree;
+mod digest;
 mod group_geometry;
 mod implicit;
 mod indexed_mesh;

@@ -166,8 +166,10 @@ pub(crate) const RENDER_ID: &str = "renderId";
 /// value, the view time and the image settings but the crop included, overrides applied), the
 /// backend and the overrides as given. Two files with the same id are frames of the same render settings:
 /// `--resume` skips only a frame whose file says so. The hash is std's (SipHash with fixed
-/// keys), fed the scene's debug text as it is formatted, with no copy of it; another build of
-/// the compiler may hash differently, which costs a frame rendered again, nothing more.
+/// keys), fed the scene's debug text as it is formatted, with no copy of it; a geometry's bulk
+/// (primitives, mesh vertices and indices, corner data) stands there as its counts and a
+/// digest of its bits (`geometry::digest`), not as text. Another build of the compiler may hash
+/// differently, which costs a frame rendered again, nothing more.
 pub(crate) fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> String {
     use std::fmt::Write as _;
     use std::hash::Hasher;

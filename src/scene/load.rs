@@ -286,9 +286,13 @@ fn group(
     let mut geometry = Geometry::default();
     for o in t.tables("object")? {
         let id = objects.len() as u32;
-        let (first, implicit) = (geometry.prims.len(), geometry.implicit.len());
+        let (first, implicit, parts) = (
+            geometry.prims.len(),
+            geometry.implicit.len(),
+            geometry.parts.len(),
+        );
         let kind = add_object(&o, id, material_ids, &mut geometry, total)?;
-        check_object(&o, id, &kind, &geometry, materials, (first, implicit))?;
+        check_object(&o, &kind, &geometry, materials, (first, implicit, parts))?;
         objects.push(ObjectInfo {
             name: o.string("name")?.map(str::to_string),
             kind,
@@ -376,17 +380,18 @@ fn holds_glass_or_media(geometry: &Geometry, materials: &[Material]) -> bool {
 }
 
 /// Refuse an object just added to `geometry` (its held primitives from `first`, its implicit
-/// ones from `implicit`) that an image texture cannot be mapped onto, or that reaches farther
-/// than coordinates may.
+/// ones from `implicit`, its parts from `parts`: an object's parts are the last added, so a
+/// group of many objects is checked in time linear in them) that an image texture cannot be
+/// mapped onto, or that reaches farther than coordinates may.
 fn check_object(
     o: &Table,
-    id: u32,
     kind: &str,
     geometry: &Geometry,
     materials: &[Material],
-    (first, implicit): (usize, usize),
+    (first, implicit, parts): (usize, usize, usize),
 ) -> SceneResult<()> {
-    let spins_inside = geometry.parts.iter().filter(|p| p.object == id).any(|p| {
+    let own = &geometry.parts[parts..];
+    let spins_inside = own.iter().any(|p| {
         let m = &materials[p.material as usize];
         p.spin.is_some() && (m.transmit > 0.0 || m.medium.is_some())
     });
@@ -406,20 +411,16 @@ fn check_object(
             .any(|t| matches!(**t, Texture::Image(_)))
     };
     // (A box turned into triangles keeps its box's mapping through its placement.)
-    let unmapped = geometry
-        .parts
-        .iter()
-        .filter(|p| p.object == id)
-        .any(|part| {
-            let triangles = matches!(
-                geometry.prim(part.start),
-                crate::geometry::Primitive::Triangle { .. }
-            );
-            triangles
-                && imaged(part.material)
-                && part.corners.as_ref().is_none_or(|c| c.uvs.is_none())
-                && part.placement.as_ref().is_none_or(|pl| pl.shape.is_none())
-        });
+    let unmapped = own.iter().any(|part| {
+        let triangles = matches!(
+            geometry.prim(part.start),
+            crate::geometry::Primitive::Triangle { .. }
+        );
+        triangles
+            && imaged(part.material)
+            && part.corners.as_ref().is_none_or(|c| c.uvs.is_none())
+            && part.placement.as_ref().is_none_or(|pl| pl.shape.is_none())
+    });
     if unmapped {
         return Err(o.error(
             "material",

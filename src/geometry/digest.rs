@@ -1,0 +1,151 @@
+//! A 64-bit digest of a geometry's bulk data (its primitives, parts, mesh vertices and
+//! indices, corner normals and texture coordinates), taken from the numbers' bits with xxh3:
+//! what a geometry's debug text shows in place of the numbers themselves, so that the render
+//! id (`output::header::render_id`, a hash of the scene's debug text) costs a pass over the
+//! bytes, not the formatting of every vertex as decimal text.
+
+use super::{Corners, Geometry, Implicit, IndexedMesh, Primitive};
+use xxhash_rust::xxh3::Xxh3;
+
+/// A running digest.
+pub(crate) struct Digest(Xxh3);
+
+impl Digest {
+    pub fn new() -> Digest {
+        Digest(Xxh3::new())
+    }
+
+    pub fn f64(&mut self, x: f64) {
+        self.0.update(&x.to_bits().to_le_bytes());
+    }
+
+    pub fn f64s(&mut self, xs: &[f64]) {
+        for &x in xs {
+            self.f64(x);
+        }
+    }
+
+    pub fn u32(&mut self, x: u32) {
+        self.0.update(&x.to_le_bytes());
+    }
+
+    pub fn bytes(&mut self, b: &[u8]) {
+        self.0.update(b);
+    }
+
+    pub fn finish(&self) -> u64 {
+        self.0.digest()
+    }
+}
+
+fn primitive(d: &mut Digest, p: &Primitive) {
+    match *p {
+        Primitive::Sphere { center, radius } => {
+            d.u32(0);
+            d.f64s(&[center.x, center.y, center.z, radius]);
+        }
+        Primitive::Capsule { a, b, radius } => {
+            d.u32(1);
+            d.f64s(&[a.x, a.y, a.z, b.x, b.y, b.z, radius]);
+        }
+        Primitive::Cuboid { min, max } => {
+            d.u32(2);
+            d.f64s(&[min.x, min.y, min.z, max.x, max.y, max.z]);
+        }
+        Primitive::Triangle { v } => {
+            d.u32(3);
+            for p in v {
+                d.f64s(&[p.x, p.y, p.z]);
+            }
+        }
+    }
+}
+
+/// A mesh's corner data into `d`.
+pub(crate) fn corners(d: &mut Digest, c: &Corners) {
+    if let Some(n) = &c.normals {
+        d.u32(n.len() as u32);
+        for v in n.iter().flatten() {
+            d.f64s(&[v.x, v.y, v.z]);
+        }
+    }
+    if let Some(t) = &c.uvs {
+        d.u32(t.len() as u32 | 1 << 31);
+        for uv in t.iter().flatten() {
+            d.f64s(uv);
+        }
+    }
+}
+
+/// A mesh's vertices and triangles into `d`.
+pub(crate) fn mesh(d: &mut Digest, m: &IndexedMesh) {
+    let (positions, triangles) = (m.positions(), m.triangles());
+    d.u32(positions.len() as u32);
+    for p in positions {
+        d.f64s(&[p.x, p.y, p.z]);
+    }
+    d.u32(triangles.len() as u32);
+    for t in triangles {
+        for &i in t {
+            d.u32(i);
+        }
+    }
+}
+
+/// The digest of everything in `g`.
+pub(crate) fn geometry(g: &Geometry) -> u64 {
+    let mut d = Digest::new();
+    d.u32(g.prims.len() as u32);
+    for p in &g.prims {
+        primitive(&mut d, p);
+    }
+    for part in &g.parts {
+        for x in [part.start, part.end, part.object, part.material] {
+            d.u32(x);
+        }
+        if let Some(c) = &part.corners {
+            corners(&mut d, c);
+        }
+        if let Some(pl) = &part.placement {
+            d.bytes(format!("{:?}", **pl).as_bytes());
+        }
+        if let Some(sp) = &part.spin {
+            d.bytes(format!("{sp:?}").as_bytes());
+        }
+    }
+    for run in &g.implicit {
+        d.u32(run.first);
+        match &run.shape {
+            Implicit::Mesh(m) => mesh(&mut d, m),
+            other => d.bytes(format!("{other:?}").as_bytes()),
+        }
+    }
+    d.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// Any change of a number changes the digest; the same numbers give the same one.
+    #[test]
+    fn a_changed_vertex_changes_the_digest() {
+        let tri = |z: f64| Primitive::Triangle {
+            v: [DVec3::ZERO, DVec3::X, DVec3::new(0.0, 1.0, z)],
+        };
+        let mut a = Geometry::default();
+        a.push_part(0, 0, [tri(0.0), tri(1.0)]);
+        let mut b = Geometry::default();
+        b.push_part(0, 0, [tri(0.0), tri(1.0)]);
+        assert_eq!(geometry(&a), geometry(&b));
+        let mut c = Geometry::default();
+        c.push_part(0, 0, [tri(0.0), tri(1.0 + 1e-15)]);
+        assert_ne!(geometry(&a), geometry(&c));
+        let mut e = Geometry::default();
+        e.push_part(0, 1, [tri(0.0), tri(1.0)]);
+        assert_ne!(geometry(&a), geometry(&e), "another material");
+        let text = format!("{a:?}");
+        assert!(text.contains("digest") && text.len() < 200, "{text}");
+    }
+}
