@@ -672,3 +672,101 @@ fn ctrl_c_stops_it_cleanly() {
         "no longer listening"
     );
 }
+
+/// The server's resident memory, from /proc (MiB).
+fn rss_mib(pid: u32) -> f64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+    status
+        .lines()
+        .find(|l| l.starts_with("VmRSS:"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|k| k.parse::<f64>().ok())
+        .map_or(0.0, |k| k / 1024.0)
+}
+
+/// Abuse without the token (and some with it) leaves the server up, small and answering: a
+/// body claimed to be 40 GB, a head of megabytes, two Host headers, more connections than it
+/// takes trickling their heads a byte at a time while a request with the token is answered
+/// within 5 s; a body that never finishes gets 408 (docs/viewer.md, "Limits").
+#[test]
+fn abuse_neither_kills_nor_fills_nor_stalls_it() {
+    let v = start("scenes/lattice.toml", "abuse");
+    let pid = v.child.id();
+    let host = format!("127.0.0.1:{}", v.port);
+    let send = |bytes: &[u8]| -> (Option<u16>, Vec<u8>) {
+        let mut s = TcpStream::connect(("127.0.0.1", v.port)).unwrap();
+        s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+        let _ = s.write_all(bytes);
+        let mut all = Vec::new();
+        let _ = s.read_to_end(&mut all);
+        let status = String::from_utf8_lossy(&all)
+            .split(' ')
+            .nth(1)
+            .and_then(|c| c.parse().ok());
+        (status, all)
+    };
+    // 40 GB claimed, without the token and with it: answered without a byte of it read.
+    for (target, want) in [
+        ("/api/frame".to_string(), 403),
+        (v.with_token("/api/frame"), 413),
+    ] {
+        let head = format!(
+            "POST {target} HTTP/1.1\r\nHost: {host}\r\nContent-Length: 40000000000\r\n\r\n{{"
+        );
+        let t0 = Instant::now();
+        let (status, _) = send(head.as_bytes());
+        assert_eq!(status, Some(want), "{target}");
+        assert!(t0.elapsed() < Duration::from_secs(5));
+    }
+    // A head of 4 MB: refused (431) or the connection closed, never held.
+    let huge = format!(
+        "GET /api/status HTTP/1.1\r\nHost: {host}\r\nX-Junk: {}\r\n\r\n",
+        "a".repeat(4 << 20)
+    );
+    let (status, _) = send(huge.as_bytes());
+    assert!(matches!(status, None | Some(431)), "{status:?}");
+    // Two Host headers.
+    let two = format!(
+        "GET {} HTTP/1.1\r\nHost: {host}\r\nHost: evil.example\r\nConnection: close\r\n\r\n",
+        v.with_token("/api/status")
+    );
+    assert_eq!(send(two.as_bytes()).0, Some(400));
+    // A body that stops coming: 408 within the body's time.
+    let mut s = TcpStream::connect(("127.0.0.1", v.port)).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    let head = format!(
+        "POST {} HTTP/1.1\r\nHost: {host}\r\nContent-Length: 100\r\n\r\n{{\"a\"",
+        v.with_token("/api/save")
+    );
+    s.write_all(head.as_bytes()).unwrap();
+    let mut reply = Vec::new();
+    let _ = s.read_to_end(&mut reply);
+    assert!(String::from_utf8_lossy(&reply).starts_with("HTTP/1.1 408"));
+    // 300 connections trickling their heads: the token's request is answered within 5 s
+    // (served, or 503 where every connection is taken), and served once theirs time out.
+    let mut slow: Vec<TcpStream> = (0..300)
+        .filter_map(|_| TcpStream::connect(("127.0.0.1", v.port)).ok())
+        .collect();
+    for s in &mut slow {
+        let _ = s.write_all(b"GET / HTTP/1.1\r\nHo");
+    }
+    let t0 = Instant::now();
+    let (status, _) = send(
+        format!(
+            "GET {} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n",
+            v.with_token("/api/status")
+        )
+        .as_bytes(),
+    );
+    assert!(
+        t0.elapsed() < Duration::from_secs(5),
+        "waited {:?}",
+        t0.elapsed()
+    );
+    assert!(matches!(status, Some(200 | 503)), "{status:?}");
+    std::thread::sleep(Duration::from_secs(4));
+    assert_eq!(v.get("/api/status").status, 200, "served again");
+    drop(slow);
+    assert!(rss_mib(pid) < 300.0, "{} MiB", rss_mib(pid));
+    assert_eq!(v.get("/api/scene").status, 200, "still serving");
+}

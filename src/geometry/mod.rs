@@ -25,6 +25,7 @@ pub use indexed_mesh::IndexedMesh;
 pub use lattice::Lattice;
 pub(crate) use light_buffer::LightBuffer;
 pub use primitive::Primitive;
+pub(crate) use primitive::ball_crossings;
 #[cfg(feature = "embree")]
-pub(crate) use primitive::{ball_crossings, capsule_hit, cuboid_hit, cylinder_crossings, AxisRod};
+pub(crate) use primitive::{capsule_hit, cuboid_hit, cylinder_crossings, AxisRod};
 pub(crate) use real::Real;

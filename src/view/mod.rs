@@ -1,6 +1,7 @@
 //! `rest-embree view SCENE`: the scene in the browser, its velocities, camera and passes on
-//! controls, refined while nothing changes (docs/viewer.md). A local web server (tiny_http)
-//! on 127.0.0.1 by default, behind a random token, the Host and the Origin (`access.rs`); the
+//! controls, refined while nothing changes (docs/viewer.md). A local web server (hyper over
+//! tokio, bounded in what it reads and how long it waits: `server.rs`) on 127.0.0.1 by
+//! default, behind a random token, the Host and the Origin (`access.rs`); the
 //! view's values become edits of the scene file (`edits.rs`), rendered at a ladder of levels
 //! and cancelled by a newer view (`frames.rs`), or saved and rendered to an EXR in the
 //! background (`jobs.rs`); the page is one file of HTML, style and script in the binary.
@@ -10,6 +11,7 @@ mod edits;
 mod frames;
 mod jobs;
 mod routes;
+mod server;
 
 use crate::accel::Backend;
 use crate::render::Frame;
@@ -35,8 +37,6 @@ pub(crate) struct Config {
 
 /// The most clients whose last frame is kept (the oldest is forgotten first).
 const MAX_CLIENTS: usize = 16;
-/// The most requests handled at once; more are answered 503.
-const MAX_HANDLERS: usize = 256;
 
 /// One page's state: its newest request's number, the switch that stops that request's
 /// render, and its last frame (for clicks).
@@ -87,20 +87,17 @@ pub(crate) struct Viewer {
     render_lock: Mutex<()>,
     rendering: AtomicUsize,
     waiting: AtomicUsize,
-    handlers: AtomicUsize,
     jobs: jobs::Jobs,
 }
 
-/// The running server, for Ctrl-C to stop.
-static SERVER: OnceLock<Arc<tiny_http::Server>> = OnceLock::new();
-static STOPPING: AtomicBool = AtomicBool::new(false);
+/// What stops the running server (Ctrl-C), once it runs.
+static STOP: OnceLock<Arc<tokio::sync::Notify>> = OnceLock::new();
 
 /// Ctrl-C while a viewer runs: stop serving and let `run` return (true); false if none runs.
 pub(crate) fn interrupt() -> bool {
-    match SERVER.get() {
-        Some(s) => {
-            STOPPING.store(true, Ordering::Release);
-            s.unblock();
+    match STOP.get() {
+        Some(stop) => {
+            stop.notify_one();
             true
         }
         None => false,
@@ -111,15 +108,24 @@ pub(crate) fn interrupt() -> bool {
 pub(crate) fn run(config: &Config) -> crate::Result<()> {
     let viewer = Arc::new(Viewer::new(config)?);
     let addr = SocketAddr::new(config.bind, config.port);
-    let server = tiny_http::Server::http(addr)
+    let listener = std::net::TcpListener::bind(addr)
         .map_err(|e| crate::Error::flag("--port", format!("cannot listen on {addr}: {e}")))?;
-    let server = Arc::new(server);
-    let port = server
-        .server_addr()
-        .to_ip()
+    let port = listener
+        .local_addr()
         .map(|a| a.port())
         .unwrap_or(config.port);
-    let _ = SERVER.set(server.clone());
+    listener
+        .set_nonblocking(true)
+        .map_err(|e| crate::Error::flag("--port", format!("cannot listen on {addr}: {e}")))?;
+    // Few threads for the connections (the work is on tokio's blocking threads and rayon's).
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .map_err(|e| crate::Error::flag("view", format!("cannot start the server: {e}")))?;
+    let stop = STOP
+        .get_or_init(|| Arc::new(tokio::sync::Notify::new()))
+        .clone();
     let host = match config.bind {
         IpAddr::V6(a) if !a.is_unspecified() => format!("[{a}]"),
         a if a.is_unspecified() => "127.0.0.1".to_string(),
@@ -140,32 +146,23 @@ pub(crate) fn run(config: &Config) -> crate::Result<()> {
     if config.open_browser {
         open_browser(&url);
     }
-    let handlers = &viewer.handlers;
-    loop {
-        let request = match server.recv() {
-            Ok(r) => r,
-            Err(_) if STOPPING.load(Ordering::Acquire) => break,
-            Err(e) => {
-                eprintln!("rest-embree view: {e}");
-                std::thread::sleep(std::time::Duration::from_millis(10));
-                continue;
+    runtime.block_on(async {
+        match tokio::net::TcpListener::from_std(listener) {
+            Ok(l) => {
+                server::serve(l, viewer.clone(), stop).await;
+                Ok(())
             }
-        };
-        if handlers.fetch_add(1, Ordering::AcqRel) >= MAX_HANDLERS {
-            handlers.fetch_sub(1, Ordering::AcqRel);
-            let _ = request.respond(routes::text(503, "busy: too many requests at once"));
-            continue;
+            Err(e) => Err(crate::Error::flag(
+                "--port",
+                format!("cannot listen on {addr}: {e}"),
+            )),
         }
-        let v = viewer.clone();
-        std::thread::spawn(move || {
-            routes::handle(&v, request);
-            v.handlers.fetch_sub(1, Ordering::AcqRel);
-        });
-    }
+    })?;
     // Stop every render, and leave no half-written file.
     for c in viewer.clients.lock().expect("not poisoned").values() {
         c.cancel.store(true, Ordering::Relaxed);
     }
+    runtime.shutdown_timeout(std::time::Duration::from_secs(1));
     crate::output::file::remove_partial_files();
     crate::cli::say("rest-embree view: stopped");
     Ok(())
@@ -239,7 +236,6 @@ impl Viewer {
             render_lock: Mutex::new(()),
             rendering: AtomicUsize::new(0),
             waiting: AtomicUsize::new(0),
-            handlers: AtomicUsize::new(0),
             jobs: jobs::Jobs::new(out),
         })
     }

@@ -11,13 +11,48 @@
 
 use super::{frames, jobs, Client, Viewer, MAX_CLIENTS};
 use serde_json::{json, Value};
-use std::io::Read;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
-use tiny_http::{Header, Method, Request, Response, ResponseBox};
 
-const MAX_BODY: usize = 64 * 1024;
+/// The most a request's body may hold.
+pub(super) const MAX_BODY: usize = 64 * 1024;
+
+/// A request as the endpoints see it, after the server has checked its access and read its
+/// body (`server.rs`).
+pub(super) struct Req<'a> {
+    pub method: Method,
+    pub path: &'a str,
+    pub query: &'a str,
+    pub body: &'a [u8],
+}
+
+/// The methods the endpoints tell apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Method {
+    Get,
+    Post,
+    Other,
+}
+
+/// A reply: its status, headers and body (bytes, or a file the server streams).
+pub(super) struct Reply {
+    pub status: u16,
+    pub headers: Vec<(&'static str, String)>,
+    pub body: Payload,
+}
+
+pub(super) enum Payload {
+    Bytes(Vec<u8>),
+    File(std::fs::File),
+}
+
+impl Reply {
+    fn with_header(mut self, name: &'static str, value: &str) -> Reply {
+        self.headers.push((name, value.to_string()));
+        self
+    }
+}
 
 /// The page: its HTML with its style and script, all from the binary.
 fn page() -> String {
@@ -26,21 +61,20 @@ fn page() -> String {
         .replace("/*SCRIPT*/", include_str!("page/app.js"))
 }
 
-fn header(name: &str, value: &str) -> Header {
-    Header::from_bytes(name.as_bytes(), value.as_bytes()).expect("a valid header")
-}
-
-fn reply(code: u16, mime: &str, data: Vec<u8>) -> ResponseBox {
-    Response::from_data(data)
-        .with_status_code(code)
-        .with_header(header("Content-Type", mime))
-        .with_header(header("Cache-Control", "no-store"))
-        .with_header(header("X-Content-Type-Options", "nosniff"))
-        .boxed()
+fn reply(code: u16, mime: &str, data: Vec<u8>) -> Reply {
+    Reply {
+        status: code,
+        headers: vec![
+            ("Content-Type", mime.to_string()),
+            ("Cache-Control", "no-store".into()),
+            ("X-Content-Type-Options", "nosniff".into()),
+        ],
+        body: Payload::Bytes(data),
+    }
 }
 
 /// A line of text with a status.
-pub(super) fn text(code: u16, message: &str) -> ResponseBox {
+pub(super) fn text(code: u16, message: &str) -> Reply {
     reply(
         code,
         "text/plain; charset=utf-8",
@@ -48,59 +82,37 @@ pub(super) fn text(code: u16, message: &str) -> ResponseBox {
     )
 }
 
-fn json_reply(code: u16, v: &Value) -> ResponseBox {
+fn json_reply(code: u16, v: &Value) -> Reply {
     reply(code, "application/json", v.to_string().into_bytes())
 }
 
-fn header_value<'a>(rq: &'a Request, name: &str) -> Option<&'a str> {
-    rq.headers()
-        .iter()
-        .find(|h| h.field.as_str().as_str().eq_ignore_ascii_case(name))
-        .map(|h| h.value.as_str())
+/// A request whose access the server has checked, answered. A bug that panics answers 500;
+/// the server goes on (the panic is printed on stderr).
+pub(super) fn handle(v: &Viewer, rq: &Req) -> Reply {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| route(v, rq))).unwrap_or_else(|_| {
+        text(
+            500,
+            "internal error: this request failed (a bug: please report it)",
+        )
+    })
 }
 
-pub(super) fn handle(v: &Viewer, mut rq: Request) {
-    let url = rq.url().to_string();
-    let (path, query) = url.split_once('?').unwrap_or((url.as_str(), ""));
-    let allowed = v.access.check(
-        query,
-        header_value(&rq, "Host"),
-        header_value(&rq, "Origin"),
-    );
-    let response = match allowed {
-        Err(why) => text(403, why),
-        // A bug that panics answers 500; the server goes on (the panic is printed on stderr).
-        Ok(()) => std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            route(v, &mut rq, path, query)
-        }))
-        .unwrap_or_else(|_| {
-            text(
-                500,
-                "internal error: this request failed (a bug: please report it)",
-            )
-        }),
-    };
-    // A client that has gone is no error of ours.
-    let _ = rq.respond(response);
-}
-
-fn route(v: &Viewer, rq: &mut Request, path: &str, query: &str) -> ResponseBox {
-    let method = rq.method().clone();
-    let result = match (&method, path) {
+fn route(v: &Viewer, rq: &Req) -> Reply {
+    let result = match (rq.method, rq.path) {
         (Method::Get, "/") => Ok(reply(200, "text/html; charset=utf-8", page().into_bytes())
-            .with_header(header("X-Frame-Options", "DENY"))
-            .with_header(header("Referrer-Policy", "no-referrer"))
-            .with_header(header(
+            .with_header("X-Frame-Options", "DENY")
+            .with_header("Referrer-Policy", "no-referrer")
+            .with_header(
                 "Content-Security-Policy",
                 "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; img-src blob:; connect-src 'self'; frame-ancestors 'none'",
-            ))),
+            )),
         (Method::Get, "/api/scene") => Ok(json_reply(200, &v.info)),
         (Method::Get, "/api/status") => Ok(status(v)),
         (Method::Post, "/api/frame") => body(rq).and_then(|b| frame(v, &b)),
-        (Method::Get, "/api/probe") => probe(v, query),
+        (Method::Get, "/api/probe") => probe(v, rq.query),
         (Method::Post, "/api/save") => body(rq).and_then(|b| save(v, &b)),
         (Method::Post, "/api/render") => body(rq).and_then(|b| start_render(v, &b)),
-        (Method::Get, "/api/job") => job(v, query),
+        (Method::Get, "/api/job") => job(v, rq.query),
         (Method::Get, p) if p.starts_with("/files/") => file(v, &p["/files/".len()..]),
         (_, "/" | "/api/scene" | "/api/status" | "/api/frame" | "/api/probe" | "/api/save"
         | "/api/render" | "/api/job") => Err((405, "method not allowed here".into())),
@@ -109,25 +121,17 @@ fn route(v: &Viewer, rq: &mut Request, path: &str, query: &str) -> ResponseBox {
     result.unwrap_or_else(|(code, message)| text(code, &message))
 }
 
-type Answer = Result<ResponseBox, (u16, String)>;
+type Answer = Result<Reply, (u16, String)>;
 
-/// The request's body as JSON.
-fn body(rq: &mut Request) -> Result<Value, (u16, String)> {
-    if rq.body_length().is_some_and(|n| n > MAX_BODY) {
+/// The request's body as JSON (the server has read at most `MAX_BODY` bytes of it).
+fn body(rq: &Req) -> Result<Value, (u16, String)> {
+    if rq.body.len() > MAX_BODY {
         return Err((413, format!("the body is larger than {MAX_BODY} bytes")));
     }
-    let mut bytes = Vec::new();
-    rq.as_reader()
-        .take(MAX_BODY as u64 + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| (400, format!("cannot read the body: {e}")))?;
-    if bytes.len() > MAX_BODY {
-        return Err((413, format!("the body is larger than {MAX_BODY} bytes")));
-    }
-    serde_json::from_slice(&bytes).map_err(|e| (400, format!("the body is not JSON: {e}")))
+    serde_json::from_slice(rq.body).map_err(|e| (400, format!("the body is not JSON: {e}")))
 }
 
-fn status(v: &Viewer) -> ResponseBox {
+fn status(v: &Viewer) -> Reply {
     let clients = v.clients.lock().expect("not poisoned").len();
     json_reply(
         200,
@@ -230,13 +234,13 @@ fn frame(v: &Viewer, body: &Value) -> Answer {
         }
     }
     Ok(reply(200, "image/png", png)
-        .with_header(header("X-Seq", &seq.to_string()))
-        .with_header(header("X-Level", &level.to_string()))
-        .with_header(header("X-Final", if last { "true" } else { "false" }))
-        .with_header(header("X-Width", &w.to_string()))
-        .with_header(header("X-Height", &h.to_string()))
-        .with_header(header("X-Samples", &l.samples.to_string()))
-        .with_header(header("X-Render-Ms", &format!("{ms:.1}"))))
+        .with_header("X-Seq", &seq.to_string())
+        .with_header("X-Level", &level.to_string())
+        .with_header("X-Final", if last { "true" } else { "false" })
+        .with_header("X-Width", &w.to_string())
+        .with_header("X-Height", &h.to_string())
+        .with_header("X-Samples", &l.samples.to_string())
+        .with_header("X-Render-Ms", &format!("{ms:.1}")))
 }
 
 /// A count of work in progress, held up while the guard lives (a panic lowers it too).
@@ -341,10 +345,10 @@ fn save(v: &Viewer, body: &Value) -> Answer {
         .take(40)
         .collect();
     Ok(
-        reply(200, "application/toml", text.into_bytes()).with_header(header(
+        reply(200, "application/toml", text.into_bytes()).with_header(
             "Content-Disposition",
             &format!("attachment; filename=\"{stem}-view.toml\""),
-        )),
+        ),
     )
 }
 
@@ -390,13 +394,17 @@ fn file(v: &Viewer, name: &str) -> Answer {
     } else {
         "application/toml"
     };
-    Ok(Response::from_file(f)
-        .with_header(header("Content-Type", mime))
-        .with_header(header("Cache-Control", "no-store"))
-        .with_header(header("X-Content-Type-Options", "nosniff"))
-        .with_header(header(
-            "Content-Disposition",
-            &format!("attachment; filename=\"{name}\""),
-        ))
-        .boxed())
+    Ok(Reply {
+        status: 200,
+        headers: vec![
+            ("Content-Type", mime.into()),
+            ("Cache-Control", "no-store".into()),
+            ("X-Content-Type-Options", "nosniff".into()),
+            (
+                "Content-Disposition",
+                format!("attachment; filename=\"{name}\""),
+            ),
+        ],
+        body: Payload::File(f),
+    })
 }
