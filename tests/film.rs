@@ -290,3 +290,68 @@ fn a_png_film_resumed_renders_again_what_is_not_its_own() {
         );
     }
 }
+
+/// A film's frame that is a symbolic link (to another frame) is refused before any frame is
+/// written, naming the frame and where the link leads, with and without --resume; the frame
+/// it leads to is left as it was. A tile's output likewise; a still's `-o` may be a link to a
+/// regular file, which it writes through.
+#[test]
+fn no_output_of_a_run_is_written_through_a_link() {
+    let d = Dir::new("film-links");
+    let scene = d.file("film.toml", &film(0.3, ""));
+    let pattern = d.0.join("f-#.png").to_str().unwrap().to_string();
+    render(&["render", scene.to_str().unwrap(), "-o", &pattern, "-q"]);
+    let zero = std::fs::read(d.0.join("f-0.png")).unwrap();
+    std::fs::remove_file(d.0.join("f-3.png")).unwrap();
+    std::os::unix::fs::symlink("f-0.png", d.0.join("f-3.png")).unwrap();
+    for resume in [true, false] {
+        let mut args = vec!["render", scene.to_str().unwrap(), "-o", &pattern, "-q"];
+        if resume {
+            args.push("--resume");
+        }
+        let (code, err) = status(&args);
+        assert_eq!(code, Some(1), "{err}");
+        assert!(
+            err.contains("frame 3") && err.contains("f-3.png") && err.contains("f-0.png"),
+            "{err}"
+        );
+        assert_eq!(std::fs::read(d.0.join("f-0.png")).unwrap(), zero);
+    }
+    // A tile of a farm's grid.
+    let tile = d.0.join("tile.exr");
+    std::os::unix::fs::symlink("f-0.png", &tile).unwrap();
+    let still_scene = d.file("still.toml", &still(0.3));
+    let (code, err) = status(&[
+        "render",
+        still_scene.to_str().unwrap(),
+        "-o",
+        tile.to_str().unwrap(),
+        "--tiles",
+        "2x2",
+        "--tile",
+        "1",
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("tile 1") && err.contains("symbolic link"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(d.0.join("f-0.png")).unwrap(), zero);
+    // A still through a link to a regular file: written through, the link kept.
+    let target = d.0.join("target.png");
+    std::fs::write(&target, b"old").unwrap();
+    let link = d.0.join("link.png");
+    std::os::unix::fs::symlink("target.png", &link).unwrap();
+    render(&[
+        "render",
+        still_scene.to_str().unwrap(),
+        "-o",
+        link.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(std::fs::read(&target).unwrap().starts_with(b"\x89PNG"));
+}

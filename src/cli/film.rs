@@ -107,6 +107,13 @@ pub(super) fn run(
         std::fs::create_dir_all(dir)
             .map_err(|e| Error::flag("-o", format!("cannot make the folder {dir}: {e}")))?;
     }
+    // Every frame's file, before any is written: none may be a link (it could lead to another
+    // frame, which would be lost).
+    for k in first..=last {
+        let what = format!("frame {k}");
+        crate::output::file::refuse_link(&pattern.path(k), &what)
+            .map_err(|m| Error::flag("-o", m))?;
+    }
     let t0 = std::time::Instant::now();
     let rest = render::RestGroups::build(scene, backend, render::WorldOptions::default())?;
     let build = t0.elapsed().as_secs_f64();

@@ -618,6 +618,8 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         scene.image.transparent.get_or_insert(false);
     }
     if let (Some(grid), Some(index)) = (args.tiles, args.tile) {
+        let what = format!("tile {index}");
+        output::file::refuse_link(&args.output, &what).map_err(|m| Error::flag("-o", m))?;
         let shown = format!("--tiles {}x{} --tile {index}", grid.0, grid.1);
         scene.image.crop = Some(tiles::tile_crop(&scene, format, grid, index, &shown)?);
     }

@@ -24,8 +24,8 @@ pub use implicit::{Blocks, Implicit, Member};
 pub use indexed_mesh::IndexedMesh;
 pub use lattice::Lattice;
 pub(crate) use light_buffer::LightBuffer;
-pub use primitive::Primitive;
 pub(crate) use primitive::ball_crossings;
+pub use primitive::Primitive;
 #[cfg(feature = "embree")]
 pub(crate) use primitive::{capsule_hit, cuboid_hit, cylinder_crossings, AxisRod};
 pub(crate) use real::Real;

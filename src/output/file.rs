@@ -85,6 +85,26 @@ pub(crate) fn write_whole(
     })
 }
 
+/// Refuse `path` where it is a symbolic link: one of several outputs of a run (a film's frame,
+/// a farm's tile) is written to a file of its own, never through a link, which could lead to
+/// another output of the same run (`frame-04.png -> frame-00.png` would overwrite frame 0).
+/// `what` says which output it is. A still's `-o` may be a link to a regular file (as shell
+/// redirection writes through one); [`write_whole`] follows it.
+pub(crate) fn refuse_link(path: &Path, what: &str) -> Result<(), String> {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => {
+            let to = std::fs::read_link(path)
+                .map(|t| t.display().to_string())
+                .unwrap_or_else(|_| "somewhere unreadable".into());
+            Err(format!(
+                "{what} `{}` is a symbolic link to `{to}`: each of a run's outputs is written to a file of its own, not through a link (it could lead to another of them); remove the link or name another file",
+                path.display()
+            ))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// The file a path names, following symbolic links (relative ones from the link's directory).
 fn through_links(path: &Path) -> Result<PathBuf, String> {
     let mut p = path.to_path_buf();
