@@ -28,6 +28,7 @@ pub mod rng;
 pub mod scene;
 pub mod spacetime;
 pub mod spectrum;
+mod text;
 mod view;
 
 pub use error::{Cause, Error, Result};

@@ -355,3 +355,46 @@ fn no_output_of_a_run_is_written_through_a_link() {
         .is_symlink());
     assert!(std::fs::read(&target).unwrap().starts_with(b"\x89PNG"));
 }
+
+/// --resume keeps an EXR frame only if every block of it decodes: a byte flipped in the middle
+/// of the file, or its last 100 bytes zeroed, and the frame is rendered again, to the bytes of
+/// an untouched run.
+#[test]
+fn a_damaged_exr_frame_is_rendered_again() {
+    let d = Dir::new("film-exr-damage");
+    let scene = d.file("film.toml", &film(0.3, ""));
+    let pattern = |dir: &str| d.0.join(dir).join("f-#.exr").to_str().unwrap().to_string();
+    for dir in ["whole", "cut"] {
+        render(&["render", scene.to_str().unwrap(), "-o", &pattern(dir), "-q"]);
+    }
+    let cut = d.0.join("cut");
+    let mut one = std::fs::read(cut.join("f-1.exr")).unwrap();
+    let mid = one.len() / 2;
+    one[mid] ^= 0x5a;
+    std::fs::write(cut.join("f-1.exr"), &one).unwrap();
+    let mut two = std::fs::read(cut.join("f-2.exr")).unwrap();
+    let n = two.len();
+    two[n - 100..].fill(0);
+    std::fs::write(cut.join("f-2.exr"), &two).unwrap();
+    let frames = std::fs::read_dir(&cut).unwrap().count();
+    let (ok, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        &pattern("cut"),
+        "--resume",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains(&format!("2 frames rendered, {} already there", frames - 2)),
+        "{err}"
+    );
+    for k in 0..frames {
+        let name = format!("f-{k}.exr");
+        assert_eq!(
+            std::fs::read(cut.join(&name)).unwrap(),
+            std::fs::read(d.0.join("whole").join(&name)).unwrap(),
+            "{name}"
+        );
+    }
+}

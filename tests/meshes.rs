@@ -290,13 +290,13 @@ fn bad_meshes_and_transforms_are_clear_errors() {
     let cases: [(&str, &[&str]); 17] = [
         ("type = \"mesh\"\nfile = \"missing.obj\"", &["missing.obj", "cannot read it"]),
         ("type = \"mesh\"\nfile = \"bad-v.obj\"", &["bad-v.obj:2", "position parse error"]),
-        ("type = \"mesh\"\nfile = \"bad-f.obj\"", &["bad-f.obj:4", "out of bounds"]),
+        ("type = \"mesh\"\nfile = \"bad-f.obj\"", &["bad-f.obj:4", "names vertex 9"]),
         ("type = \"mesh\"\nfile = \"empty.obj\"", &["empty.obj", "no triangles"]),
         ("type = \"mesh\"\nfile = \"bad.ply\"", &["bad.ply", "not a readable PLY"]),
         ("type = \"mesh\"\nfile = \"range.ply\"", &["range.ply", "vertex 7"]),
         ("type = \"mesh\"\nfile = \"model.3ds\"", &["model.3ds", ".obj, .ply"]),
         ("type = \"mesh\"\nfile = \"bad.stl\"", &["bad.stl", "not a readable STL"]),
-        ("type = \"mesh\"\nfile = \"nan.obj\"", &["nan.obj", "not finite"]),
+        ("type = \"mesh\"\nfile = \"nan.obj\"", &["nan.obj:2", "not a finite number"]),
         ("type = \"mesh\"\nfile = \"folder.obj\"", &["folder.obj", "not a regular file"]),
         (
             "type = \"mesh\"\nfile = \"bad-f.obj\"\nvertices = [[0, 0, 0]]",

@@ -120,23 +120,39 @@ pub(super) fn run(
     let (mut rendered, mut skipped) = (0u64, 0u64);
     let mut render_secs = 0.0;
     let shown: Vec<String> = args.overrides().into_iter().map(|(s, _)| s).collect();
+    // A frame is done only if its file is a finished image of this very frame
+    // (`output::finished`: every block decoded); anything else in its place is rendered again.
+    // The files are checked all at once, on every core, before the first frame renders.
+    let done: Vec<Option<Result<(), String>>> = match args.resume {
+        false => vec![None; (last - first + 1) as usize],
+        true => {
+            use rayon::prelude::*;
+            (first..=last)
+                .into_par_iter()
+                .map(|k| {
+                    let path = pattern.path(k);
+                    std::fs::symlink_metadata(&path).ok()?;
+                    let frame_scene = scene.film_frame(k).expect("a film");
+                    let id = crate::output::header::render_id(&frame_scene, backend_name, &shown);
+                    let size = frame_scene.image.frame_size();
+                    Some(crate::output::finished(&path, format, size, &id))
+                })
+                .collect()
+        }
+    };
     for k in first..=last {
         let path = pattern.path(k);
         let frame_scene = scene.film_frame(k).expect("a film");
-        // A frame is done only if its file is a finished image of this very frame
-        // (`output::finished`); anything else in its place is rendered again.
-        if args.resume && std::fs::symlink_metadata(&path).is_ok() {
-            let id = crate::output::header::render_id(&frame_scene, backend_name, &shown);
-            match crate::output::finished(&path, format, frame_scene.image.frame_size(), &id) {
-                Ok(()) => {
-                    skipped += 1;
-                    continue;
-                }
-                Err(why) => eprintln!(
-                    "frame {k}: {} is not a finished frame of this render ({why}): rendering it again",
-                    path.display()
-                ),
+        match &done[(k - first) as usize] {
+            Some(Ok(())) => {
+                skipped += 1;
+                continue;
             }
+            Some(Err(why)) => eprintln!(
+                "frame {k}: {} is not a finished frame of this render ({why}): rendering it again",
+                path.display()
+            ),
+            None => {}
         }
         let t1 = std::time::Instant::now();
         let world = render::World::aim(&frame_scene, &rest, backend)?;

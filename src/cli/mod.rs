@@ -163,7 +163,7 @@ pub(crate) struct RenderArgs {
     #[arg(long)]
     pub threads: Option<usize>,
     /// Store colour, alpha, normals and the Doppler factor as half floats in an EXR (positions,
-    /// depth, lookback and ids stay full floats).
+    /// depth, lookback and ids stay full floats); values beyond ±65504 saturate there.
     #[arg(long)]
     pub half: bool,
     /// The passes an EXR holds beside colour and alpha, comma-separated (`none` for colour and
@@ -196,7 +196,7 @@ pub(crate) struct RenderArgs {
     pub tile: Option<u32>,
     /// Render in rounds of samples until this many seconds have passed (a round that would
     /// end later is not begun; at least one is rendered); the scene's samples stay the most.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = positive)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = seconds)]
     pub max_time: Option<f64>,
     /// Render in rounds of samples until the estimated RMS noise of the image (the standard
     /// error of the pixels' means, linear RGB) is at most this; the scene's samples stay the
@@ -255,8 +255,7 @@ impl RenderArgs {
     }
 }
 
-/// A finite number (clap takes `nan` and `inf` for f64).
-/// A finite number above 0 (a budget of time or noise).
+/// A finite number above 0 (a budget of noise).
 fn positive(text: &str) -> Result<f64, String> {
     match finite(text)? {
         v if v > 0.0 => Ok(v),
@@ -264,6 +263,20 @@ fn positive(text: &str) -> Result<f64, String> {
     }
 }
 
+/// The most seconds a time budget may be (about 31 years: any more is a mistake).
+pub(crate) const MAX_SECONDS: f64 = 1e9;
+
+/// A time budget in seconds: above 0 and at most `MAX_SECONDS`.
+pub(crate) fn seconds(text: &str) -> Result<f64, String> {
+    match positive(text)? {
+        v if v <= MAX_SECONDS => Ok(v),
+        v => Err(format!(
+            "must be at most {MAX_SECONDS:e} seconds, about 31 years (got {v:e})"
+        )),
+    }
+}
+
+/// A finite number (clap takes `nan` and `inf` for f64).
 fn finite(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
@@ -396,7 +409,9 @@ fn report(r: crate::Result<()>) -> ExitCode {
     match r {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // A message may quote a file's text: each line cut and its control characters
+            // escaped, whatever the file held.
+            eprintln!("{}", crate::text::terminal_safe(&format!("error: {e}")));
             ExitCode::FAILURE
         }
     }

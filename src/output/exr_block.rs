@@ -204,11 +204,17 @@ fn store_run<const N: usize>(
     }
 }
 
+/// `v` as a half float, saturated at half's largest finite value (65504) rather than made
+/// infinite: a bright glow stays the brightest a half holds, not `inf` in a compositor.
+pub(super) fn half_of(v: f32) -> f16 {
+    f16::from_f32(v.clamp(-65504.0, 65504.0))
+}
+
 /// Store `v` as a `t` in `sample` (its size).
 #[inline(always)]
 fn store(sample: &mut [u8], t: SampleType, v: f32) {
     match t {
-        SampleType::F16 => sample.copy_from_slice(&f16::from_f32(v).to_ne_bytes()),
+        SampleType::F16 => sample.copy_from_slice(&half_of(v).to_ne_bytes()),
         SampleType::F32 => sample.copy_from_slice(&v.to_ne_bytes()),
         SampleType::U32 => sample.copy_from_slice(&(v as u32).to_ne_bytes()),
     }

@@ -58,7 +58,7 @@ pub(super) fn channels(
         .map(|&name| {
             let values = frame.channel(name).expect("known channel");
             let samples = if options.half && MAY_BE_HALF.contains(&name) {
-                FlatSamples::F16(values.into_iter().map(f16::from_f32).collect())
+                FlatSamples::F16(values.into_iter().map(super::exr_block::half_of).collect())
             } else {
                 FlatSamples::F32(values)
             };

@@ -1,6 +1,6 @@
 //! Whether a file is a finished image of a render, for a film's `--resume`: a regular file that
-//! reads to its end as the format says (every EXR chunk its offset table promises, every PNG
-//! row), of the frame's size, that names the same render (`header::render_id`, an EXR
+//! reads to its end as the format says (every EXR block its offset table promises, each
+//! decompressed; every PNG row), of the frame's size, that names the same render (`header::render_id`, an EXR
 //! attribute and a PNG text chunk). A file that is empty, cut short, garbage, a directory, the
 //! wrong size or another render's is not, whatever its name.
 
@@ -87,17 +87,22 @@ fn exr(path: &Path, size: (u32, u32), id: &str) -> Result<(), String> {
     if said.as_deref() != Some(id) {
         return Err("from another render (or none said)".into());
     }
+    // Every block read and decompressed (in parallel): a byte flipped in the middle of a
+    // compressed block, or zeros where its last bytes were, fails here. (A file written
+    // without compression holds no check of its own: a flipped byte there is a wrong pixel.)
+    use exr::block::reader::ChunksReader;
     let expected = header.chunk_count;
-    let mut chunks = 0;
-    for chunk in reader
+    let mut blocks = 0;
+    reader
         .all_chunks(false)
         .map_err(|e| format!("cut short or damaged ({e})"))?
-    {
-        chunk.map_err(|e| format!("cut short or damaged ({e})"))?;
-        chunks += 1;
-    }
-    if chunks != expected {
-        return Err(format!("{chunks} of its {expected} blocks"));
+        .decompress_parallel(false, |_, _| {
+            blocks += 1;
+            Ok(())
+        })
+        .map_err(|e| format!("cut short or damaged ({e})"))?;
+    if blocks != expected {
+        return Err(format!("{blocks} of its {expected} blocks"));
     }
     Ok(())
 }

@@ -95,8 +95,82 @@ pub fn read(path: &Path) -> Result<MeshData, MeshError> {
     Ok(mesh)
 }
 
+/// The numbers of an OBJ statement's rest (`v x y z`), where each parses: Some(values).
+fn obj_numbers(rest: &str) -> Option<Vec<f64>> {
+    rest.split_whitespace().map(|x| x.parse().ok()).collect()
+}
+
+/// What tobj accepts of an OBJ file but this renderer must not, found line by line with the
+/// line named: numbers that are not finite in `v`, `vn` and `vt`; a face's index 0 (OBJ
+/// counts from 1) or an index past the positions, normals or texture coordinates given before
+/// it.
+fn check_obj_lines(text: &str) -> Result<(), MeshError> {
+    let (mut v, mut vn, mut vt) = (0i64, 0i64, 0i64);
+    for (n, line) in text.lines().enumerate() {
+        let line = line.trim();
+        let (head, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
+        let shown = || crate::text::shown(line);
+        match head {
+            "v" | "vn" | "vt" => {
+                if let Some(x) =
+                    obj_numbers(rest).and_then(|xs| xs.into_iter().find(|x| !x.is_finite()))
+                {
+                    return Err(MeshError::at(
+                        n + 1,
+                        format!("`{}`: {x} is not a finite number", shown()),
+                    ));
+                }
+                match head {
+                    "v" => v += 1,
+                    "vn" => vn += 1,
+                    _ => vt += 1,
+                }
+            }
+            "f" => {
+                for corner in rest.split_whitespace() {
+                    for (k, (what, count)) in
+                        [("vertex", v), ("texture coordinate", vt), ("normal", vn)]
+                            .into_iter()
+                            .enumerate()
+                    {
+                        let Some(i) = corner.split('/').nth(k).filter(|x| !x.is_empty()) else {
+                            continue;
+                        };
+                        let Ok(i) = i.parse::<i64>() else {
+                            continue;
+                        };
+                        if i == 0 {
+                            return Err(MeshError::at(
+                                n + 1,
+                                format!("`{}`: {what} index 0 (OBJ counts from 1)", shown()),
+                            ));
+                        }
+                        if i > count || -i > count {
+                            return Err(MeshError::at(
+                                n + 1,
+                                format!(
+                                    "`{}` names {what} {i}; the file gives {count} before this line",
+                                    shown()
+                                ),
+                            ));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 fn read_obj(path: &Path) -> Result<MeshData, MeshError> {
-    let bytes = std::fs::read(path).map_err(|e| MeshError::new(format!("cannot read it: {e}")))?;
+    let mut bytes =
+        std::fs::read(path).map_err(|e| MeshError::new(format!("cannot read it: {e}")))?;
+    // A byte-order mark before the first statement is no part of it.
+    if bytes.starts_with("\u{feff}".as_bytes()) {
+        bytes.drain(..3);
+    }
+    check_obj_lines(&String::from_utf8_lossy(&bytes))?;
     // tobj keeps a triangle's `usemtl` only where a material library defines that name, and
     // the scene maps names to its own materials without reading the file's library: the
     // names used are collected first and given to tobj as a library of their own.
@@ -257,6 +331,7 @@ fn obj_error(path: &Path, e: &tobj::LoadError) -> MeshError {
     let Ok(text) = std::fs::read_to_string(path) else {
         return MeshError::new(what);
     };
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let floats = |rest: &str, counts: &[usize]| {
         let v: Vec<&str> = rest.split_whitespace().collect();
         counts.contains(&v.len()) && v.iter().all(|x| x.parse::<f64>().is_ok())
@@ -290,7 +365,7 @@ fn obj_error(path: &Path, e: &tobj::LoadError) -> MeshError {
             vertices += 1;
         }
         if bad {
-            return MeshError::at(n + 1, format!("{what}: `{line}`"));
+            return MeshError::at(n + 1, format!("{what}: `{}`", crate::text::shown(line)));
         }
     }
     MeshError::new(what)
@@ -451,6 +526,19 @@ fn vertex_data(vertices: Vec<PlyVertex>) -> Result<VertexData, MeshError> {
         positions.push(DVec3::new(v.values[0], v.values[1], v.values[2]));
     }
     let any = !vertices.is_empty();
+    for (i, v) in vertices.iter().enumerate() {
+        for (k, name) in ["x", "y", "z", "nx", "ny", "nz", "u", "v"]
+            .iter()
+            .enumerate()
+        {
+            if v.has(1 << k) && !v.values[k].is_finite() {
+                return Err(MeshError::new(format!(
+                    "vertex {i} (counted from 0) has {name} = {}, not a finite number",
+                    v.values[k]
+                )));
+            }
+        }
+    }
     let normals = (any && vertices.iter().all(|v| v.has(0b111_000))).then(|| {
         let n = |v: &PlyVertex| DVec3::new(v.values[3], v.values[4], v.values[5]);
         vertices.iter().map(|v| n(v).normalize_or_zero()).collect()
@@ -464,18 +552,85 @@ fn vertex_data(vertices: Vec<PlyVertex>) -> Result<VertexData, MeshError> {
     Ok((positions, normals, uvs))
 }
 
+/// A PLY parser's error in this project's words: its message's first line, and the line of
+/// the file it read (once, cut short, its control characters escaped), without the parser's
+/// own dump of its state.
+fn ply_message(e: &ply_rs_bw::parser::ParseError) -> String {
+    let text = e.to_string();
+    let mut parts = text.split("\n\t");
+    let first = parts.next().unwrap_or_default();
+    // "Line N: " is the parser's; the line number goes into the error's place instead.
+    let first = match first.split_once(": ") {
+        Some((l, rest)) if l.starts_with("Line ") => rest,
+        _ => first,
+    };
+    let mut message = format!("not a readable PLY file: {}", crate::text::shown(first));
+    if let Some(line) = parts.find_map(|p| p.strip_prefix("String: ")) {
+        let line = line.trim_matches('\'').trim_end();
+        message.push_str(&format!(" (the line reads `{}`)", crate::text::shown(line)));
+    }
+    message
+}
+
+/// Refuse a PLY header whose elements the file cannot hold: an element without properties
+/// (nothing to read, any count), or more entries than the bytes after the header could hold at
+/// the fewest bytes an entry takes (a property's bytes in a binary file; a number and a
+/// separator, two bytes, in ASCII). Checked before anything is read or allocated: a header of
+/// 130 bytes claiming four billion vertices would otherwise grow until the machine refuses.
+fn check_counts(header: &ply_rs_bw::ply::Header, size: u64) -> Result<(), MeshError> {
+    use ply_rs_bw::ply::{Encoding, PropertyType, ScalarType};
+    let bytes = |t: &ScalarType| match t {
+        ScalarType::Char | ScalarType::UChar => 1u64,
+        ScalarType::Short | ScalarType::UShort => 2,
+        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
+        ScalarType::Double => 8,
+    };
+    let ascii = matches!(header.encoding, Encoding::Ascii);
+    for (name, def) in &header.elements {
+        let name = crate::text::shown(name);
+        if def.properties.is_empty() {
+            if def.count > 0 {
+                return Err(MeshError::new(format!(
+                    "element `{name}` has {} entries and no properties: there is nothing to read in it",
+                    def.count
+                )));
+            }
+            continue;
+        }
+        let least: u64 = def
+            .properties
+            .values()
+            .map(|p| match (&p.data_type, ascii) {
+                (_, true) => 2,
+                (PropertyType::Scalar(t), false) => bytes(t),
+                (PropertyType::List(index, _), false) => bytes(index),
+            })
+            .sum();
+        let need = (def.count as u64).saturating_mul(least);
+        if need > size {
+            return Err(MeshError::new(format!(
+                "element `{name}` claims {} entries of at least {least} bytes each, more than the file's {size} bytes hold",
+                def.count
+            )));
+        }
+    }
+    Ok(())
+}
+
 fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
     use ply_rs_bw::parser::{Parser, Reader};
     let file =
         std::fs::File::open(path).map_err(|e| MeshError::new(format!("cannot read it: {e}")))?;
+    let size = file.metadata().map(|m| m.len()).unwrap_or(0);
     let unreadable = |e: ply_rs_bw::parser::ParseError| MeshError {
         line: e.line(),
-        message: format!("not a readable PLY file: {e}"),
+        message: ply_message(&e),
     };
     let mut reader = Reader::new(std::io::BufReader::with_capacity(1 << 20, file));
     let header = Parser::<PlySkip>::new()
         .read_header(&mut reader)
         .map_err(unreadable)?;
+    check_counts(&header, size)?;
     let (mut vertices, mut faces) = (None, None);
     // Elements are read in the header's order, each by the type that keeps what it needs.
     for (name, def) in &header.elements {

@@ -12,7 +12,7 @@ use std::sync::Arc;
 fn image_beside(
     t: &Table,
     key: &str,
-) -> SceneResult<(std::path::PathBuf, usize, usize, Vec<[f32; 3]>)> {
+) -> SceneResult<(std::path::PathBuf, usize, usize, super::texture::Texels)> {
     let node = t.get(key).expect("the caller read it");
     let path = t.path_beside(t.req_string(key)?);
     let (w, h, texels) = super::texture::read_image(&path)

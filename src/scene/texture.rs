@@ -44,8 +44,9 @@ pub struct ImageTexture {
     pub width: usize,
     /// Size in texels.
     pub height: usize,
-    /// Linear RGB, row by row from the top.
-    pub texels: Vec<[f32; 3]>,
+    /// Linear RGB, row by row from the top (shared by the texture's roles: a reflectance's and
+    /// an emitter's uplift of the same image hold one copy).
+    pub texels: std::sync::Arc<[[f32; 3]]>,
     /// Pure red, green and blue, uplifted in the texture's role.
     pub basis: [Colour; 3],
     /// From RGB to the coefficients on `basis`.
@@ -57,7 +58,7 @@ impl std::fmt::Debug for ImageTexture {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         use std::hash::{Hash, Hasher};
         let mut h = std::hash::DefaultHasher::new();
-        for t in &self.texels {
+        for t in self.texels.iter() {
             t.map(f32::to_bits).hash(&mut h);
         }
         write!(
@@ -77,7 +78,7 @@ impl ImageTexture {
         path: String,
         width: usize,
         height: usize,
-        texels: Vec<[f32; 3]>,
+        texels: std::sync::Arc<[[f32; 3]]>,
         role: Role,
     ) -> ImageTexture {
         let basis = [DVec3::X, DVec3::Y, DVec3::Z].map(|e| Colour::rgb(e, role));
@@ -225,13 +226,37 @@ fn checker_cell(size: DVec3, p: DVec3) -> usize {
     sum.rem_euclid(2) as usize
 }
 
+/// The largest value a texel keeps (an EXR's larger ones, infinity included, are clamped to
+/// it, its negative ones to 0): a colour's own limit.
+pub(crate) const MAX_TEXEL: f32 = 1e15;
+
 /// The most texels an image texture may have (a 16384 x 16384 image).
 pub(crate) const MAX_TEXELS: u64 = 1 << 28;
 
+/// A texture's texels, shared by its roles.
+pub(crate) type Texels = std::sync::Arc<[[f32; 3]]>;
+
+/// Whether an image of `w` x `h` texels may be read: at most `MAX_TEXELS`, and its peak while
+/// read (`per_texel` bytes a texel: the decoder's buffer and the texels made from it) within
+/// the memory limit. Checked from the file's header, before its texels are read.
+fn fits(w: usize, h: usize, per_texel: u64) -> Result<(), String> {
+    let n = w as u64 * h as u64;
+    if n == 0 || n > MAX_TEXELS {
+        return Err(format!("it is {w}x{h}; a texture has 1 to 2^28 texels"));
+    }
+    let what = format!("a {w}x{h} texture");
+    match crate::memory::too_much(n.saturating_mul(per_texel), &what) {
+        Some(why) => Err(why),
+        None => Ok(()),
+    }
+}
+
 /// An image file's linear RGB texels, row by row from the top: a PNG (8 or 16 bits, grey,
 /// RGB, with or without alpha, palette; sRGB-decoded; alpha ignored) or an EXR (its R, G, B
-/// channels, or Y as grey). Why not, in words.
-pub(crate) fn read_image(path: &std::path::Path) -> Result<(usize, usize, Vec<[f32; 3]>), String> {
+/// channels, or Y as grey). Made straight into the shared buffer a texture holds (no copy of
+/// them at any time); the size the header claims is checked before anything is decoded. Why
+/// not, in words.
+pub(crate) fn read_image(path: &std::path::Path) -> Result<(usize, usize, Texels), String> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -240,17 +265,8 @@ pub(crate) fn read_image(path: &std::path::Path) -> Result<(usize, usize, Vec<[f
     if !meta.is_file() {
         return Err("it is not a regular file".into());
     }
-    let fits = |w: usize, h: usize| -> Result<(), String> {
-        let n = w as u64 * h as u64;
-        if n == 0 || n > MAX_TEXELS {
-            return Err(format!("it is {w}x{h}; a texture has 1 to 2^28 texels"));
-        }
-        let what = format!("a {w}x{h} texture");
-        match crate::memory::too_much(n * 16, &what) {
-            Some(why) => Err(why),
-            None => Ok(()),
-        }
-    };
+    // 12 bytes a texel stay (three f32); the decoders' own buffers come on top.
+    const TEXEL: u64 = 12;
     match ext.as_deref() {
         Some("png") => {
             let file = std::fs::File::open(path).map_err(|e| format!("cannot read it: {e}"))?;
@@ -260,7 +276,8 @@ pub(crate) fn read_image(path: &std::path::Path) -> Result<(usize, usize, Vec<[f
                 .read_info()
                 .map_err(|e| format!("not a readable PNG: {e}"))?;
             let (w, h) = (reader.info().width as usize, reader.info().height as usize);
-            fits(w, h)?;
+            let n = (w as u64 * h as u64).max(1);
+            fits(w, h, TEXEL + reader.output_buffer_size() as u64 / n)?;
             let mut buf = vec![0; reader.output_buffer_size()];
             let frame = reader
                 .next_frame(&mut buf)
@@ -287,18 +304,46 @@ pub(crate) fn read_image(path: &std::path::Path) -> Result<(usize, usize, Vec<[f
             Ok((w, h, texels))
         }
         Some("exr") => {
+            // The header first: its data window says how large the image claims to be.
+            let header = exr::meta::MetaData::read_from_file(path, false)
+                .map_err(|e| format!("not a readable EXR: {e}"))?;
+            let first = header.headers.first().ok_or("it has no layer")?;
+            let (w, h) = (first.layer_size.width(), first.layer_size.height());
+            // As decoded (each channel as stored), each channel as f32 again, and the texels.
+            let stored: u64 = first
+                .channels
+                .list
+                .iter()
+                .map(|c| c.sample_type.bytes_per_sample() as u64 + 4)
+                .sum();
+            fits(w, h, TEXEL + stored)?;
             let (w, h, ch) = crate::exr_read::read_channels(path).map_err(|e| e.to_string())?;
-            fits(w, h)?;
             let pick =
                 |names: [&str; 3]| names.iter().map(|n| ch.get(*n)).collect::<Option<Vec<_>>>();
             let planes = pick(["R", "G", "B"])
                 .or_else(|| pick(["Y", "Y", "Y"]))
                 .ok_or("it has neither R, G, B nor Y channels")?;
+            if let Some(p) = (0..w * h).find(|&p| planes.iter().any(|c| c[p].is_nan())) {
+                return Err(format!(
+                    "texel ({}, {}) (column, row from the top) is not a number",
+                    p % w,
+                    p / w
+                ));
+            }
+            // As a colour may be: 0 to MAX_TEXEL. Negative texels (a filter's ringing in an HDR
+            // map) would give negative light, infinite ones infinite light.
+            let clamp = |v: f32| v.clamp(0.0, MAX_TEXEL);
             Ok((
                 w,
                 h,
                 (0..w * h)
-                    .map(|p| [planes[0][p], planes[1][p], planes[2][p]])
+                    .map(|p| {
+                        [
+                            clamp(planes[0][p]),
+                            clamp(planes[1][p]),
+                            clamp(planes[2][p]),
+                        ]
+                    })
                     .collect(),
             ))
         }
