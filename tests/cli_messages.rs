@@ -636,3 +636,121 @@ fn far_shifted_rgb_colours_are_warned_of() {
     ]);
     assert!(ok && !err.contains("warning"), "{err}");
 }
+
+/// Hostile input, round three: each exits 1 with a message that names the file, line or flag,
+/// quickly and small, and never echoes a control character from a file to the terminal.
+#[test]
+fn round_three_inputs_are_clear_errors() {
+    let d = Dir::new("hostile-three");
+    let scene = d.file("scene.toml", GOOD);
+    let out = d.0.join("out.png");
+    let render = |scene: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        status(&args)
+    };
+    // Flags: a time budget past 31 years, an empty or self-contradicting pass list.
+    for (extra, needles) in [
+        (&["--max-time", "1e20"][..], &["--max-time", "at most"][..]),
+        (&["--passes", ""], &["--passes", "empty"]),
+        (&["--passes", "all,none"], &["--passes", "cannot stand"]),
+        (&["--passes", "depth,,normal"], &["--passes", "empty name"]),
+    ] {
+        let (code, err) = render(&scene, extra);
+        assert_eq!(code, Some(1), "{extra:?}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{extra:?}: `{n}` in {err}");
+        }
+    }
+    // A mesh named through a scene: a PLY bomb, an OBJ with escape sequences in a bad line.
+    let with_mesh = |file: &str| {
+        GOOD.replace(
+            "type = \"box\"\nmin = [-0.5, 10, -0.5]\nmax = [0.5, 11, 0.5]",
+            &format!("type = \"mesh\"\nfile = \"{file}\""),
+        )
+    };
+    d.file(
+        "bomb.ply",
+        "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n",
+    );
+    d.file(
+        "title.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \u{1b}]0;pwned\u{7}\n",
+    );
+    d.file("bom.obj", "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+    for (file, needles) in [
+        (
+            "bomb.ply",
+            &["bomb.ply", "4000000000 entries", "more than the file's"][..],
+        ),
+        ("title.obj", &["title.obj:4", "\\x1b]0;pwned\\x07"][..]),
+        ("bom.obj", &["bom.obj:4", "index 0"][..]),
+    ] {
+        let s = d.file("mesh.toml", &with_mesh(file));
+        assert!(
+            std::fs::read_to_string(&s).unwrap().contains(file),
+            "the scene names {file}"
+        );
+        let t0 = std::time::Instant::now();
+        let (code, err) = render(&s, &[]);
+        assert_eq!(code, Some(1), "{file}: {err}");
+        assert!(t0.elapsed().as_secs() < 10, "{file}: quickly");
+        assert!(
+            !err.contains('\u{1b}') && !err.contains('\u{7}'),
+            "{file}: {err:?}"
+        );
+        for n in needles {
+            assert!(err.contains(n), "{file}: `{n}` in {err}");
+        }
+    }
+    // An EXR sky map whose header claims 1,000,000 x 100,000 texels: refused from its header.
+    let small = d.0.join("small.exr");
+    let (code, err) = status(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        small.to_str().unwrap(),
+        "--width",
+        "4",
+        "--height",
+        "4",
+        "--passes",
+        "none",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let mut bytes = std::fs::read(&small).unwrap();
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+    for (k, v) in [0i32, 0, 999_999, 99_999].iter().enumerate() {
+        bytes[at + 4 * k..at + 4 * k + 4].copy_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(d.0.join("huge.exr"), &bytes).unwrap();
+    let sky = d.file("sky.toml", &format!("{GOOD}\n[sky]\nmap = \"huge.exr\"\n"));
+    let (code, err) = render(&sky, &[]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("huge.exr") && err.contains("1000000x100000"),
+        "{err}"
+    );
+    // A camera's worldline of too many segments says it is the camera's.
+    let segments = vec!["{ until = 0.0, velocity = [0, 0, 0] }"; 4097].join(", ");
+    let camera = d.file(
+        "camera.toml",
+        &GOOD.replace(
+            "[camera]\n",
+            &format!("[camera]\nworldline = [{segments}]\n"),
+        ),
+    );
+    let (code, err) = render(&camera, &[]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("camera's worldline") && !err.contains("group"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}

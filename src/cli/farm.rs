@@ -86,6 +86,18 @@ fn quote(text: &str) -> String {
     format!("'{}'", text.replace('\'', r"'\''"))
 }
 
+/// `text` as one word for bash: as it is where every character is plain, else quoted.
+fn shell_word(text: &str) -> String {
+    let plain = !text.is_empty()
+        && text
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=:,+@%".contains(c));
+    match plain {
+        true => text.to_string(),
+        false => quote(text),
+    }
+}
+
 fn absolute(path: &Path) -> crate::Result<PathBuf> {
     std::path::absolute(path).map_err(|e| Error::flag("-o", e))
 }
@@ -392,7 +404,13 @@ fn print_jobs(jobs: &[Job], args: &SlurmArgs) {
         say(format_args!("# {file} ({tasks} task{})", plural(tasks)));
         say(&job.text);
         let after = (i > 0).then_some("JOBID");
-        let cmd = sbatch_command(job, after, args).join(" ");
+        // Quoted as bash reads it: pasted, it runs the same sbatch, and nothing in an argument
+        // (a `$(...)` in a --comment, say) runs.
+        let cmd = sbatch_command(job, after, args)
+            .iter()
+            .map(|a| shell_word(a))
+            .collect::<Vec<_>>()
+            .join(" ");
         say(format_args!("# submitted with: {cmd}\n"));
     }
 }

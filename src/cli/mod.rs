@@ -171,6 +171,7 @@ pub(crate) struct RenderArgs {
     /// primitive_id, normal, position, rest_position, camera_position, cryptomatte; or the
     /// shorthands all (the default), ids, relativity.
     #[arg(long, value_name = "LIST")]
+    #[arg(value_parser = pass_list)]
     pub passes: Option<String>,
     /// An EXR's compression: zip (default), zips, piz, rle or none.
     #[arg(long, value_name = "NAME", value_parser = exr_compression)]
@@ -274,6 +275,28 @@ pub(crate) fn seconds(text: &str) -> Result<f64, String> {
             "must be at most {MAX_SECONDS:e} seconds, about 31 years (got {v:e})"
         )),
     }
+}
+
+/// A `--passes` list: names separated by commas, none of them empty, and `none` alone (with
+/// other names it says two things; so does `all` with `none`). The names themselves are
+/// checked as `[image] passes` are.
+fn pass_list(text: &str) -> Result<String, String> {
+    let names: Vec<&str> = text.split(',').map(str::trim).collect();
+    if names.iter().all(|n| n.is_empty()) {
+        return Err(
+            "is empty: give pass names separated by commas, `all`, or `none` for colour and alpha alone"
+                .into(),
+        );
+    }
+    if names.iter().any(|n| n.is_empty()) {
+        return Err(format!("`{text}` has an empty name between commas"));
+    }
+    if names.len() > 1 && names.contains(&"none") {
+        return Err(format!(
+            "`{text}`: `none` (colour and alpha alone) cannot stand with other passes"
+        ));
+    }
+    Ok(text.to_string())
 }
 
 /// A finite number (clap takes `nan` and `inf` for f64).

@@ -83,7 +83,7 @@ pub(super) fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
         }
     };
     let time = t.f64_or("time", 0.0)?;
-    let worldline = segments::read(t, "velocity_direction")?
+    let worldline = segments::read(t, "velocity_direction", segments::Whose::Camera)?
         .map(|s| Worldline::new(Event::new(time, position), &s));
     let velocity = match &worldline {
         Some(w) => w.velocity(time),

@@ -71,7 +71,7 @@ pub(super) fn light(t: &Table, groups: &[Group]) -> SceneResult<Light> {
         (None, v) => v.unwrap_or(Velocity::ZERO),
     };
     // A worldline through `position` at world time 0, whose clock reads 0 there.
-    let segments = super::segments::read(t, "velocity_direction")?;
+    let segments = super::segments::read(t, "velocity_direction", super::segments::Whose::Light)?;
     if segments.is_some() && t.has("group") {
         return Err(t.error("group", "give either `group` or a worldline, not both"));
     }

@@ -278,7 +278,7 @@ fn group(
     index: usize,
     total: &mut u64,
 ) -> SceneResult<Vec<Group>> {
-    let segments = worldline::read(t, "direction")?;
+    let segments = worldline::read(t, "direction", super::segments::Whose::Group)?;
     let velocity = match segments {
         Some(_) => Velocity::ZERO,
         None => velocity(t, "direction")?.unwrap_or(Velocity::ZERO),
@@ -505,6 +505,13 @@ fn image(t: &Table, frame: FrameSize) -> SceneResult<ImageSettings> {
             None => None,
         },
         passes: match t.strings("passes")? {
+            Some((n, names)) if names.len() > 1 && names.contains(&"none") => {
+                return Err(t.error_at(
+                    n,
+                    "passes",
+                    "`none` (colour and alpha alone) cannot stand with other passes",
+                ))
+            }
             Some((n, names)) => PassSet::from_names(names).map_err(|bad| {
                 t.error_at(
                     n,

@@ -61,9 +61,17 @@ pub(crate) struct Segment {
     pub motion: Motion,
 }
 
+/// Whose worldline a table's is (its messages say so).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Whose {
+    Group,
+    Camera,
+    Light,
+}
+
 /// The segments of a table's `worldline`, in time order; None if it has none. `dir_key` is the
 /// table's key for a velocity's direction, which a worldline replaces.
-pub(crate) fn read(t: &Table, dir_key: &str) -> SceneResult<Option<Vec<Segment>>> {
+pub(crate) fn read(t: &Table, dir_key: &str, whose: Whose) -> SceneResult<Option<Vec<Segment>>> {
     if !t.has("worldline") {
         return Ok(None);
     }
@@ -77,12 +85,16 @@ pub(crate) fn read(t: &Table, dir_key: &str) -> SceneResult<Option<Vec<Segment>>
     }
     let tables = t.tables("worldline")?;
     if tables.len() > MAX_SEGMENTS {
+        let why = match whose {
+            Whose::Group => {
+                "a group's worldline: each segment holds a copy of the group's geometry"
+            }
+            Whose::Camera => "the camera's worldline",
+            Whose::Light => "a light's worldline",
+        };
         return Err(t.error(
             "worldline",
-            format!(
-                "{} segments: at most {MAX_SEGMENTS} (each segment of a group is a copy of its geometry)",
-                tables.len()
-            ),
+            format!("{} segments: at most {MAX_SEGMENTS} in {why}", tables.len()),
         ));
     }
     if tables.is_empty() {

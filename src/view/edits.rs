@@ -210,8 +210,11 @@ pub(crate) fn saved_text(original: &str, source: &str, edits: &[Edit]) -> Result
         table.insert(e.key, Item::Value(value));
     }
     absolute_paths(&mut doc, source);
+    // The path goes into a comment: escaped, so that no character of it can end the comment
+    // and write TOML of its own.
+    let from = crate::text::shown(source);
     Ok(format!(
-        "# The view saved by `rest-embree view` from {source}: render it with `rest-embree render`\n# from anywhere (the files it names are given by their full paths).\n{doc}"
+        "# The view saved by `rest-embree view` from {from}: render it with `rest-embree render`\n# from anywhere (the files it names are given by their full paths).\n{doc}"
     ))
 }
 

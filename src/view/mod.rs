@@ -189,6 +189,27 @@ fn open_browser(url: &str) {
 impl Viewer {
     fn new(config: &Config) -> crate::Result<Viewer> {
         let source = config.scene.display().to_string();
+        // The path goes into the text the viewer saves and renders: refused where a
+        // character of it could be read as more than a name.
+        if source.chars().any(char::is_control) {
+            return Err(crate::Error::flag(
+                "view",
+                format!(
+                    "the scene's path `{}` has a control character (a newline, say); rename the file",
+                    crate::text::shown(&source)
+                ),
+            ));
+        }
+        // Where renders of views go: a folder (made when the first is rendered), not a file.
+        if config.out.exists() && !config.out.is_dir() {
+            return Err(crate::Error::flag(
+                "--out",
+                format!(
+                    "`{}` is a file, not a folder for the views' renders",
+                    config.out.display()
+                ),
+            ));
+        }
         let text = std::fs::read_to_string(&config.scene)
             .map_err(|e| crate::Error::flag("view", format!("cannot read {source}: {e}")))?;
         Viewer::from_text(
