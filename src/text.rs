@@ -2,7 +2,21 @@
 //! its control characters escaped, so that no file's content can write a 20 MB message, set a
 //! terminal's title or clear its screen through an error (`shown`); and a whole message made
 //! safe for a terminal the same way line by line, as the command line prints it
-//! (`terminal_safe`).
+//! (`terminal_safe`); a line on standard output that a closed pipe does not turn into a
+//! panic (`say`).
+
+/// Write a line to standard output. A reader that has gone (`rest-embree backends | head -1`)
+/// wants no more: the rest is dropped, quietly. Any other failure is said on standard error;
+/// neither panics, as `println!` would.
+pub(crate) fn say(line: impl std::fmt::Display) {
+    use std::io::Write;
+    match writeln!(std::io::stdout().lock(), "{line}") {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            eprintln!("error: cannot write to standard output: {e}");
+        }
+        _ => {}
+    }
+}
 
 /// The most characters of a file's text an error quotes.
 pub const SHOWN_CHARS: usize = 200;

@@ -8,6 +8,7 @@ mod farm;
 mod film;
 mod hints;
 mod tiles;
+pub(crate) use crate::text::say;
 mod view_cmd;
 
 use crate::render::Passes;
@@ -412,19 +413,6 @@ fn run(cli: Cli) -> ExitCode {
             }
             Err(e) => report(Err(crate::Error::flag("probe-group-visits", e.to_string()))),
         },
-    }
-}
-
-/// Write a line to standard output. A reader that has gone (`rest-embree backends | head -1`)
-/// wants no more: the rest is dropped, quietly. Any other failure is said on standard error;
-/// neither panics, as `println!` would.
-pub(crate) fn say(line: impl std::fmt::Display) {
-    use std::io::Write;
-    match writeln!(std::io::stdout().lock(), "{line}") {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            eprintln!("error: cannot write to standard output: {e}");
-        }
-        _ => {}
     }
 }
 

@@ -5,10 +5,11 @@
 
 use super::reader::{SceneResult, Table};
 use super::speed::velocity;
+pub(crate) use super::worldline::{Motion, Segment};
 use super::worldline::{Piece, Worldline};
 use super::Group;
 use crate::geometry::Geometry;
-use crate::spacetime::{Boost, Event, Velocity};
+use crate::spacetime::{Boost, Event};
 use glam::{DMat3, DVec3};
 use std::sync::Arc;
 
@@ -40,25 +41,6 @@ pub(crate) fn accelerates(segments: &[Segment]) -> bool {
     segments
         .iter()
         .any(|s| matches!(s.motion, Motion::Accelerated(_)))
-}
-
-/// How a segment moves, as the scene gives it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Motion {
-    /// At this velocity.
-    Uniform(Velocity),
-    /// At the velocity the segment before it reached (a uniform segment without a velocity,
-    /// after an accelerated one).
-    Coast,
-    /// With this proper acceleration (in the frame it starts at rest in).
-    Accelerated(DVec3),
-}
-
-/// One segment: its motion until world time `until` (None: for ever).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Segment {
-    pub until: Option<f64>,
-    pub motion: Motion,
 }
 
 /// Whose worldline a table's is (its messages say so).

@@ -3,9 +3,27 @@
 //! light cone, and each piece's window of emission events (docs/physics.md §12.4, §12.5, §12.7,
 //! §12.8). Reading the segments and making a group's groups of them: `segments.rs`.
 
-use super::segments::{Motion, Segment};
 use crate::spacetime::{Boost, Event, Hyperbola, Slice, Velocity, Window};
 use glam::{DMat3, DVec3};
+
+/// How a segment moves, as the scene gives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Motion {
+    /// At this velocity.
+    Uniform(Velocity),
+    /// At the velocity the segment before it reached (a uniform segment without a velocity,
+    /// after an accelerated one).
+    Coast,
+    /// With this proper acceleration (in the frame it starts at rest in).
+    Accelerated(DVec3),
+}
+
+/// One segment: its motion until world time `until` (None: for ever).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Segment {
+    pub until: Option<f64>,
+    pub motion: Motion,
+}
 
 /// A piece of a resolved worldline.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -132,17 +132,17 @@ pub(crate) fn run(config: &Config) -> crate::Result<()> {
         a => a.to_string(),
     };
     let url = format!("http://{host}:{port}/?token={}", viewer.access.token());
-    crate::cli::say(format_args!(
+    crate::text::say(format_args!(
         "rest-embree view: {} at\n  {url}",
         config.scene.display()
     ));
     if !config.bind.is_loopback() {
-        crate::cli::say(format_args!(
+        crate::text::say(format_args!(
             "From another machine, through an SSH tunnel: ssh -N -L {port}:localhost:{port} THIS-HOST, then open\n  http://localhost:{port}/?token={}",
             viewer.access.token()
         ));
     }
-    crate::cli::say("Ctrl-C stops it.");
+    crate::text::say("Ctrl-C stops it.");
     if config.open_browser {
         open_browser(&url);
     }
@@ -164,7 +164,7 @@ pub(crate) fn run(config: &Config) -> crate::Result<()> {
     }
     runtime.shutdown_timeout(std::time::Duration::from_secs(1));
     crate::output::file::remove_partial_files();
-    crate::cli::say("rest-embree view: stopped");
+    crate::text::say("rest-embree view: stopped");
     Ok(())
 }
 

@@ -6,38 +6,11 @@
 //! and both `wo` (toward the viewer) and `wi` (toward where the light comes from) point away
 //! from the surface (docs/physics.md §10).
 
+pub use super::draws::Basis;
 use super::draws::{cosine_dir, cosine_pdf, sincos_turn};
 use crate::render::band::Band;
 use glam::DVec3;
 use std::f64::consts::PI;
-
-/// An orthonormal frame about a unit normal (Duff et al. 2017, without branches but the sign).
-pub struct Basis {
-    t: DVec3,
-    b: DVec3,
-    n: DVec3,
-}
-
-impl Basis {
-    pub fn new(n: DVec3) -> Basis {
-        let sign = 1f64.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        Basis {
-            t: DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-            b: DVec3::new(b, sign + n.y * n.y * a, -n.y),
-            n,
-        }
-    }
-
-    pub fn to_local(&self, v: DVec3) -> DVec3 {
-        DVec3::new(v.dot(self.t), v.dot(self.b), v.dot(self.n))
-    }
-
-    pub fn to_world(&self, v: DVec3) -> DVec3 {
-        v.x * self.t + v.y * self.b + v.z * self.n
-    }
-}
 
 /// Unpolarised Fresnel reflectance at a boundary met at `cos_i` (> 0) from the side of index
 /// n_i, with `eta` = n_t / n_i; 1 on total internal reflection.

@@ -8,6 +8,34 @@
 use glam::DVec3;
 use std::f64::consts::PI;
 
+/// An orthonormal frame about a unit normal (Duff et al. 2017, without branches but the sign).
+pub struct Basis {
+    t: DVec3,
+    b: DVec3,
+    n: DVec3,
+}
+
+impl Basis {
+    pub fn new(n: DVec3) -> Basis {
+        let sign = 1f64.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        Basis {
+            t: DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+            b: DVec3::new(b, sign + n.y * n.y * a, -n.y),
+            n,
+        }
+    }
+
+    pub fn to_local(&self, v: DVec3) -> DVec3 {
+        DVec3::new(v.dot(self.t), v.dot(self.b), v.dot(self.n))
+    }
+
+    pub fn to_world(&self, v: DVec3) -> DVec3 {
+        v.x * self.t + v.y * self.b + v.z * self.n
+    }
+}
+
 /// sin and cos of 2π u, for u in [0, 1) (any finite u works: whole turns drop out), without a
 /// call into libm: the turn is cut into quarters exactly (4u and its nearest whole number are
 /// exact in f64), and the quarter's remainder, at most π/4 either way, goes through the Taylor
@@ -63,7 +91,7 @@ pub(crate) fn cosine_dir(u1: f64, u2: f64) -> DVec3 {
 /// drawn uniformly by solid angle from two uniform numbers.
 #[inline(always)]
 pub(crate) fn cone_dir(axis: DVec3, omc: f64, u1: f64, u2: f64) -> DVec3 {
-    let basis = super::bsdf::Basis::new(axis);
+    let basis = Basis::new(axis);
     let a = u1 * omc;
     let cos = 1.0 - a;
     let sin = (a * (2.0 - a)).max(0.0).sqrt();

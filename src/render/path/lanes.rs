@@ -10,8 +10,7 @@
 //! computes for that vertex, to the bit; the band's arithmetic (colours, spectra) and the
 //! rays stay per path.
 
-use super::bsdf::Basis;
-use super::draws::{cosine_dir, cosine_pdf, power, sphere_cone, sphere_point};
+use super::draws::{cosine_dir, cosine_pdf, power, sphere_cone, sphere_point, Basis};
 use glam::DVec3;
 use multiversion::multiversion;
 use std::f64::consts::PI;
