@@ -148,10 +148,11 @@ pub(super) fn run(
                 skipped += 1;
                 continue;
             }
-            Some(Err(why)) => eprintln!(
+            Some(Err(why)) if !args.quiet => eprintln!(
                 "frame {k}: {} is not a finished frame of this render ({why}): rendering it again",
                 path.display()
             ),
+            Some(Err(_)) => {}
             None => {}
         }
         let t1 = std::time::Instant::now();
@@ -160,7 +161,7 @@ pub(super) fn run(
         let secs = t1.elapsed().as_secs_f64();
         render_secs += secs;
         rendered += 1;
-        warn_nonfinite(&stats);
+        warn_nonfinite(&stats, args.quiet);
         if !args.quiet {
             eprintln!(
                 "frame {k} ({} of {}..{last}), view time {:?}: {} in {secs:.3} s",

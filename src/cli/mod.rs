@@ -185,6 +185,11 @@ pub(crate) struct RenderArgs {
     /// counted from 0.
     #[arg(long, value_name = "A..B", value_parser = film::parse_frames)]
     pub frames: Option<(u64, u64)>,
+    /// Render one still of a scene with a [film] to a plain file name: frame N with
+    /// `--frames N`, else the scene's own view (its camera's time). `--frames N` with a plain
+    /// name does the same without it.
+    #[arg(long)]
+    pub still: bool,
     /// Skip the frames of a film whose files exist already (a frame's file appears only when it
     /// is written whole, so an existing one is complete).
     #[arg(long)]
@@ -650,10 +655,37 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
         scene.image.crop = Some(tiles::tile_crop(&scene, format, grid, index, &shown)?);
     }
     fits_in_memory(&scene, format, args)?;
-    if let Some(w) = render::extrapolation_warning(&scene) {
+    // Said once per command (a film's frames share it), and not under --quiet.
+    if let Some(w) = render::extrapolation_warning(&scene).filter(|_| !args.quiet) {
         eprintln!("{w}");
     }
-    if scene.film.is_some() || args.frames.is_some() {
+    // One frame of a film to a plain name (no run of #): a still of that frame.
+    let plain = !args
+        .output
+        .file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n.contains('#'));
+    let single = args.frames.filter(|(a, b)| a == b).map(|(a, _)| a);
+    if plain && (single.is_some() || args.still) {
+        match (&scene.film, single) {
+            (Some(film), Some(k)) => {
+                film::frame_range(film, Some((k, k)))?;
+                scene = scene.film_frame(k).expect("a film");
+            }
+            (None, Some(_)) => {
+                return Err(Error::flag(
+                    "--frames",
+                    "the scene is not a film: add a [film] table (start, end, fps or step), or leave --frames out",
+                ))
+            }
+            (_, None) => scene.film = None,
+        }
+    } else if args.still {
+        return Err(Error::flag(
+            "--still",
+            "renders one picture: give a plain file name (no run of #), and at most one frame",
+        ));
+    } else if scene.film.is_some() || args.frames.is_some() {
         if let Some(flag) = [
             ("--max-time", args.max_time),
             ("--target-rms", args.target_rms),
@@ -682,17 +714,19 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
     }
     let mut stats = render_to_file(&scene, &world, &backend_name, format, args, &args.output)?;
     stats.build_time = build_time;
-    warn_nonfinite(&stats);
+    warn_nonfinite(&stats, args.quiet);
     if !args.quiet {
         let secs = stats.trace_time.as_secs_f64();
         eprintln!(
-            "{}: {}x{}, {} spp, {} primitives in {} groups, backend {backend_name}: build {:.3} s, render {:.3} s ({:.2} M primary rays/s)",
+            "{}: {}x{}, {} spp, {} primitive{} in {} group{}, backend {backend_name}: build {:.3} s, render {:.3} s ({:.2} M primary rays/s)",
             args.output.display(),
             scene.image.frame_size().0,
             scene.image.frame_size().1,
             stats.samples.unwrap_or(scene.image.samples),
             scene.primitive_count(),
+            if scene.primitive_count() == 1 { "" } else { "s" },
             scene.groups.len(),
+            if scene.groups.len() == 1 { "" } else { "s" },
             stats.build_time.as_secs_f64(),
             secs,
             stats.primary_rays as f64 / secs.max(1e-9) / 1e6
@@ -717,8 +751,8 @@ fn run_assemble(output: &Path, tiles: &[PathBuf]) -> crate::Result<()> {
     output::assemble(tiles, output)
 }
 
-fn warn_nonfinite(stats: &render::RenderStats) {
-    if stats.nonfinite_pixels > 0 {
+fn warn_nonfinite(stats: &render::RenderStats, quiet: bool) {
+    if stats.nonfinite_pixels > 0 && !quiet {
         eprintln!(
             "warning: {} pixels came out NaN or infinite and were set to black; please report this scene",
             stats.nonfinite_pixels

@@ -288,7 +288,7 @@ const MOSTLY_OUTSIDE: (f64, f64) = (380.0 / 580.0, 780.0 / 580.0);
 /// never show it.
 pub(crate) fn extrapolation_warning(scene: &Scene) -> Option<String> {
     use crate::spacetime::Velocity;
-    if !scene.render.doppler {
+    if !scene.render.doppler || !scene.render.rgb_shift_warning {
         return None;
     }
     let coloured = |c: &crate::spectrum::Colour| {
@@ -319,14 +319,8 @@ pub(crate) fn extrapolation_warning(scene: &Scene) -> Option<String> {
     let d = phi.exp();
     (d > MOSTLY_OUTSIDE.1).then(|| {
         format!(
-            "warning: colours given as RGB may be seen shifted by up to D = {d:.2} ({what} moves at \
-             {:.2}c relative to the camera): from D = {:.2} on (or below {:.2}) most of what the \
-             camera sees of them left at wavelengths outside 380-780 nm, where an RGB colour says \
-             nothing and its spectrum is held at its end values; give such a colour as a spectrum \
-             to say what it is there (docs/physics.md, section 6.1)",
+            "warning: {what} moves at {:.2}c relative to the camera: its colours given as RGB may be seen shifted by up to D = {d:.2}, from light outside 380-780 nm, where RGB says nothing (docs/physics.md 6.1).\n  Give them as spectra to say what they are there; `[render] rgb_shift_warning = false` (or --quiet) silences this.",
             phi.tanh(),
-            MOSTLY_OUTSIDE.1,
-            MOSTLY_OUTSIDE.0
         )
     })
 }

@@ -572,6 +572,7 @@ fn render_settings(t: &Table) -> SceneResult<RenderSettings> {
             }
         },
         seed: t.uint("seed", Some(0), 0, i64::MAX as u64)?,
+        rgb_shift_warning: t.bool_or("rgb_shift_warning", d.rgb_shift_warning)?,
     };
     t.finish(&[
         "max_depth",
@@ -581,6 +582,7 @@ fn render_settings(t: &Table) -> SceneResult<RenderSettings> {
         "searchlight",
         "integrator",
         "seed",
+        "rgb_shift_warning",
     ])?;
     Ok(s)
 }

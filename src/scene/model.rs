@@ -202,6 +202,9 @@ pub struct RenderSettings {
     /// The seed of the path integrator's random numbers: the same seed gives the same image
     /// on any number of threads.
     pub seed: u64,
+    /// Whether a render warns where colours given as RGB may be seen shifted beyond the
+    /// camera's band (`rgb_shift_warning = false` silences it, as `--quiet` does).
+    pub rgb_shift_warning: bool,
 }
 
 /// How light is followed from the camera (`[render] integrator`).
@@ -229,6 +232,7 @@ impl Default for RenderSettings {
             searchlight: true,
             integrator: Integrator::Whitted,
             seed: 0,
+            rgb_shift_warning: true,
         }
     }
 }
