@@ -400,6 +400,32 @@ fn a_progress_bar_on_a_terminal_only() {
         !err.contains("rendering [") && err.contains("out.png: 2000x2000"),
         "{err}"
     );
+    // Rounds under a noise target: the round, the samples and the noise so far, within half a
+    // second of the start (the bar is drawn a few times a second once shown).
+    let path = GOOD.replace("[image]\n", "[image]\nsamples = 4096\n")
+        + "[render]\nintegrator = \"path\"\n";
+    let path_scene = d.file("path.toml", &path);
+    let cmd = format!(
+        "{} render {} -o {} --width 400 --height 400 --target-rms 1e-9 --max-time 2",
+        env!("CARGO_BIN_EXE_rest-embree"),
+        path_scene.display(),
+        out.display()
+    );
+    let t0 = std::time::Instant::now();
+    let rounds = std::process::Command::new("script")
+        .args(["-qec", &cmd, "/dev/null"])
+        .output()
+        .unwrap();
+    let shown = String::from_utf8_lossy(&rounds.stdout);
+    assert!(t0.elapsed().as_secs() < 20);
+    assert!(
+        shown.contains("rendering round ")
+            && shown.contains("/4096 spp, RMS ")
+            && shown.contains("(target 1.0e-9)")
+            && shown.contains(" s left")
+            && shown.contains("stopped by time"),
+        "{shown}"
+    );
     // The bench: a bar over its cases on a terminal, a line per case otherwise.
     let out = d.0.join("bench");
     let case = "lattice beta=0.9, no lights";

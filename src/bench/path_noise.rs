@@ -48,7 +48,8 @@ pub(crate) fn summary(quick: bool, backends: &[&str]) -> crate::Result<String> {
         let world = World::build(&scene(width, 4)?, b.as_ref())?;
         let everything = StopAt::default();
         let reference = scene(width, reference_spp)?;
-        let (truth, _, done) = render_progressive(&reference, &world, Passes::Colour, everything)?;
+        let (truth, _, done) =
+            render_progressive(&reference, &world, Passes::Colour, everything, None)?;
         let own = done.rms.unwrap_or(0.0);
         let _ = writeln!(
             lines,
@@ -59,7 +60,13 @@ pub(crate) fn summary(quick: bool, backends: &[&str]) -> crate::Result<String> {
             let sc = scene(width, spp)?;
             let mut out = None;
             let secs = super::fastest(if quick { 1 } else { 2 }, || {
-                out = Some(render_progressive(&sc, &world, Passes::Colour, everything));
+                out = Some(render_progressive(
+                    &sc,
+                    &world,
+                    Passes::Colour,
+                    everything,
+                    None,
+                ));
             });
             let (frame, _, d) = out.expect("rendered")?;
             let err = (rms(&frame, &truth).powi(2) - own * own).max(0.0).sqrt();

@@ -449,7 +449,12 @@ fn render_to_file(
     let t1 = std::time::Instant::now();
     let (w, h) = scene.image.frame_size();
     let watching = !args.quiet && std::io::stderr().is_terminal();
-    let progress = watching.then(|| render::Progress::new(u64::from(w) * u64::from(h)));
+    let pixels = u64::from(w) * u64::from(h);
+    let progress = watching.then(|| match args.stop_at() {
+        // Rounds of samples: a bar per round, and the rounds, samples and noise so far.
+        Some(_) => render::Progress::rounds(pixels),
+        None => render::Progress::new(pixels),
+    });
     let progress = progress.as_ref();
     let mut stats = render::RenderStats::default();
     let written = match format {
@@ -528,7 +533,8 @@ fn render_pixels(
     let Some(stop) = args.stop_at() else {
         return render::render_world_in_strips(scene, world, passes, strip, progress, put);
     };
-    let (frame, stats, done) = render::render_progressive(scene, world, passes, stop)?;
+    let (frame, stats, done) = render::render_progressive(scene, world, passes, stop, progress)?;
+    progress.inspect(|p| p.finish());
     put(&frame)?;
     if !args.quiet {
         let rms = done

@@ -40,6 +40,26 @@ impl Progress {
         p
     }
 
+    /// Progress over rounds of samples (`--max-time`, `--target-rms`): each round's pixels
+    /// as the bar, and what the rounds have done so far as its message.
+    pub fn rounds(pixels: u64) -> Progress {
+        let p = Progress::new(pixels);
+        p.bar.set_style(
+            ProgressStyle::with_template(
+                "rendering {msg} [{wide_bar}] {percent:>3}%, {elapsed} elapsed",
+            )
+            .expect("a valid template")
+            .progress_chars("=> "),
+        );
+        p
+    }
+
+    /// A new round: the bar starts again, `message` says where the rounds are.
+    pub fn next_round(&self, message: String) {
+        self.bar.set_position(0);
+        self.bar.set_message(message);
+    }
+
     /// The share of the pixels done, 0 to 1.
     pub fn fraction(&self) -> f64 {
         let total = self.bar.length().unwrap_or(0).max(1);

@@ -37,11 +37,14 @@ pub struct Converged {
 
 /// Render `scene` (its `samples` the most per pixel) in rounds until `stop` says so. The frame
 /// holds the passes of the first round's centre rays and the mean colour and coverage of all.
+/// `progress`, where given, shows each round's pixels, and the rounds, samples, noise and time
+/// left so far.
 pub(crate) fn render(
     scene: &Scene,
     world: &super::World,
     passes: Passes,
     stop: StopAt,
+    progress: Option<&super::Progress>,
 ) -> crate::Result<(super::Frame, RenderStats, Converged)> {
     let t0 = Instant::now();
     let cap = scene.image.samples.max(1);
@@ -55,11 +58,25 @@ pub(crate) fn render(
     let mut first: Option<super::Frame> = None;
     let mut stats = RenderStats::default();
     let (mut done, mut rounds) = (0u32, 0u32);
-    let mut rms;
+    let mut rms: Option<f64> = None;
     let stopped_by = loop {
         let t_round = Instant::now();
         let round_passes = if rounds == 0 { passes } else { Passes::Colour };
-        let rows = Rows::new(&round_scene, world, round_passes, None).with_sample_base(done);
+        if let Some(p) = progress {
+            let noise = rms.map_or("RMS not yet known".into(), |r: f64| format!("RMS {r:.2e}"));
+            let target = stop
+                .target_rms
+                .map_or(String::new(), |t| format!(" (target {t:.1e})"));
+            let left = stop.max_time.map_or(String::new(), |m| {
+                let s = m.saturating_sub(t0.elapsed()).as_secs_f64();
+                format!(", {s:.0} s left")
+            });
+            p.next_round(format!(
+                "round {}, {done}/{cap} spp, {noise}{target}{left}",
+                rounds + 1
+            ));
+        }
+        let rows = Rows::new(&round_scene, world, round_passes, progress).with_sample_base(done);
         let (frame, s) = rows.render(0..h);
         world.check()?;
         stats.primary_rays += s.primary_rays;

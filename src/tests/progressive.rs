@@ -79,7 +79,7 @@ fn rounds_average_to_the_image_and_know_their_noise() {
     let reference = scene(1024);
     let world = World::build(&reference, backend.as_ref()).unwrap();
     let (full, _, done) =
-        render_progressive(&reference, &world, Passes::Colour, StopAt::default()).unwrap();
+        render_progressive(&reference, &world, Passes::Colour, StopAt::default(), None).unwrap();
     assert_eq!(
         (done.samples, done.rounds, done.stopped_by),
         (1024, 256, "samples")
@@ -89,7 +89,8 @@ fn rounds_average_to_the_image_and_know_their_noise() {
         target_rms: Some(0.02),
         max_time: None,
     };
-    let (quick, _, q) = render_progressive(&scene(1024), &world, Passes::Colour, stop).unwrap();
+    let (quick, _, q) =
+        render_progressive(&scene(1024), &world, Passes::Colour, stop, None).unwrap();
     assert_eq!(q.stopped_by, "target");
     let estimated = q.rms.unwrap();
     assert!(estimated <= 0.02 && q.samples < 1024, "{q:?}");
@@ -115,7 +116,8 @@ fn one_round_is_the_ordinary_render_and_threads_change_nothing() {
     let sc = scene(4);
     let world = World::build(&sc, backend.as_ref()).unwrap();
     let (whole, _) = render_world(&sc, &world);
-    let (one, _, done) = render_progressive(&sc, &world, Passes::All, StopAt::default()).unwrap();
+    let (one, _, done) =
+        render_progressive(&sc, &world, Passes::All, StopAt::default(), None).unwrap();
     assert_eq!((done.rounds, done.samples), (1, 4));
     assert_eq!(
         super::differing_pixels(&whole, &one),
@@ -132,7 +134,7 @@ fn one_round_is_the_ordinary_render_and_threads_change_nothing() {
             .num_threads(threads)
             .build()
             .unwrap();
-        pool.install(|| render_progressive(&many, &world, Passes::Colour, stop).unwrap())
+        pool.install(|| render_progressive(&many, &world, Passes::Colour, stop, None).unwrap())
     };
     let (a, b) = (run(1), run(2));
     assert_eq!((a.2.samples, a.2.stopped_by), (40, "samples"));
