@@ -481,6 +481,19 @@ fn slips_say_what_would_be_accepted() {
             "{ blackbody = T }",
         ],
     );
+    // A slip inside an inline table: the key blamed, not a missing one.
+    fails(
+        "checker-colour",
+        &with(
+            "color = [0.8, 0.8, 0.8]",
+            "color = \"squares\"\n[[texture]]\nname = \"squares\"\nchecker = { size = 0.5, colour1 = 0.9, color2 = 0.1 }",
+        ),
+        &[],
+        &[
+            "checker.colour1",
+            "unknown key\n  did you mean `color1`?",
+        ],
+    );
     fails(
         "samples-point",
         &with("height = 32", "height = 32\nsamples = 4.5"),

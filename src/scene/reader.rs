@@ -80,7 +80,30 @@ impl<'a> Table<'a> {
 
     /// An error about this table as a whole (a missing key, a conflict).
     pub fn error(&self, key: &str, msg: impl Into<String>) -> SceneError {
+        // A key said missing that is written nearly so (`colour1` for `color1` in an inline
+        // table, which is read before its unknown keys are looked for): that key is blamed,
+        // with the name meant, as `finish` blames an unknown key.
+        if self.get(key).is_none() {
+            let near = self.entries().iter().find(|(k, _)| {
+                !self.used.borrow()[self.index_of(k)] && closest(k, &[key]).is_some()
+            });
+            if let Some((k, n)) = near {
+                return self.error_at(
+                    n,
+                    k,
+                    format!("unknown key\n  did you mean `{key}`?{}", case_note(k, key)),
+                );
+            }
+        }
         SceneError::new(self.doc.locate(&self.node.origin), self.key_path(key), msg)
+    }
+
+    /// The index of entry `key` among the entries (as `used` counts them).
+    fn index_of(&self, key: &str) -> usize {
+        self.entries()
+            .iter()
+            .position(|(k, _)| k == key)
+            .unwrap_or(0)
     }
 
     /// An error about one value.
