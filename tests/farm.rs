@@ -223,6 +223,64 @@ fn bad_farms_are_clear_errors() {
         !d.0.join("rest-embree-farm").exists(),
         "a dry run writes nothing"
     );
+    // The render's flags, as render takes them; the sbatch arguments, memory and time as
+    // #SBATCH lines of the script itself (a resubmitted script keeps them), each default said.
+    let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args([
+            "farm",
+            "slurm",
+            s(&film),
+            "-o",
+            s(&out_pattern(&d.0)),
+            "--dry-run",
+            "--width",
+            "64",
+            "--samples",
+            "2",
+            "--passes",
+            "depth",
+            "--sbatch-arg=--partition=long",
+            "--sbatch-arg=--cpus-per-task=2",
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    for needle in [
+        "#SBATCH --partition=long",
+        "#SBATCH --cpus-per-task=2",
+        "#SBATCH --mem=",
+        "# (--mem: the render's estimate",
+        "#SBATCH --time=0-",
+        "on 2 CPUs",
+        " --width '64'",
+        " --samples '2'",
+        " --passes 'depth'",
+        "--resume",
+        "a file system every node sees",
+    ] {
+        assert!(text.contains(needle), "`{needle}` in {text}");
+    }
+    let given = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+        .args([
+            "farm",
+            "slurm",
+            s(&film),
+            "-o",
+            s(&out_pattern(&d.0)),
+            "--dry-run",
+            "--mem",
+            "4G",
+            "--time",
+            "1:00:00",
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&given.stdout);
+    assert!(
+        text.contains("#SBATCH --mem=4G\n") && text.contains("#SBATCH --time=1:00:00\n"),
+        "{text}"
+    );
 }
 
 fn out_pattern(dir: &Path) -> std::path::PathBuf {

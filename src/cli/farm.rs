@@ -61,9 +61,31 @@ pub(crate) struct SlurmArgs {
     /// Split a still into N columns x M rows of tiles, one task each (an EXR output).
     #[arg(long, value_name = "NxM", value_parser = tiles::parse_grid)]
     pub tiles: Option<(u32, u32)>,
-    /// An argument for sbatch, e.g. --sbatch-arg=--partition=long (repeat for more).
+    /// An argument for sbatch, e.g. --sbatch-arg=--partition=long (repeat for more): written
+    /// into every job script as an #SBATCH line (a script resubmitted by hand keeps it) and
+    /// given to sbatch.
     #[arg(long = "sbatch-arg", value_name = "ARG", allow_hyphen_values = true)]
     pub sbatch_args: Vec<String>,
+    /// Memory per task, as sbatch's --mem takes it (e.g. 8G); default: the render's own
+    /// estimate with room to spare, said in the script.
+    #[arg(long, value_name = "SIZE")]
+    pub mem: Option<String>,
+    /// Time limit per task, as sbatch's --time takes it (e.g. 2:00:00); default: estimated from
+    /// a small render of the scene here, with room to spare, said in the script.
+    #[arg(long, value_name = "TIME")]
+    pub time: Option<String>,
+    /// Image width in pixels, as for render.
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels, as for render.
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Samples per pixel, as for render.
+    #[arg(long)]
+    pub samples: Option<u32>,
+    /// The passes an EXR holds, as for render.
+    #[arg(long, value_name = "LIST", value_parser = super::pass_list)]
+    pub passes: Option<String>,
     /// Override a scene value in every task, as `render --set`.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
@@ -128,9 +150,25 @@ fn job_name(stem: &str) -> String {
         .collect()
 }
 
-fn script(name: &str, logs: &Path, array: Option<u64>, body: &str) -> String {
+fn script(
+    name: &str,
+    logs: &Path,
+    array: Option<u64>,
+    directives: &[String],
+    body: &str,
+) -> String {
     let mut s = String::from("#!/bin/bash\n");
     let _ = writeln!(s, "#SBATCH --job-name={name}");
+    for d in directives {
+        match d.starts_with('#') {
+            true => {
+                let _ = writeln!(s, "{d}");
+            }
+            false => {
+                let _ = writeln!(s, "#SBATCH {d}");
+            }
+        }
+    }
     let logs = slurm_pattern(&logs.display().to_string());
     match array {
         Some(n) => {
@@ -142,6 +180,7 @@ fn script(name: &str, logs: &Path, array: Option<u64>, body: &str) -> String {
         }
     }
     s.push_str("# Written by `rest-embree farm slurm`. Watch: squeue --me, sacct -j JOBID; stop: scancel JOBID.\n");
+    s.push_str("# The binary, the scene and every file it names are read by their full paths on the\n# node that runs a task: they must be on a file system every node sees (as the output is).\n");
     s.push_str("set -euo pipefail\n");
     s.push_str(body);
     s
@@ -175,6 +214,9 @@ struct Plan {
     name: String,
     common: String,
     flags: String,
+    /// The #SBATCH lines of every task's script but the job's name and logs: --mem, --time
+    /// (each with how it was chosen, in a comment above) and the --sbatch-args.
+    directives: Vec<String>,
 }
 
 impl Plan {
@@ -184,11 +226,26 @@ impl Plan {
         let exe = std::env::current_exe().map_err(|e| Error::flag("farm", e))?;
         let scene_path = std::fs::canonicalize(&args.scene)
             .map_err(|e| Error::flag(&args.scene.display().to_string(), e))?;
-        let overrides: Vec<(String, String)> = args
-            .set
-            .iter()
-            .map(|s| (format!("--set {s}"), s.clone()))
-            .collect();
+        // The render flags a task is given, as the scene it reads is checked here.
+        let mut render_flags: Vec<(String, String)> = Vec::new();
+        for (flag, key, v) in [
+            ("--width", "image.width", args.width),
+            ("--height", "image.height", args.height),
+            ("--samples", "image.samples", args.samples),
+        ] {
+            if let Some(v) = v {
+                render_flags.push((format!("{flag} {v}"), format!("{key}={v}")));
+            }
+        }
+        if let Some(list) = &args.passes {
+            let names: Vec<String> = list.split(',').map(|n| format!("{:?}", n.trim())).collect();
+            render_flags.push((
+                format!("--passes {list}"),
+                format!("image.passes=[{}]", names.join(", ")),
+            ));
+        }
+        let mut overrides = render_flags.clone();
+        overrides.extend(args.set.iter().map(|s| (format!("--set {s}"), s.clone())));
         // A tiled image may be larger than one frame; each tile's frame is checked below.
         let frame = match args.tiles {
             Some(_) => scene::FrameSize::InTiles,
@@ -213,10 +270,15 @@ impl Plan {
         if let Some(b) = &args.backend {
             let _ = write!(flags, " --backend {}", quote(b));
         }
+        for (shown, _) in &render_flags {
+            let (flag, value) = shown.split_once(' ').expect("a flag and its value");
+            let _ = write!(flags, " {flag} {}", quote(value));
+        }
         for s in &args.set {
             let _ = write!(flags, " --set {}", quote(s));
         }
         flags.push_str(" ${SLURM_CPUS_PER_TASK:+--threads $SLURM_CPUS_PER_TASK}");
+        let directives = directives(&scene, format, args)?;
         let plan = Plan {
             exe,
             format,
@@ -227,6 +289,7 @@ impl Plan {
             name,
             common,
             flags,
+            directives,
         };
         Ok((scene, plan))
     }
@@ -252,7 +315,7 @@ impl Plan {
         );
         Ok(vec![Job {
             file: self.logs.join(format!("{}-frames.sbatch", self.stem)),
-            text: script(&self.name, &self.logs, Some(tasks), &body),
+            text: script(&self.name, &self.logs, Some(tasks), &self.directives, &body),
             tasks,
         }])
     }
@@ -280,7 +343,7 @@ impl Plan {
             );
             return Ok(vec![Job {
                 file: self.logs.join(format!("{}-render.sbatch", self.stem)),
-                text: script(&self.name, &self.logs, Some(1), &body),
+                text: script(&self.name, &self.logs, Some(1), &self.directives, &body),
                 tasks: 1,
             }]);
         };
@@ -294,12 +357,12 @@ impl Plan {
         let prefix = self.dir.join(format!("{}.tile-", self.stem));
         let prefix = quote(&prefix.display().to_string());
         let body = format!(
-            "{}tile={prefix}\nexec \"$exe\" render \"$scene\" -o \"${{tile}}${{SLURM_ARRAY_TASK_ID}}.exr\" --tiles {columns}x{rows} --tile \"$SLURM_ARRAY_TASK_ID\"{}\n",
+            "{}tile={prefix}\nexec \"$exe\" render \"$scene\" -o \"${{tile}}${{SLURM_ARRAY_TASK_ID}}.exr\" --tiles {columns}x{rows} --tile \"$SLURM_ARRAY_TASK_ID\" --resume{}\n",
             self.common, self.flags
         );
         let render = Job {
             file: self.logs.join(format!("{}-tiles.sbatch", self.stem)),
-            text: script(&self.name, &self.logs, Some(tasks), &body),
+            text: script(&self.name, &self.logs, Some(tasks), &self.directives, &body),
             tasks,
         };
         let all: Vec<String> = (0..tasks)
@@ -314,11 +377,159 @@ impl Plan {
         );
         let assemble = Job {
             file: self.logs.join(format!("{}-assemble.sbatch", self.stem)),
-            text: script(&format!("{}-assemble", self.name), &self.logs, None, &body),
+            text: script(
+                &format!("{}-assemble", self.name),
+                &self.logs,
+                None,
+                &self.directives,
+                &body,
+            ),
             tasks: 1,
         };
         Ok(vec![render, assemble])
     }
+}
+
+/// The CPUs a task has: sbatch's `-c N` or `--cpus-per-task=N` among the --sbatch-args, else 1.
+fn cpus_per_task(args: &SlurmArgs) -> u64 {
+    let a = &args.sbatch_args;
+    a.iter()
+        .enumerate()
+        .find_map(|(i, x)| {
+            let v = x
+                .strip_prefix("--cpus-per-task=")
+                .or_else(|| x.strip_prefix("-c").filter(|v| !v.is_empty()))
+                .map(str::to_string)
+                .or_else(|| {
+                    (x == "-c" || x == "--cpus-per-task")
+                        .then(|| a.get(i + 1).cloned())
+                        .flatten()
+                });
+            v.and_then(|v| v.parse().ok())
+        })
+        .unwrap_or(1)
+        .max(1)
+}
+
+/// The #SBATCH lines every task's script carries (with a comment after each of --mem and
+/// --time saying how it was chosen): --mem and --time as given or estimated, then the
+/// --sbatch-args (a comment for one sbatch's lines cannot hold).
+fn directives(
+    scene: &scene::Scene,
+    format: output::Format,
+    args: &SlurmArgs,
+) -> crate::Result<Vec<String>> {
+    let cpus = cpus_per_task(args);
+    let mut out = Vec::new();
+    match &args.mem {
+        Some(m) => out.push(format!("--mem={m}")),
+        None => {
+            // The render's own estimate (strips of the image, the primitives), half again
+            // for the allocator and the process, and 256 MiB for the binary and its libraries.
+            let need = super::memory_need(scene, format, cpus as usize);
+            let mib = (need as f64 * 1.5 / (1 << 20) as f64).ceil() as u64 + 256;
+            out.push(format!(
+                "--mem={mib}M\n# (--mem: the render's estimate of {} MiB, half again, and 256 MiB for the process; --mem sets it)",
+                need >> 20
+            ));
+        }
+    }
+    match &args.time {
+        Some(t) => out.push(format!("--time={t}")),
+        None => {
+            let (limit, why) = time_estimate(scene, args, cpus)?;
+            out.push(format!("--time={limit}\n# (--time: {why}; --time sets it)"));
+        }
+    }
+    for a in &args.sbatch_args {
+        if a.chars().any(char::is_control) {
+            return Err(Error::flag(
+                "--sbatch-arg",
+                format!("`{}` has a control character", crate::text::shown(a)),
+            ));
+        }
+        // sbatch splits an #SBATCH line at spaces: an argument with one goes on sbatch's
+        // command line alone, and the script says so.
+        match a.chars().any(char::is_whitespace) {
+            false => out.push(a.clone()),
+            true => out.push(format!(
+                "# (given to sbatch on its command line, not here: it holds a space) {}",
+                crate::text::shown(a)
+            )),
+        }
+    }
+    for (flag, v) in [("--mem", &args.mem), ("--time", &args.time)] {
+        if let Some(v) = v
+            .as_ref()
+            .filter(|v| v.is_empty() || v.chars().any(|c| c.is_whitespace() || c.is_control()))
+        {
+            return Err(Error::flag(
+                flag,
+                format!("`{}` is no value for sbatch", crate::text::shown(v)),
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// A task's time limit estimated from a small render of the scene here (one tile's width, the
+/// scene's samples up to 16): its time per pixel and sample on one core, times a task's
+/// pixels, samples and frames on its CPUs, three times over, plus ten minutes; as
+/// sbatch's D-HH:MM:SS, and how it was reached.
+fn time_estimate(
+    scene: &scene::Scene,
+    args: &SlurmArgs,
+    cpus: u64,
+) -> crate::Result<(String, String)> {
+    let (w, h) = scene.image.frame_size();
+    let spp = scene.image.samples.max(1);
+    let mut small = scene.clone();
+    let pw = 64u32.min(w);
+    let ph = ((u64::from(h) * u64::from(pw) / u64::from(w.max(1))) as u32).clamp(1, 64);
+    small.image.width = pw;
+    small.image.height = ph;
+    small.image.crop = None;
+    small.image.samples = spp.min(16);
+    small.film = None;
+    let backend_name = args
+        .backend
+        .clone()
+        .unwrap_or_else(|| crate::accel::default_backend_name().to_string());
+    let backend = crate::accel::backend_by_name(&backend_name)?;
+    let t0 = std::time::Instant::now();
+    let world = crate::render::World::build(&small, backend.as_ref())?;
+    crate::render::render_world_passes(&small, &world, crate::render::Passes::All);
+    let threads = rayon::current_num_threads() as f64;
+    let per = t0.elapsed().as_secs_f64() * threads
+        / (f64::from(pw) * f64::from(ph) * f64::from(small.image.samples));
+    let frames = match (&scene.film, args.tiles) {
+        (Some(f), None) => {
+            let (first, last) = film::frame_range(f, args.frames)?;
+            // Frames per task, as `film_jobs` deals them.
+            (last - first + 1).div_ceil(MAX_TASKS)
+        }
+        _ => 1,
+    };
+    let pixels = match args.tiles {
+        Some((c, r)) => (u64::from(w) * u64::from(h)).div_ceil(u64::from(c) * u64::from(r)),
+        None => u64::from(w) * u64::from(h),
+    };
+    let secs = per * pixels as f64 * f64::from(spp) * frames as f64 / cpus as f64;
+    let limit = (3.0 * secs + 600.0).ceil() as u64;
+    let (d, h2, m, s2) = (
+        limit / 86400,
+        limit / 3600 % 24,
+        limit / 60 % 60,
+        limit % 60,
+    );
+    let why = format!(
+        "a {pw}x{ph} render here took {:.2e} core-seconds a pixel and sample; a task renders {pixels} pixels at {spp} spp{} on {cpus} CPU{}, about {:.0} s; three times that and ten minutes",
+        per,
+        if frames > 1 { format!(" for {frames} frames") } else { String::new() },
+        if cpus == 1 { "" } else { "s" },
+        secs
+    );
+    Ok((format!("{d}-{h2:02}:{m:02}:{s2:02}"), why))
 }
 
 /// `output` made absolute, refused where it holds what an `#SBATCH --output` line cannot.

@@ -190,8 +190,8 @@ pub(crate) struct RenderArgs {
     /// name does the same without it.
     #[arg(long)]
     pub still: bool,
-    /// Skip the frames of a film whose files exist already (a frame's file appears only when it
-    /// is written whole, so an existing one is complete).
+    /// Skip the frames of a film whose files are finished images of this very render (every
+    /// block decodes, the size and the render's id match); likewise a still or a tile.
     #[arg(long)]
     pub resume: bool,
     /// Render one tile of a grid of N columns and M rows over the image (with --tile), to an
@@ -557,21 +557,8 @@ fn fits_in_memory(
     args: &RenderArgs,
 ) -> crate::Result<()> {
     let (w, h) = scene.image.frame_size();
-    let pixels = u64::from(w) * u64::from(h);
-    // Images are written strip by strip: only a strip (whole pairs of rows of tiles) is held
-    // at a time.
-    let row = u64::from(w) * u64::from(render::TILE);
-    let strip = |least: u64| least.max(4 * rayon::current_num_threads() as u64 * row) + 2 * row;
-    let held = match format {
-        output::Format::Exr => pixels
-            .min(strip(memory::STRIP_PIXELS))
-            .saturating_mul(memory::BYTES_PER_PIXEL_EXR),
-        output::Format::Png => pixels
-            .min(strip(memory::STRIP_PIXELS))
-            .saturating_mul(memory::BYTES_PER_PIXEL_PNG),
-    };
     let prims = scene.primitive_count() as u64;
-    let need = held.saturating_add(scene.primitive_bytes());
+    let need = memory_need(scene, format, rayon::current_num_threads());
     let what = format!("a {w}x{h} render of {prims} primitives");
     let Some(why) = memory::too_much(need, &what) else {
         return Ok(());
@@ -588,6 +575,26 @@ fn fits_in_memory(
             why,
         )),
     })
+}
+
+/// The memory a render of `scene` to `format` on `threads` threads needs, estimated: a strip of
+/// the image (whole pairs of rows of tiles: images are written strip by strip) and the
+/// scene's primitives.
+pub(crate) fn memory_need(scene: &scene::Scene, format: output::Format, threads: usize) -> u64 {
+    let (w, _) = scene.image.frame_size();
+    let (fw, fh) = scene.image.frame_size();
+    let pixels = u64::from(fw) * u64::from(fh);
+    let row = u64::from(w) * u64::from(render::TILE);
+    let strip = |least: u64| least.max(4 * threads as u64 * row) + 2 * row;
+    let held = match format {
+        output::Format::Exr => pixels
+            .min(strip(memory::STRIP_PIXELS))
+            .saturating_mul(memory::BYTES_PER_PIXEL_EXR),
+        output::Format::Png => pixels
+            .min(strip(memory::STRIP_PIXELS))
+            .saturating_mul(memory::BYTES_PER_PIXEL_PNG),
+    };
+    held.saturating_add(scene.primitive_bytes())
 }
 
 /// Whether two paths name one existing file (through links).
@@ -705,6 +712,28 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
             ));
         }
         return film::run(&scene, backend.as_ref(), &backend_name, format, args);
+    }
+    // A still (or a farm's tile) already written whole by this very render is kept.
+    if args.resume && std::fs::symlink_metadata(&args.output).is_ok() {
+        let shown: Vec<String> = args.overrides().into_iter().map(|(s, _)| s).collect();
+        let id = output::header::render_id(&scene, &backend_name, &shown);
+        let size = scene.image.frame_size();
+        match output::finished(&args.output, format, size, &id) {
+            Ok(()) => {
+                if !args.quiet {
+                    eprintln!(
+                        "{}: a finished image of this render already (--resume): kept",
+                        args.output.display()
+                    );
+                }
+                return Ok(());
+            }
+            Err(why) if !args.quiet => eprintln!(
+                "{} is not a finished image of this render ({why}): rendering it again",
+                args.output.display()
+            ),
+            Err(_) => {}
+        }
     }
     let t0 = std::time::Instant::now();
     let world = render::World::build(&scene, backend.as_ref())?;
