@@ -139,3 +139,63 @@ fn every_cited_section_of_the_physics_exists() {
     }
     assert!(cited > 10, "the code cites the physics ({cited} citations)");
 }
+
+/// Every README picture's commands are the ones `scripts/readme-images.sh` runs to make it: the
+/// README's `rest-embree render … -o docs/img/NAME.png` lines are the script's (`$r` for
+/// `rest-embree`, `$o/` for `docs/img/`, `$q` for its --quiet), the same set both ways; each
+/// film's six frames and their mosaic name the frames the script joins; and every picture the
+/// README shows is made by one of them.
+#[test]
+fn every_readme_picture_says_the_command_that_makes_it() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let script = std::fs::read_to_string(root.join("scripts/readme-images.sh")).unwrap();
+    let from_readme: std::collections::BTreeSet<String> = readme
+        .lines()
+        .filter(|l| l.starts_with("rest-embree render ") && l.contains("-o docs/img/"))
+        .map(str::to_string)
+        .collect();
+    let from_script: std::collections::BTreeSet<String> = script
+        .lines()
+        .filter(|l| l.starts_with("$r render "))
+        .map(|l| {
+            l.replacen("$r render ", "rest-embree render ", 1)
+                .replace(" $q", "")
+                .replace("\"$o/", "docs/img/")
+                .replace(".png\"", ".png")
+        })
+        .collect();
+    assert!(from_script.len() > 30, "{from_script:?}");
+    let only_readme: Vec<_> = from_readme.difference(&from_script).collect();
+    let only_script: Vec<_> = from_script.difference(&from_readme).collect();
+    assert!(
+        only_readme.is_empty() && only_script.is_empty(),
+        "in the README only: {only_readme:#?}\nin the script only: {only_script:#?}"
+    );
+    // Films: `six SCENE NAME K...` in the script, the same frames under the picture.
+    for line in script.lines().filter(|l| l.starts_with("six ")) {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let (scene, name, ks) = (words[1], words[2], words[3..].join(" "));
+        assert!(
+            readme.contains(&format!("for k in {ks}; do"))
+                && readme.contains(&format!(
+                    "rest-embree render scenes/{scene}.toml -o {name}-$k.png --width 320 --height 180 --frames $k"
+                ))
+                && readme.contains(&format!("--mosaic 3x2 -o docs/img/{name}.png")),
+            "the README's commands for {name}: frames {ks} of scenes/{scene}.toml"
+        );
+    }
+    // Every picture shown is made by a command above (or is the viewer's screenshot).
+    for pic in readme
+        .split("](docs/img/")
+        .skip(1)
+        .map(|s| s.split(')').next().unwrap())
+    {
+        let made = from_readme
+            .iter()
+            .any(|c| c.contains(&format!("-o docs/img/{pic}")))
+            || readme.contains(&format!("-o docs/img/{pic}"))
+            || pic == "viewer.png";
+        assert!(made, "no command makes docs/img/{pic}");
+    }
+}
