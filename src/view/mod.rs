@@ -371,7 +371,17 @@ fn info(
 ) -> serde_json::Value {
     use serde_json::json;
     let c = &scene.camera;
-    let v3 = |v: glam::DVec3| [v.x, v.y, v.z];
+    // Rounded to 12 significant digits for people (a field of view of 60 degrees read back
+    // from radians is 59.99999999999999): the page shows these, and sends back only values
+    // a control changed.
+    let people = |x: f64| -> f64 {
+        if x == 0.0 || !x.is_finite() {
+            return x;
+        }
+        let scale = 10f64.powi(11 - x.abs().log10().floor() as i32);
+        (x * scale).round() / scale
+    };
+    let v3 = |v: glam::DVec3| [people(v.x), people(v.y), people(v.z)];
     let mut seen = std::collections::HashSet::new();
     let groups: Vec<_> = scene
         .groups
@@ -386,7 +396,7 @@ fn info(
         })
         .collect();
     let fov = match c.projection {
-        crate::scene::Projection::Pinhole { fov_y } => Some(fov_y.to_degrees()),
+        crate::scene::Projection::Pinhole { fov_y } => Some(people(fov_y.to_degrees())),
         _ => None,
     };
     json!({
@@ -399,7 +409,7 @@ fn info(
             "direction": v3(c.forward),
             "up": v3(c.up),
             "fov_y": fov,
-            "time": c.time,
+            "time": people(c.time),
         },
         "doppler": scene.render.doppler,
         "searchlight": scene.render.searchlight,

@@ -131,7 +131,6 @@ function slider(label, min, max, step, value, onInput) {
 
 function groupControls() {
   const box = $('groups');
-  const back = scale(unit(viewer.info.camera.direction), -1);
   for (const g of viewer.info.groups) {
     const div = document.createElement('div');
     div.className = 'group';
@@ -147,7 +146,8 @@ function groupControls() {
       continue;
     }
     const beta = norm(g.velocity);
-    const st = { beta, direction: beta > 0 ? unit(g.velocity) : back };
+    // A group at rest has no direction of its own: +x until one is typed.
+    const st = { beta, direction: beta > 0 ? unit(g.velocity) : [1, 0, 0] };
     viewer.state.groups[g.name] = st;
     const s = slider('β', 0, 0.999, 0.001, beta.toFixed(3), (x) => { st.beta = Math.min(Math.max(x, 0), 0.999999); touch('group:' + g.name); });
     s.range.dataset.group = g.name;
