@@ -44,8 +44,8 @@ test: setup
 	@for isa in sse2 sse4.2 avx avx2 avx512; do \
 	  if REST_EMBREE_ISA=$$isa ./target/release/rest-embree backends >/dev/null 2>&1; then \
 	    echo "conformance under REST_EMBREE_ISA=$$isa"; \
-	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test backend_conformance --test meshes --test radar --test worldline --test shutter --test spin --test acceleration --test wigner_rotation --test turning -q || exit 1; \
-	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test path the_lanes_change_no_picture -q || exit 1; \
+	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test suite -q -- backend_conformance:: meshes:: radar:: worldline:: shutter:: spin:: acceleration:: wigner_rotation:: turning:: || exit 1; \
+	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test suite -q -- path::the_lanes_change_no_picture || exit 1; \
 	  fi; \
 	done
 	scripts/slurm-test.sh target/release/rest-embree

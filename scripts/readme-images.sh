@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Render the README's pictures (docs/img) from the scenes. Needs a release build.
 # Each picture's command is written here in full, as the README shows it under the picture
-# (`rest-embree` for "$r", docs/img/ for "$o/"); tests/house.rs holds the two to the same
+# (`rest-embree` for "$r", docs/img/ for "$o/"); tests/suite/house.rs holds the two to the same
 # commands. Films are shown as six frames joined by oiiotool.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -433,7 +433,7 @@ pub fn empty_geometry(backend: &dyn Backend, _tol: &Tolerance) {
 macro_rules! conformance_suite {
     ($modname:ident, $backend:expr, $tol:expr) => {
         mod $modname {
-            use super::common::conformance::*;
+            use $crate::common::conformance::*;
             #[test]
             fn analytic_hits_of_each_primitive() {
                 analytic_hits(&*$backend, &$tol);

@@ -3,6 +3,7 @@
 
 mod basics;
 pub mod cli;
+#[macro_use]
 pub mod conformance;
 pub mod exrcheck;
 pub use basics::*;

@@ -9,7 +9,7 @@
 //! set beside bare Embree's (the bench's `embree no-fused` row). Here the same arithmetic
 //! (`Pinhole::look`, `Boost::null_dir_lanes`, `lane_geometry`, each written once for one lane or
 //! four) runs on columns, so every lane's values are the scalar path's to the bit and images do
-//! not depend on which path made them (tests/fused_primary.rs); the columns (`FanHits`) are
+//! not depend on which path made them (src/tests/fused_primary.rs); the columns (`FanHits`) are
 //! what the renderer reads the rays and hits from (`render::PrimaryHits`).
 
 use super::exact::Lanes;

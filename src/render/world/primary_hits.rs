@@ -1,7 +1,7 @@
 //! Primary rays as fans: where one group is seen from close by through a pinhole camera and
 //! the backend has a path of its own (`Accelerator::intersect_fan`), a packet's primary rays are
 //! made, boosted and traced by the backend from the camera and the lanes' image points, with the
-//! same rays and hits to the bit as `CameraRays::ray` and `closest_hits` (tests/fused_primary.rs).
+//! same rays and hits to the bit as `CameraRays::ray` and `closest_hits` (src/tests/fused_primary.rs).
 
 use super::{SurfaceHit, World, WorldGroup};
 use crate::accel::{Accelerator, Fan, FanHits, NO_HIT};

@@ -123,7 +123,7 @@ impl RestGroups {
                 geometry,
                 accel,
                 // Relative to the group's size and place alone, so that a scene scaled as a
-                // whole renders the same (tests/envelope.rs); an accelerated body's own, not the
+                // whole renders the same (tests/suite/envelope.rs); an accelerated body's own, not the
                 // box it sweeps.
                 epsilon: 1e-7 * own.diagonal() + 1e-12 * bounds.max_abs(),
                 window,
