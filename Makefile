@@ -19,8 +19,8 @@ demo: setup
 	./target/release/rest-embree render scenes/passing_spheres.toml -o $(OUT)/passing-spheres.png
 	@echo "demo: wrote $(OUT)/lattice-0.9.png, $(OUT)/lattice-0.9.exr and $(OUT)/passing-spheres.png"
 
-# The formatting and the lints (both builds), then every test, optimised, without the Embree
-# backend and with it; then a real one-node SLURM
+# The formatting and the lints (the library alone and the whole program), then every test,
+# optimised, without the Embree backend and with it; then a real one-node SLURM
 # cluster runs a film and a tiled still through `rest-embree farm slurm` (scripts/slurm-test.sh;
 # it needs root, and says so when skipped). `--release` builds the tests in target/release
 # beside `make demo`'s binary, on the same optimised dependencies: one optimised build of
@@ -31,11 +31,12 @@ demo: setup
 # the viewer's page: a slider moved, a frame awaited, a pixel clicked (scripts/browser-test.sh).
 test: setup
 	@mkdir -p target && (scripts/blender-test.sh --install >target/bpy-install.log 2>&1 &)
-	@# The code as the house keeps it: formatted, and no lint in either build.
+	@# The code as the house keeps it: formatted, and no lint in the library alone (no Embree,
+	@# no command line: what a program that links it builds) or in the whole program.
 	$(CARGO) fmt --check
 	$(CARGO) clippy --release --no-default-features --all-targets -- -D warnings
 	$(CARGO) clippy --release --all-targets -- -D warnings
-	$(CARGO) test --release --no-default-features
+	$(CARGO) test --release --no-default-features --features cli
 	$(CARGO) test --release --workspace
 	@# The backend's conformance suite (grazing packets against single rays, analytic hits)
 	@# and the meshes' (held meshes are Embree triangle geometries) again under each of

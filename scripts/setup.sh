@@ -12,7 +12,7 @@ done
 if [ ${#missing[@]} -gt 0 ]; then
   if [ "$(id -u)" -eq 0 ]; then sudo=(); else sudo=(sudo); fi
   if ! command -v apt-get >/dev/null 2>&1; then
-    echo "setup: apt-get not found; install Embree 3 and libclang yourself (or build with --no-default-features)" >&2
+    echo "setup: apt-get not found; install Embree 3 and libclang yourself (or build with --no-default-features --features cli)" >&2
     exit 1
   fi
   echo "setup: installing ${missing[*]}"

@@ -43,6 +43,9 @@ pids+=("$(cat "$work/munge/munged.pid")")
 
 host=$(hostname -s)
 cpus=$(nproc)
+# The node's memory as a real cluster's configuration gives it: farm slurm asks for --mem, and
+# a node left at SLURM's default of 1 MB could satisfy none.
+mem_mb=$(awk '/^MemTotal:/ { print int($2 / 1024) }' /proc/meminfo)
 mkdir -p "$work/state" "$work/spool" "$work/log"
 cat > "$work/slurm.conf" <<CONF
 ClusterName=rest-embree-test
@@ -70,7 +73,7 @@ SelectTypeParameters=CR_CPU
 MpiDefault=none
 ReturnToService=2
 SchedulerType=sched/builtin
-NodeName=$host CPUs=$cpus State=UNKNOWN
+NodeName=$host CPUs=$cpus RealMemory=$mem_mb State=UNKNOWN
 PartitionName=test Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
 export SLURM_CONF="$work/slurm.conf"

@@ -1,4 +1,6 @@
 #![warn(missing_docs)]
+// Without the command line (feature `cli`), the entry points only it calls so far are unused.
+#![cfg_attr(not(feature = "cli"), allow(dead_code, unused_imports))]
 //! rest-embree: a special-relativistic ray tracer after Hsiung & Dunn's REST-frame algorithm.
 //!
 //! As a library: load a scene ([`scene::load_file`], [`scene::load_str`]), change it in code if
@@ -15,7 +17,9 @@
 //! docs/architecture.md walks through them.
 
 pub mod accel;
+#[cfg(feature = "cli")]
 mod bench;
+#[cfg(feature = "cli")]
 mod cli;
 pub mod compare;
 mod error;
@@ -29,6 +33,7 @@ pub mod scene;
 pub mod spacetime;
 pub mod spectrum;
 mod text;
+#[cfg(feature = "cli")]
 mod view;
 
 pub use error::{Cause, Error, Result};
@@ -36,6 +41,7 @@ pub use error::{Cause, Error, Result};
 /// The `rest-embree` command: parse the process's arguments and run it (what `src/main.rs`
 /// calls; not part of the library's API).
 #[doc(hidden)]
+#[cfg(feature = "cli")]
 pub fn run_command_line() -> std::process::ExitCode {
     cli::main()
 }

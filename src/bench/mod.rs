@@ -16,19 +16,20 @@ mod memory;
 mod path_noise;
 mod path_room;
 mod plot;
+mod primary;
 pub mod probe;
 mod report;
 mod scene_files;
 mod suite;
 mod threads;
 
-pub(crate) use suite::{cases, many_groups, paper, PAPER_SCENES};
+pub(crate) use crate::scene::paper::{paper, PAPER_SCENES};
+pub(crate) use primary::trace_primary;
+pub(crate) use suite::{cases, many_groups};
 
 use crate::accel::backend_by_name;
 use crate::compare::{compare, Comparison};
-use crate::render::{
-    render_world, render_world_passes, trace_primary, Frame, Passes, World, WorldOptions,
-};
+use crate::render::{render_world, render_world_passes, Frame, Passes, World, WorldOptions};
 use crate::scene::{PassSet, Scene};
 use std::time::Instant;
 
@@ -453,7 +454,7 @@ pub(crate) fn bare_rays(
     accel: &crate::accel::EmbreeAccel,
 ) -> Vec<Vec<crate::accel::BareRay>> {
     let g = &world.groups[0];
-    crate::render::primary_rays_by_tile(scene)
+    primary::primary_rays_by_tile(scene)
         .iter()
         .map(|rays| {
             rays.iter()

@@ -1,8 +1,9 @@
 //! Probes for profiling one measure at a time, repeated for as long as asked, with the internals
 //! the bench's table sums up (`examples/primary_ns.rs` and `examples/group_visits.rs` call these).
 
+use super::primary::trace_primary;
 use crate::accel::backend_by_name;
-use crate::render::{render_world, trace_primary, World, WorldOptions};
+use crate::render::{render_world, World, WorldOptions};
 use crate::scene::Scene;
 use std::time::Instant;
 

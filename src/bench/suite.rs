@@ -1,32 +1,9 @@
 //! The fixed cases of `rest-embree bench`.
 
-use super::{Case, LazyCase};
+use super::{paper, Case, LazyCase, PAPER_SCENES};
 use crate::rng::Rng;
 use crate::scene::{load_str, SceneError};
 use std::fmt::Write as _;
-
-/// The paper's scenes, built into the binary so the benchmark runs from any directory.
-pub(crate) const PAPER_SCENES: [(&str, &str); 3] = [
-    (
-        "calibration_cube",
-        include_str!("../../scenes/calibration_cube.toml"),
-    ),
-    ("bar_array", include_str!("../../scenes/bar_array.toml")),
-    ("lattice", include_str!("../../scenes/lattice.toml")),
-];
-
-/// A paper scene with overrides.
-pub(crate) fn paper(name: &str, sets: &[String]) -> Result<crate::scene::Scene, SceneError> {
-    let (_, text) = PAPER_SCENES
-        .iter()
-        .find(|(n, _)| *n == name)
-        .ok_or_else(|| SceneError::new("bench", "", format!("no paper scene named {name}")))?;
-    let sets: Vec<(String, String)> = sets
-        .iter()
-        .map(|s| (format!("--set {s}"), s.clone()))
-        .collect();
-    load_str(&format!("scenes/{name}.toml"), text, &sets)
-}
 
 /// The fast-moving planet (scenes/planet.toml) with overrides: its map written beside a copy
 /// of the scene in the temporary folder, so the bench runs from any directory.

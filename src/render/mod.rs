@@ -2,12 +2,10 @@
 //! each velocity group's rest frame, the merge of hits by world-frame lookback time, and Whitted
 //! shading in the rest frame of the surface hit.
 
-mod apparent_tree;
 mod band;
 mod camera;
 mod frame;
-mod group_tree;
-mod light_tree;
+mod optics;
 mod path;
 mod progress;
 mod progressive;
@@ -31,16 +29,18 @@ pub(crate) use camera::CameraRays;
 pub(crate) use progress::Progress;
 pub(crate) use progressive::render as render_progressive;
 pub(crate) use screen_cull::ScreenCull;
+pub(crate) use tile::TileScratch;
 pub(crate) use world::{RestGroups, World};
+// What the bench's passes of primary rays alone reach (src/bench/primary.rs).
+#[cfg(feature = "cli")]
+pub(crate) use tile::{image_points, primary_rays, tile_pixels};
 // What the tests of the internals reach (src/tests/).
 #[cfg(test)]
 pub(crate) use {
-    apparent_tree::apparent_box,
-    group_tree::{world_box, GroupTree, SlicedGroupTree},
-    light_tree::{reach_box, LightTree},
     path::Emitters,
     shade::Shader,
-    tile::{render_tile, TileScratch, View},
+    tile::{render_tile, View},
+    world::{apparent_box, reach_box, world_box, GroupTree, LightTree, SlicedGroupTree},
 };
 
 use crate::accel::Backend;
@@ -117,46 +117,12 @@ pub fn render(
     Ok((frame, stats))
 }
 
-fn tiles(scene: &Scene) -> Vec<(u32, u32)> {
+/// The top-left pixels of the image's tiles, row by row.
+pub(crate) fn tiles(scene: &Scene) -> Vec<(u32, u32)> {
     let (w, h) = scene.image.frame_size();
     let tiles_x = w.div_ceil(TILE);
     (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..tiles_x).map(move |tx| (tx * TILE, ty * TILE)))
-        .collect()
-}
-
-/// Trace every primary ray of the image through the world without shading (the benchmark's
-/// measure of intersection throughput); returns (rays, hits).
-pub(crate) fn trace_primary(scene: &Scene, world: &World) -> (u64, u64) {
-    let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
-    let cull = ScreenCull::new(world, &cam).filter(|_| !cam.has_shutter());
-    tiles(scene)
-        .par_iter()
-        .map_init(tile::TileScratch::default, |scratch, &xy| {
-            tile::trace_tile(scene, world, &cam, cull.as_ref(), xy, scratch)
-        })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
-}
-
-/// Every pixel-centre primary ray, tile by tile in the order the renderer traces them (for the
-/// benchmark's bare-Embree baseline).
-#[cfg(feature = "embree")]
-pub(crate) fn primary_rays_by_tile(scene: &Scene) -> Vec<Vec<crate::spacetime::NullRay>> {
-    let cam = CameraRays::new(&scene.camera, scene.image.width, scene.image.height);
-    let (w, h) = scene.image.frame_size();
-    tiles(scene)
-        .iter()
-        .map(|&(x0, y0)| {
-            let mut rays = Vec::new();
-            tile::primary_rays(
-                &cam,
-                &tile::tile_pixels(x0, y0, w, h),
-                scene.image.frame_offset(),
-                None,
-                &mut rays,
-            );
-            rays
-        })
         .collect()
 }
 

@@ -1,16 +1,7 @@
 //! Reproducible stratified pixel samples: the same scene gives the same image on any number of
 //! threads, because every sample's jitter is a hash of its pixel and index.
 
-pub(super) fn splitmix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-fn unit(h: u64) -> f64 {
-    (h >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-}
+use crate::rng::{splitmix64 as splitmix, unit_f64 as unit};
 
 /// Offset in [0, 1)² of sample `s` of `n` in pixel (x, y), in a round of samples that starts at
 /// sample `base` of the pixel (a progressive render's; 0 otherwise): the centre when n = 1 in

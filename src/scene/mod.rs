@@ -11,6 +11,9 @@ mod mesh_file;
 mod model;
 mod node;
 mod objects;
+// Only the bench and the tests load the paper's scenes by name.
+#[cfg(any(test, feature = "cli"))]
+pub(crate) mod paper;
 mod pass_set;
 mod procedural;
 mod reader;

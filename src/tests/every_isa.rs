@@ -14,8 +14,8 @@
 
 use super::common::Rng;
 use crate::accel::{Backend, Callback, EmbreeBackend, Isa};
-use crate::bench::paper;
 use crate::render::{render, Frame, RenderOptions, WorldOptions};
+use crate::scene::paper::paper;
 use crate::scene::Scene;
 use glam::DVec3;
 

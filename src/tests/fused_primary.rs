@@ -5,8 +5,9 @@
 #![cfg(feature = "embree")]
 
 use crate::accel::backend_by_name;
-use crate::bench::paper;
-use crate::render::{render_world, trace_primary, CameraRays, Frame, World, WorldOptions};
+use crate::bench::trace_primary;
+use crate::render::{render_world, CameraRays, Frame, World, WorldOptions};
+use crate::scene::paper::paper;
 use crate::scene::Scene;
 
 fn lattice(sets: &[&str]) -> Scene {

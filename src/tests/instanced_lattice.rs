@@ -180,7 +180,7 @@ fn the_paper_scenes_render_alike_instanced() {
         ("bar_array", sets(&["group.bars.velocity=[0.9, 0, 0]"])),
     ];
     for (paper, sets) in scenes {
-        let scene = crate::bench::paper(paper, &sets).unwrap();
+        let scene = crate::scene::paper::paper(paper, &sets).unwrap();
         for name in crate::accel::backend_names() {
             let backend = backend_by_name(name).unwrap();
             let build = |instance_over| {

@@ -8,6 +8,8 @@ mod common;
 mod allocations;
 mod backend_names;
 mod every_isa;
+// It counts the bench's primary hits (src/bench/primary.rs).
+#[cfg(feature = "cli")]
 mod fused_primary;
 mod instanced_lattice;
 mod light_buffer;

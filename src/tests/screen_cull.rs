@@ -3,8 +3,8 @@
 //! in a block it keeps, every block it keeps lies in a tile it keeps, and renders with and
 //! without bounds culling agree.
 
-use crate::bench::paper;
 use crate::render::{render_world, CameraRays, ScreenCull, World, WorldOptions, TILE};
+use crate::scene::paper::paper;
 use crate::scene::Scene;
 
 fn scenes() -> Vec<(String, Scene)> {

@@ -2,9 +2,9 @@
 //! whole frame's pixels, and the PNG decodes to the whole frame's colours.
 
 use crate::accel::backend_by_name;
-use crate::bench::paper;
 use crate::output::srgb_encode;
 use crate::render::{render_world_in_strips, render_world_passes, Frame, Passes, World};
+use crate::scene::paper::paper;
 
 fn lattice(sets: &[&str]) -> crate::scene::Scene {
     let mut all: Vec<String> = vec![

@@ -131,7 +131,11 @@ fn check_as(name: &str, text: &str, sets: &[(String, String)], what: &str) -> bo
             return false;
         };
         // Large generated objects cost time, not coverage.
-        if s.primitive_count() > 20_000 || s.image.samples > 64 {
+        let stars = s.sky.as_ref().and_then(|k| k.stars.as_ref());
+        if s.primitive_count() > 20_000
+            || s.image.samples > 64
+            || stars.is_some_and(|f| f.stars.len() > 5_000)
+        {
             return false;
         }
         for b in backends() {
@@ -155,9 +159,12 @@ fn ten_thousand_mutated_scenes_neither_panic_nor_give_nan() {
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
         .map(|p| {
+            // Star fields of tens of thousands cost time, not coverage: a few hundred here.
+            let text = std::fs::read_to_string(&p).unwrap();
+            let text = text.replace("count = 40000", "count = 400");
             (
                 p.display().to_string(),
-                std::fs::read_to_string(&p).unwrap(),
+                text.replace("count = 30000", "count = 300"),
             )
         })
         .collect();

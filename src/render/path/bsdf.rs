@@ -9,38 +9,9 @@
 pub use super::draws::Basis;
 use super::draws::{cosine_dir, cosine_pdf, sincos_turn};
 use crate::render::band::Band;
+use crate::render::optics::{fresnel, phong, reflect, refract};
 use glam::DVec3;
 use std::f64::consts::PI;
-
-/// Unpolarised Fresnel reflectance at a boundary met at `cos_i` (> 0) from the side of index
-/// n_i, with `eta` = n_t / n_i; 1 on total internal reflection.
-pub(crate) fn fresnel(cos_i: f64, eta: f64) -> f64 {
-    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
-    if sin2_t >= 1.0 {
-        return 1.0;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    0.5 * (rs * rs + rp * rp)
-}
-
-/// `wo` mirrored about `h`.
-fn reflect(wo: DVec3, h: DVec3) -> DVec3 {
-    2.0 * wo.dot(h) * h - wo
-}
-
-/// `wo` refracted through a boundary with normal `h` (on its side), `eta` = n_t / n_i; None on
-/// total internal reflection.
-fn refract(wo: DVec3, h: DVec3, eta: f64) -> Option<DVec3> {
-    let c = wo.dot(h);
-    let sin2_t = (1.0 - c * c) / (eta * eta);
-    if sin2_t >= 1.0 {
-        return None;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    Some(-wo / eta + (c / eta - cos_t) * h)
-}
 
 /// The GGX (Trowbridge-Reitz) distribution of normals with roughness α.
 #[derive(Clone, Copy, Debug)]
@@ -221,7 +192,7 @@ impl<B: Band> Lobes<B> {
             if let Some((ks, n)) = &self.phong {
                 let r = DVec3::new(-wo.x, -wo.y, wo.z);
                 let c = r.dot(wi).max(0.0);
-                let l = c.powf(*n);
+                let l = phong(c, *n);
                 f.add(&(*ks * ((n + 2.0) / (2.0 * PI) * l)));
                 pdf += self.pick[1] * (n + 1.0) / (2.0 * PI) * l;
             }
@@ -462,8 +433,5 @@ mod tests {
         }
         let r = reflected as f64 / n as f64;
         assert!((r - 0.04).abs() < 0.002, "reflected share {r}");
-        assert!((fresnel(1.0, 1.5) - 0.04).abs() < 1e-15);
-        // Beyond the critical angle, inside the glass, all is reflected.
-        assert_eq!(fresnel(0.5, 1.0 / 1.5), 1.0);
     }
 }

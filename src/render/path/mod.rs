@@ -20,10 +20,9 @@ pub(crate) use emitters::Emitters;
 pub(crate) use wave::{Start, WaveScratch};
 
 use super::band::Band;
-use super::sampler::splitmix;
-use super::shade::{surface_colour, Lit, Shader, Spread};
+use super::shade::{surface_colour, Lit, MediaWalk, Shader, Spread};
 use super::world::SurfaceHit;
-use crate::rng::Rng;
+use crate::rng::{splitmix64 as splitmix, Rng};
 use crate::spacetime::{Event, NullRay};
 use bsdf::{Basis, Lobes};
 use glam::DVec3;
@@ -121,22 +120,19 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
         rng: &mut Rng,
     ) -> Reached {
         let (sh, world) = (self.shader, self.shader.world);
-        // Outside every object, a ray is in the fog (if the scene has one).
-        let mut within = within.or(sh.fog);
-        let mut t = 0.0;
-        let mut known = first;
+        let mut way = MediaWalk::new(sh, within, first);
         loop {
-            let hit = known.take().or_else(|| world.closest_hit(ray, t));
-            if let Some((g, m)) = within {
+            let stretch = way.next(sh, ray);
+            if let Some((g, m)) = stretch.within {
                 // Free flight through the medium, in its frame.
                 let gs = world.groups[g].boost.null_dir(ray.dir).1;
                 // The medium's wavelengths, and what its light gains on the way to the receiver.
                 let (shift_m, k) =
                     sh.arriving(receiver_s, sh.lookback_factor(g, ray.dir), path.shift);
-                let end = hit.map_or(f64::INFINITY, |h| h.lambda);
-                match self.fly(m, shift_m, gs * (end - t), path, rng) {
+                let end = stretch.hit.map_or(f64::INFINITY, |h| h.lambda);
+                match self.fly(m, shift_m, gs * (end - stretch.from), path, rng) {
                     Some(ts) => {
-                        let lambda = t + ts / gs;
+                        let lambda = stretch.from + ts / gs;
                         path.beta = path.beta * k;
                         path.shift = shift_m;
                         return Reached::Scatter(Scatter {
@@ -147,31 +143,13 @@ impl<'s, 'a, B: Band> PathTracer<'s, 'a, B> {
                             slow: None,
                         });
                     }
-                    None if hit.is_none() => return Reached::Lost,
+                    None if stretch.hit.is_none() => return Reached::Lost,
                     None => {}
                 }
             }
-            let Some(h) = hit else {
-                return self.reach(ray, receiver_s, None, within, path);
-            };
-            // Only the boundaries of media are invisible: without any, every hit is a surface.
-            let part = match sh.has_invisible() {
-                true => Some(world.groups[h.group].geometry.part_of(h.prim)),
-                false => None,
-            };
-            let Some(part) =
-                part.filter(|p| sh.scene.materials[p.material as usize].is_invisible())
-            else {
-                return self.reach(ray, receiver_s, Some(h), within, path);
-            };
-            let g = &world.groups[h.group];
-            let exiting = g.geometry.prim(h.prim).normal(h.point).dot(h.dir) > 0.0;
-            within = if exiting {
-                sh.fog
-            } else {
-                Some((h.group, part.material))
-            };
-            t = h.lambda + g.epsilon / h.s;
+            if !stretch.boundary {
+                return self.reach(ray, receiver_s, stretch.hit, stretch.within, path);
+            }
         }
     }
 

@@ -9,6 +9,75 @@ use crate::render::world::SurfaceHit;
 use crate::spacetime::{Event, NullRay};
 use glam::DVec3;
 
+/// A medium a ray is in: its world group and its material.
+pub(in crate::render) type Medium = Option<(usize, u32)>;
+
+/// One stretch of a null ray's way across the boundaries of media: in medium `within` from
+/// lookback `from` to `hit` (None: nothing ahead), which is either a medium's invisible
+/// boundary (`boundary`: the way goes on past it) or a surface (the way ends there).
+pub(in crate::render) struct Stretch {
+    pub within: Medium,
+    pub from: f64,
+    pub hit: Option<SurfaceHit>,
+    pub boundary: bool,
+}
+
+/// The way of a null ray across the boundaries of media, stretch by stretch: the one walk
+/// both the path integrator's legs and the shadow rays of both integrators take.
+pub(in crate::render) struct MediaWalk {
+    within: Medium,
+    t: f64,
+    known: Option<SurfaceHit>,
+}
+
+impl MediaWalk {
+    /// A walk that starts in `within` (outside every object: the fog, if the scene has one),
+    /// its first hit `first` where known.
+    pub fn new<B: Band>(sh: &Shader<B>, within: Medium, first: Option<SurfaceHit>) -> Self {
+        MediaWalk {
+            within: within.or(sh.fog),
+            t: 0.0,
+            known: first,
+        }
+    }
+
+    /// The next stretch along `ray`; past a boundary, the walk goes on in the medium beyond.
+    pub fn next<B: Band>(&mut self, sh: &Shader<B>, ray: &NullRay) -> Stretch {
+        let world = sh.world;
+        let hit = self.known.take().or_else(|| world.closest_hit(ray, self.t));
+        let (mut within, from) = (self.within, self.t);
+        // Only the boundaries of media are invisible: without any, every hit is a surface.
+        let boundary = hit.filter(|_| sh.has_invisible()).and_then(|h| {
+            let material = world.groups[h.group].geometry.part_of(h.prim).material;
+            sh.scene.materials[material as usize]
+                .is_invisible()
+                .then_some((h, material))
+        });
+        if let Some((h, material)) = boundary {
+            let g = &world.groups[h.group];
+            let exiting = g.geometry.prim(h.prim).normal(h.point).dot(h.dir) > 0.0;
+            // Leaving a medium not entered on the way: the ray started in it (media are
+            // closed and not nested).
+            if exiting && within != Some((h.group, material)) {
+                within = Some((h.group, material));
+            }
+            self.within = if exiting {
+                sh.fog
+            } else {
+                Some((h.group, material))
+            };
+            // Past the boundary, by its group's ε (rest frame) in world lookback.
+            self.t = h.lambda + g.epsilon / h.s;
+        }
+        Stretch {
+            within,
+            from,
+            hit,
+            boundary: boundary.is_some(),
+        }
+    }
+}
+
 impl<B: Band> Shader<'_, B> {
     /// The share of light the scene's fog lets through over lookback `lambda` (world frame)
     /// along world direction `dir`, seen by a receiver with lookback factor `receiver_s` and
@@ -95,12 +164,12 @@ impl<B: Band> Shader<'_, B> {
         &self,
         ray: &NullRay,
         tmax: f64,
-        mut within: Option<(usize, u32)>,
+        within: Medium,
         shift: f64,
         s: f64,
     ) -> Option<B> {
         let mut share: Option<B> = None;
-        let mut cross = |within: Option<(usize, u32)>, from: f64, to: f64| {
+        let mut cross = |within: Medium, from: f64, to: f64| {
             let Some((g, m)) = within else {
                 return;
             };
@@ -114,33 +183,17 @@ impl<B: Band> Shader<'_, B> {
                 }
             }
         };
-        // Outside every object, a ray is in the fog (if the scene has one).
-        within = within.or(self.fog);
-        let mut t0 = 0.0;
+        let mut way = MediaWalk::new(self, within, None);
         loop {
-            let Some(h) = self.world.closest_hit(ray, t0).filter(|h| h.lambda < tmax) else {
-                cross(within, t0, tmax);
-                return Some(share.unwrap_or(B::splat(1.0)));
-            };
-            let g = &self.world.groups[h.group];
-            let material = g.geometry.part_of(h.prim).material;
-            if !self.scene.materials[material as usize].is_invisible() {
-                return None;
+            let stretch = way.next(self, ray);
+            match stretch.hit.filter(|h| h.lambda < tmax) {
+                None => {
+                    cross(stretch.within, stretch.from, tmax);
+                    return Some(share.unwrap_or(B::splat(1.0)));
+                }
+                Some(_) if !stretch.boundary => return None,
+                Some(h) => cross(stretch.within, stretch.from, h.lambda),
             }
-            let exiting = g.geometry.prim(h.prim).normal(h.point).dot(h.dir) > 0.0;
-            // Leaving a medium not entered on the way: the ray started in it (media are
-            // closed and not nested).
-            if exiting && within != Some((h.group, material)) {
-                within = Some((h.group, material));
-            }
-            cross(within, t0, h.lambda);
-            within = if exiting {
-                self.fog
-            } else {
-                Some((h.group, material))
-            };
-            // Past the boundary, by its group's ε (rest frame) in world lookback.
-            t0 = h.lambda + g.epsilon / h.s;
         }
     }
 

@@ -10,8 +10,8 @@
 //! it meets that moving box at lookback λ where o − v (t_o − t_ref) + λ (d + v) lies in
 //! `at_ref`: a slab test on a static box, with no boost.
 
+use super::group_tree::world_box;
 use crate::geometry::Aabb;
-use crate::render::group_tree::world_box;
 use crate::spacetime::{NullRay, Velocity};
 use glam::DVec3;
 

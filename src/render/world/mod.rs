@@ -9,12 +9,22 @@
 //! rest, group_tree.rs for the rest, built only when such a ray comes), so a ray that misses
 //! every group costs a handful of box tests.
 
-use super::apparent_tree::ApparentTree;
-use super::group_tree::SlicedGroupTree;
-use super::light_tree::LightTree;
+use apparent_tree::ApparentTree;
+pub(crate) use group_tree::SlicedGroupTree;
+pub(crate) use light_tree::LightTree;
 
 mod accelerated;
+mod apparent_tree;
+mod group_tree;
+mod light_tree;
+// What the tests of the internals reach (src/tests/).
 pub(crate) use accelerated::point_boost;
+#[cfg(test)]
+pub(crate) use {
+    apparent_tree::apparent_box,
+    group_tree::{world_box, GroupTree},
+    light_tree::reach_box,
+};
 mod moving_bounds;
 mod turning;
 pub(crate) use turning::TurningPart;
@@ -267,7 +277,7 @@ impl World {
         // from the imaging event (secondary rays reach further back).
         let apparent: Vec<Aabb> = items
             .iter()
-            .map(|(b, v)| super::apparent_tree::apparent_box(b, v, event))
+            .map(|(b, v)| apparent_tree::apparent_box(b, v, event))
             .collect();
         let deepest = apparent
             .iter()

@@ -12,6 +12,7 @@ mod lights;
 mod media;
 
 use super::band::{Band, Seen};
+use super::optics::{fresnel, phong, reflect, refract};
 use super::ray_budget::{Branch, Budget};
 use super::star_pixels::StarCones;
 use super::world::{SurfaceHit, World};
@@ -19,6 +20,7 @@ use crate::scene::Scene;
 use crate::spacetime::{Boost, Event, NullRay};
 use glam::DVec3;
 pub(super) use lights::{LightRt, ToLight};
+pub(super) use media::MediaWalk;
 use std::marker::PhantomData;
 
 /// The sky, with the boost into its rest frame where it moves.
@@ -41,35 +43,6 @@ pub struct Shader<'a, B> {
     /// The scene's fog: the world group whose frame it rests in, and its material.
     pub(super) fog: Option<(usize, u32)>,
     band: PhantomData<B>,
-}
-
-fn reflect(v: DVec3, n: DVec3) -> DVec3 {
-    v - 2.0 * v.dot(n) * n
-}
-
-/// Phong's highlight, `cos^shininess` (cos ≥ 0): by repeated multiplication for a whole-number
-/// exponent, the usual case (`powf` is a large share of shading), else `powf`.
-fn highlight(cos: f64, shininess: f64) -> f64 {
-    if shininess.fract() == 0.0 && shininess <= 1024.0 {
-        cos.powi(shininess as i32)
-    } else {
-        cos.powf(shininess)
-    }
-}
-
-/// Unpolarised Fresnel reflectance for a ray with cos_i going from index n1 into n2, and the
-/// refracted direction, or None on total internal reflection.
-fn fresnel_refract(v: DVec3, n: DVec3, eta: f64) -> (f64, Option<DVec3>) {
-    let cos_i = (-v.dot(n)).clamp(0.0, 1.0);
-    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-    if sin2_t >= 1.0 {
-        return (1.0, None);
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    let t = (eta * v + (eta * cos_i - cos_t) * n).normalize();
-    (0.5 * (rs * rs + rp * rp), Some(t))
 }
 
 impl<'a, B: Band> Shader<'a, B> {
@@ -359,8 +332,8 @@ impl<'a, B: Band> Shader<'a, B> {
                 return None;
             }
             let highlight = glints.then(|| {
-                let r = reflect(-to_light, nf);
-                highlight(r.dot(-v).max(0.0), mat.shininess)
+                let r = reflect(to_light, nf);
+                phong(r.dot(-v).max(0.0), mat.shininess)
             });
             // D_in = ν_surface / ν_light: k is ν_world / ν_light, s_surface ν_surface / ν_world.
             let (light_shift, k_in) = self.seen.irradiance(k * s_surface, shift);
@@ -491,13 +464,14 @@ impl<'a, B: Band> Shader<'a, B> {
         let (mut kr, mut kt) = (mat.reflect, mat.transmit);
         let mut refracted = None;
         if kt > 0.0 {
-            let eta = if lit.inside { mat.ior } else { 1.0 / mat.ior };
-            let (f, t) = fresnel_refract(v, nf, eta);
-            match t {
+            let eta = if lit.inside { 1.0 / mat.ior } else { mat.ior };
+            let cos_i = (-v.dot(nf)).clamp(0.0, 1.0);
+            match refract(-v, nf, eta) {
                 Some(t) => {
+                    let f = fresnel(cos_i, eta);
                     kr += kt * f;
                     kt *= 1.0 - f;
-                    refracted = Some(t);
+                    refracted = Some(t.normalize());
                 }
                 None => {
                     kr += kt;
@@ -513,7 +487,7 @@ impl<'a, B: Band> Shader<'a, B> {
             refracted.map(|_| kt),
             |branch, b| {
                 let (side, dir, seen) = match branch {
-                    Branch::Reflected => (nf, reflect(v, nf), &mut seen_r),
+                    Branch::Reflected => (nf, reflect(-v, nf), &mut seen_r),
                     Branch::Refracted => (-nf, refracted.expect("a refracted ray"), &mut seen_t),
                 };
                 // Into a glass object, light is slower (`inside_hit`) and never changes frame.
@@ -673,32 +647,5 @@ impl Spread {
     /// (docs/physics.md §5.5).
     pub fn into_frame(self, s_to: f64) -> f64 {
         self.sr * (self.s / s_to).powi(2)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::highlight;
-
-    /// The highlight by multiplication is `powf`'s to within rounding, whole exponents or not,
-    /// and `0^0 = 1` as `powf` has it (a shininess of 0 lights the whole surface).
-    #[test]
-    fn highlight_is_powf() {
-        for shininess in [
-            0.0, 1.0, 2.0, 7.0, 40.0, 60.0, 128.0, 1024.0, 0.5, 12.25, 2000.0,
-        ] {
-            for k in 0..=100 {
-                let cos = f64::from(k) / 100.0;
-                let (got, want) = (highlight(cos, shininess), cos.powf(shininess));
-                let err = (got - want).abs() / want.max(f64::MIN_POSITIVE);
-                assert!(
-                    err < 1e-13 || (got - want).abs() < 1e-300,
-                    "cos {cos} ^ {shininess}: {got} vs powf {want}"
-                );
-            }
-        }
-        assert_eq!(highlight(0.0, 0.0), 1.0);
-        assert_eq!(highlight(0.0, 40.0), 0.0);
-        assert_eq!(highlight(1.0, 60.0), 1.0);
     }
 }

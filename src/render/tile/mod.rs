@@ -54,7 +54,7 @@ pub(crate) struct ImagePoints {
 /// The image points of `coords` (frame pixels; `offset` places the frame in the full image):
 /// sample `(s, n)` of each pixel in the round of samples that starts at `base`
 /// (`sample_offset`, and `shutter_offset` where `shutter`), or the pixel centre for None.
-fn image_points(
+pub(crate) fn image_points(
     coords: &[(u32, u32)],
     offset: (u32, u32),
     (sample, base, shutter): (Option<(u32, u32)>, u32, bool),
@@ -107,11 +107,14 @@ pub fn primary_rays(
 /// sits in the image. The others are background: their 4 × 4 block (aligned in the frame, as
 /// the tile's packets are) misses every group's cone of directions.
 #[derive(Default)]
-struct TilePixels {
-    total: usize,
-    offset: (u32, u32),
+pub(crate) struct TilePixels {
+    /// How many pixels the tile has, culled or not.
+    pub total: usize,
+    /// Where the tile's frame lies in the full image.
+    pub offset: (u32, u32),
     live: Vec<usize>,
-    live_coords: Vec<(u32, u32)>,
+    /// The pixels not culled (frame coordinates).
+    pub live_coords: Vec<(u32, u32)>,
     /// A whole tile's pixels at (0, 0) (`tile_pixels`), made on first use.
     template: Vec<(u32, u32)>,
     /// Whether `live` is every index of a whole tile (kept from one whole tile to the next).
@@ -199,7 +202,7 @@ fn wave_of<B: Band + Send + 'static>(
 
 impl TileScratch {
     /// The tile at (x0, y0): its pixels, and the buffers for its image points and hits.
-    fn tile(
+    pub(crate) fn tile(
         &mut self,
         scene: &Scene,
         cam: &CameraRays,
@@ -244,32 +247,6 @@ impl TileScratch {
             wave_of(&mut self.wave),
         )
     }
-}
-
-/// Trace (without shading) every sample's primary rays of one tile; returns the primary rays
-/// resolved (culled ones as background included) and the hits.
-pub(crate) fn trace_tile(
-    scene: &Scene,
-    world: &World,
-    cam: &CameraRays,
-    cull: Option<&ScreenCull>,
-    (x0, y0): (u32, u32),
-    scratch: &mut TileScratch,
-) -> (u64, u64) {
-    let (t, px, primary, _) = scratch.tile(scene, cam, cull, (x0, y0));
-    let n = scene.image.samples;
-    let mut found = 0;
-    for s in 0..n {
-        image_points(
-            &t.live_coords,
-            t.offset,
-            (Some((s, n)), 0, cam.has_shutter()),
-            px,
-        );
-        world.primary_hits(cam, px, primary);
-        found += primary.hit_count() as u64;
-    }
-    (n as u64 * t.total as u64, found)
 }
 
 /// The colours (linear sRGB) of primary hits (background where none), into `buf.colors`, with
@@ -400,7 +377,7 @@ type Prepared<'a> = Result<(Lit<'a>, f64), (f64, DVec3)>;
 /// The buffers of a round of samples of a tile (a sample of each pixel), kept by the worker
 /// and refilled round after round and tile after tile, so a sample allocates nothing.
 #[derive(Default)]
-struct RoundBuffers {
+pub(crate) struct RoundBuffers {
     /// One entry per light and hit (None where there is no shadow ray), hit-major.
     shadows: Vec<Option<ShadowQuery>>,
     visible: Vec<bool>,
