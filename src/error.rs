@@ -19,6 +19,12 @@ pub enum Error {
     },
     /// A backend could not be had, built or used (an unknown name, Embree's own messages).
     Backend(String),
+    /// Beyond a limit of the program: more primitives than a group numbers, more memory than
+    /// the limit allows.
+    Limit(String),
+    /// A value handed to the library that it refuses (a viewer's request, an argument from
+    /// code); the message names the value and says why.
+    Invalid(String),
     /// An image file could not be written or read (the message names the file).
     Image {
         /// The file.
@@ -60,6 +66,11 @@ impl Error {
         }
     }
 
+    /// A value refused, the message naming it.
+    pub fn invalid(message: impl Into<String>) -> Error {
+        Error::Invalid(message.into())
+    }
+
     /// The same error blamed on `flag` (a backend named on the command line, say).
     pub fn on_flag(self, flag: &str) -> Error {
         match self {
@@ -74,7 +85,7 @@ impl fmt::Display for Error {
         match self {
             Error::Scene(e) => write!(f, "{e}"),
             Error::Flag { flag, message } => write!(f, "{flag}: {message}"),
-            Error::Backend(m) => write!(f, "{m}"),
+            Error::Backend(m) | Error::Limit(m) | Error::Invalid(m) => write!(f, "{m}"),
             Error::Image { message, .. } => write!(f, "{message}"),
         }
     }

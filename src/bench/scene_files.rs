@@ -87,10 +87,10 @@ fn write_ply_terrain(path: &std::path::Path, triangles: usize) -> std::io::Resul
 /// peak memory of each step.
 fn mesh_file_here(triangles: usize, size: u32, backend: &str) -> String {
     let dir = std::env::temp_dir().join(format!("rest-embree-bench-mesh-{}", std::process::id()));
-    let line = (|| -> Result<String, String> {
-        std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let line = (|| -> Result<String, Box<dyn std::error::Error>> {
+        std::fs::create_dir_all(&dir)?;
         let ply = dir.join("terrain.ply");
-        let faces = write_ply_terrain(&ply, triangles).map_err(|e| e.to_string())?;
+        let faces = write_ply_terrain(&ply, triangles)?;
         let file_mb = std::fs::metadata(&ply).map(|m| m.len()).unwrap_or(0) as f64 / 1e6;
         let text = format!(
             "[camera]\nposition = [0, -2.2, 1.4]\nlook_at = [0, 0, 0]\nup = [0, 0, 1]\ntime = 2.6\n\n\
@@ -100,16 +100,16 @@ fn mesh_file_here(triangles: usize, size: u32, backend: &str) -> String {
              [[group.object]]\ntype = \"mesh\"\nfile = \"terrain.ply\"\n"
         );
         let scene_path = dir.join("terrain.toml");
-        std::fs::write(&scene_path, text).map_err(|e| e.to_string())?;
+        std::fs::write(&scene_path, text)?;
         reset_peak();
         let base = peak_mib().unwrap_or(0.0);
         let t0 = Instant::now();
-        let scene = crate::scene::load_file(&scene_path, &[]).map_err(|e| e.to_string())?;
+        let scene = crate::scene::load_file(&scene_path, &[])?;
         let read = t0.elapsed().as_secs_f64();
         let read_peak = peak_mib().unwrap_or(0.0) - base;
-        let b = crate::accel::backend_by_name(backend).map_err(|e| e.to_string())?;
+        let b = crate::accel::backend_by_name(backend)?;
         let t1 = Instant::now();
-        let world = crate::render::World::build(&scene, b.as_ref()).map_err(|e| e.to_string())?;
+        let world = crate::render::World::build(&scene, b.as_ref())?;
         let build = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
         let (frame, _) = crate::render::render_world(&scene, &world);

@@ -302,7 +302,7 @@ impl Plan {
     /// A film: one job array, each task a run of consecutive frames (one frame each, unless
     /// the film has more frames than an array takes tasks).
     fn film_jobs(&self, f: &crate::scene::Film, args: &SlurmArgs) -> crate::Result<Vec<Job>> {
-        film::FramePattern::parse(&args.output).map_err(|m| Error::flag("-o", m))?;
+        film::FramePattern::parse(&args.output)?;
         let (first, last) = film::frame_range(f, args.frames)?;
         let frames = last - first + 1;
         let per = frames.div_ceil(MAX_TASKS);

@@ -38,18 +38,20 @@ pub(super) struct FramePattern {
 }
 
 impl FramePattern {
-    pub fn parse(path: &Path) -> Result<FramePattern, String> {
+    /// The pattern `-o` gives; an error blamed on `-o` if it is none.
+    pub fn parse(path: &Path) -> crate::Result<FramePattern> {
+        let bad = |m: &str| Error::flag("-o", m);
         let name = path
             .file_name()
             .and_then(|n| n.to_str())
-            .ok_or("the output needs a file name")?;
-        let start = name.find('#').ok_or(
-            "a film needs a frame pattern: a run of # in the file name, e.g. out/frame-####.exr",
-        )?;
+            .ok_or_else(|| bad("the output needs a file name"))?;
+        let start = name.find('#').ok_or_else(|| {
+            bad("a film needs a frame pattern: a run of # in the file name, e.g. out/frame-####.exr")
+        })?;
         let width = name[start..].chars().take_while(|&c| c == '#').count();
         let after = &name[start + width..];
         if after.contains('#') {
-            return Err("the file name has more than one run of #; give one".into());
+            return Err(bad("the file name has more than one run of #; give one"));
         }
         Ok(FramePattern {
             dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
@@ -102,7 +104,7 @@ pub(super) fn run(
         ));
     };
     let (first, last) = frame_range(film, args.frames)?;
-    let pattern = FramePattern::parse(&args.output).map_err(|m| Error::flag("-o", m))?;
+    let pattern = FramePattern::parse(&args.output)?;
     if let Some(dir) = pattern.dir.to_str().filter(|d| !d.is_empty()) {
         std::fs::create_dir_all(dir)
             .map_err(|e| Error::flag("-o", format!("cannot make the folder {dir}: {e}")))?;
@@ -123,7 +125,7 @@ pub(super) fn run(
     // A frame is done only if its file is a finished image of this very frame
     // (`output::finished`: every block decoded); anything else in its place is rendered again.
     // The files are checked all at once, on every core, before the first frame renders.
-    let done: Vec<Option<Result<(), String>>> = match args.resume {
+    let done: Vec<Option<crate::Result<()>>> = match args.resume {
         false => vec![None; (last - first + 1) as usize],
         true => {
             use rayon::prelude::*;

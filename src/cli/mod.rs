@@ -663,7 +663,7 @@ fn run_render(args: &RenderArgs) -> crate::Result<()> {
     }
     if let (Some(grid), Some(index)) = (args.tiles, args.tile) {
         let what = format!("tile {index}");
-        output::file::refuse_link(&args.output, &what).map_err(|m| Error::flag("-o", m))?;
+        output::file::refuse_link(&args.output, &what).map_err(|e| e.on_flag("-o"))?;
         let shown = format!("--tiles {}x{} --tile {index}", grid.0, grid.1);
         scene.image.crop = Some(tiles::tile_crop(&scene, format, grid, index, &shown)?);
     }

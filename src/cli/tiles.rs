@@ -64,18 +64,18 @@ pub(super) fn crop(
     (width, height): (u32, u32),
     (columns, rows): (u32, u32),
     index: u32,
-) -> Result<[u32; 4], String> {
+) -> crate::Result<[u32; 4]> {
     if columns > width || rows > height {
-        return Err(format!(
+        return Err(Error::invalid(format!(
             "a grid of {columns}x{rows} tiles does not fit a {width}x{height} image (a tile is at least one pixel)"
-        ));
+        )));
     }
     let tiles = u64::from(columns) * u64::from(rows);
     if u64::from(index) >= tiles {
-        return Err(format!(
+        return Err(Error::invalid(format!(
             "tile {index} is not in a {columns}x{rows} grid: tiles are 0..{}",
             tiles - 1
-        ));
+        )));
     }
     let edge = |i: u32, n: u32, size: u32| (u64::from(i) * u64::from(size) / u64::from(n)) as u32;
     let (c, r) = (index % columns, index / columns);

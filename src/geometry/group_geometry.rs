@@ -217,7 +217,7 @@ impl Geometry {
         object: u32,
         runs: &[(u64, u32)],
         shape: Implicit,
-    ) -> Result<(), String> {
+    ) -> crate::Result<()> {
         let runs: Vec<_> = runs.iter().map(|&(n, m)| (n, m, None)).collect();
         self.push_implicit_with(object, &runs, shape)
     }
@@ -229,14 +229,14 @@ impl Geometry {
         object: u32,
         runs: &[(u64, u32, Option<std::sync::Arc<Corners>>)],
         shape: Implicit,
-    ) -> Result<(), String> {
+    ) -> crate::Result<()> {
         let first = self.len();
         let total = first as u64 + shape.len();
         if total > u32::MAX as u64 {
-            return Err(format!(
+            return Err(crate::Error::Limit(format!(
                 "a velocity group holds at most {} primitives; this object would make it {total}",
                 u32::MAX
-            ));
+            )));
         }
         let mut start = first;
         for (count, material, corners) in runs.iter().filter(|(count, _, _)| *count > 0) {

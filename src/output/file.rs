@@ -36,7 +36,7 @@ pub(crate) fn write_whole(
             None,
         )
     };
-    let target = through_links(path).map_err(refuse)?;
+    let target = through_links(path).map_err(|e| refuse(e.to_string()))?;
     let existing = std::fs::metadata(&target).ok();
     if let Some(m) = &existing {
         if m.is_dir() {
@@ -90,28 +90,28 @@ pub(crate) fn write_whole(
 /// another output of the same run (`frame-04.png -> frame-00.png` would overwrite frame 0).
 /// `what` says which output it is. A still's `-o` may be a link to a regular file (as shell
 /// redirection writes through one); [`write_whole`] follows it.
-pub(crate) fn refuse_link(path: &Path, what: &str) -> Result<(), String> {
+pub(crate) fn refuse_link(path: &Path, what: &str) -> crate::Result<()> {
     match std::fs::symlink_metadata(path) {
         Ok(m) if m.file_type().is_symlink() => {
             let to = std::fs::read_link(path)
                 .map(|t| t.display().to_string())
                 .unwrap_or_else(|_| "somewhere unreadable".into());
-            Err(format!(
+            Err(Error::image(path, format!(
                 "{what} `{}` is a symbolic link to `{to}`: each of a run's outputs is written to a file of its own, not through a link (it could lead to another of them); remove the link or name another file",
                 path.display()
-            ))
+            ), None))
         }
         _ => Ok(()),
     }
 }
 
 /// The file a path names, following symbolic links (relative ones from the link's directory).
-fn through_links(path: &Path) -> Result<PathBuf, String> {
+fn through_links(path: &Path) -> std::io::Result<PathBuf> {
     let mut p = path.to_path_buf();
     for _ in 0..40 {
         match std::fs::symlink_metadata(&p) {
             Ok(m) if m.file_type().is_symlink() => {
-                let to = std::fs::read_link(&p).map_err(|e| e.to_string())?;
+                let to = std::fs::read_link(&p)?;
                 p = match p.parent() {
                     Some(dir) if to.is_relative() => dir.join(to),
                     _ => to,
@@ -120,7 +120,7 @@ fn through_links(path: &Path) -> Result<PathBuf, String> {
             _ => return Ok(p),
         }
     }
-    Err("too many levels of symbolic links".into())
+    Err(std::io::Error::other("too many levels of symbolic links"))
 }
 
 /// What a file that is not a regular one is, in words.

@@ -10,14 +10,14 @@ use std::io::BufReader;
 use std::path::Path;
 
 /// Ok if `path` is a finished `format` image of `size` (the frame's) from render `id`; else
-/// why not.
-pub fn finished(path: &Path, format: Format, size: (u32, u32), id: &str) -> Result<(), String> {
-    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+/// an error that says why not.
+pub fn finished(path: &Path, format: Format, size: (u32, u32), id: &str) -> crate::Result<()> {
+    let meta = std::fs::metadata(path).map_err(|e| not(path, e))?;
     if !meta.is_file() {
-        return Err("not a regular file".into());
+        return Err(not(path, "not a regular file"));
     }
     if meta.len() == 0 {
-        return Err("empty".into());
+        return Err(not(path, "empty"));
     }
     match format {
         Format::Png => png(path, size, id),
@@ -25,16 +25,24 @@ pub fn finished(path: &Path, format: Format, size: (u32, u32), id: &str) -> Resu
     }
 }
 
-fn png(path: &Path, size: (u32, u32), id: &str) -> Result<(), String> {
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+/// Why `path` is not a finished image.
+fn not(path: &Path, why: impl std::fmt::Display) -> crate::Error {
+    crate::Error::image(path, why.to_string(), None)
+}
+
+fn png(path: &Path, size: (u32, u32), id: &str) -> crate::Result<()> {
+    let file = std::fs::File::open(path).map_err(|e| not(path, e))?;
     let mut reader = png::Decoder::new(BufReader::new(file))
         .read_info()
-        .map_err(|e| format!("not a readable PNG ({e})"))?;
+        .map_err(|e| not(path, format!("not a readable PNG ({e})")))?;
     let info = reader.info();
     if (info.width, info.height) != size {
-        return Err(format!(
-            "{}x{}, not the frame's {}x{}",
-            info.width, info.height, size.0, size.1
+        return Err(not(
+            path,
+            format!(
+                "{}x{}, not the frame's {}x{}",
+                info.width, info.height, size.0, size.1
+            ),
         ));
     }
     let said = info
@@ -43,36 +51,39 @@ fn png(path: &Path, size: (u32, u32), id: &str) -> Result<(), String> {
         .find(|t| t.keyword == RENDER_ID)
         .map(|t| t.text.clone());
     if said.as_deref() != Some(id) {
-        return Err("from another render (or none said)".into());
+        return Err(not(path, "from another render (or none said)"));
     }
     let mut rows = 0;
     while let Some(_row) = reader
         .next_row()
-        .map_err(|e| format!("cut short or damaged ({e})"))?
+        .map_err(|e| not(path, format!("cut short or damaged ({e})")))?
     {
         rows += 1;
     }
     if rows != size.1 {
-        return Err(format!("{rows} rows of {}", size.1));
+        return Err(not(path, format!("{rows} rows of {}", size.1)));
     }
     Ok(())
 }
 
-fn exr(path: &Path, size: (u32, u32), id: &str) -> Result<(), String> {
+fn exr(path: &Path, size: (u32, u32), id: &str) -> crate::Result<()> {
     use exr::meta::attribute::AttributeValue;
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let file = std::fs::File::open(path).map_err(|e| not(path, e))?;
     let reader = exr::block::read(BufReader::new(file), false)
-        .map_err(|e| format!("not a readable EXR ({e})"))?;
+        .map_err(|e| not(path, format!("not a readable EXR ({e})")))?;
     let headers = reader.headers();
     if headers.len() != 1 {
-        return Err(format!("{} layers, not one", headers.len()));
+        return Err(not(path, format!("{} layers, not one", headers.len())));
     }
     let header = &headers[0];
     let window = header.layer_size;
     if (window.0 as u32, window.1 as u32) != size {
-        return Err(format!(
-            "{}x{}, not the frame's {}x{}",
-            window.0, window.1, size.0, size.1
+        return Err(not(
+            path,
+            format!(
+                "{}x{}, not the frame's {}x{}",
+                window.0, window.1, size.0, size.1
+            ),
         ));
     }
     let said = header
@@ -85,7 +96,7 @@ fn exr(path: &Path, size: (u32, u32), id: &str) -> Result<(), String> {
             _ => None,
         });
     if said.as_deref() != Some(id) {
-        return Err("from another render (or none said)".into());
+        return Err(not(path, "from another render (or none said)"));
     }
     // Every block read and decompressed (in parallel): a byte flipped in the middle of a
     // compressed block, or zeros where its last bytes were, fails here. (A file written
@@ -95,14 +106,14 @@ fn exr(path: &Path, size: (u32, u32), id: &str) -> Result<(), String> {
     let mut blocks = 0;
     reader
         .all_chunks(false)
-        .map_err(|e| format!("cut short or damaged ({e})"))?
+        .map_err(|e| not(path, format!("cut short or damaged ({e})")))?
         .decompress_parallel(false, |_, _| {
             blocks += 1;
             Ok(())
         })
-        .map_err(|e| format!("cut short or damaged ({e})"))?;
+        .map_err(|e| not(path, format!("cut short or damaged ({e})")))?;
     if blocks != expected {
-        return Err(format!("{blocks} of its {expected} blocks"));
+        return Err(not(path, format!("{blocks} of its {expected} blocks")));
     }
     Ok(())
 }

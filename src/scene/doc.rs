@@ -83,7 +83,7 @@ impl Doc {
             ));
         }
         let origin = Origin::flag(self.flags.len());
-        let value = parse_set_value(text.trim(), origin).map_err(|m| bad(key, m))?;
+        let value = parse_set_value(text.trim(), origin, &bad(key, String::new()))?;
         self.flags.push(shown.clone());
         let segs: Vec<&str> = key.split('.').collect();
         let mut cur = &mut self.root;
@@ -166,10 +166,15 @@ impl Doc {
 }
 
 /// A `--set` value is TOML; a bare word that is not valid TOML is taken as a string, so
-/// `--set camera.projection=orthographic` works without shell-quoted quotes.
-fn parse_set_value(text: &str, origin: Origin) -> Result<Node, String> {
+/// `--set camera.projection=orthographic` works without shell-quoted quotes. `at`: the flag
+/// and key an error names.
+fn parse_set_value(text: &str, origin: Origin, at: &SceneError) -> Result<Node, SceneError> {
+    let bad = |message: String| SceneError {
+        message,
+        ..at.clone()
+    };
     if text.is_empty() {
-        return Err("the value is empty".into());
+        return Err(bad("the value is empty".into()));
     }
     match toml_tree::parse_value(text, origin) {
         Ok(v) => Ok(v),
@@ -189,7 +194,7 @@ fn parse_set_value(text: &str, origin: Origin) -> Result<Node, String> {
                     form: Form::VALUE,
                 })
             } else {
-                Err(format!("`{text}` is not a TOML value: {}", e.message))
+                Err(bad(format!("`{text}` is not a TOML value: {}", e.message)))
             }
         }
     }

@@ -552,7 +552,7 @@ impl Adding<'_, '_> {
             mesh.triangles,
         )));
         geo.push_implicit_with(id, &runs, shape)
-            .map_err(|why| at_value(t, "file", why))?;
+            .map_err(|why| at_value(t, "file", why.to_string()))?;
         Ok(())
     }
 
@@ -634,7 +634,7 @@ impl Adding<'_, '_> {
         let shape = Implicit::Lattice(l);
         implicit_budget(t, total, &shape)?;
         geo.push_implicit(id, &runs, shape)
-            .map_err(|why| at_value(t, "counts", why))?;
+            .map_err(|why| at_value(t, "counts", why.to_string()))?;
         Ok(())
     }
 
@@ -669,7 +669,7 @@ impl Adding<'_, '_> {
         let shape = Implicit::Bars(b);
         implicit_budget(t, total, &shape)?;
         geo.push_implicit(id, &runs, shape)
-            .map_err(|why| at_value(t, "counts", why))?;
+            .map_err(|why| at_value(t, "counts", why.to_string()))?;
         Ok(())
     }
 }

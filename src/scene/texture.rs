@@ -239,14 +239,17 @@ pub(crate) type Texels = std::sync::Arc<[[f32; 3]]>;
 /// Whether an image of `w` x `h` texels may be read: at most `MAX_TEXELS`, and its peak while
 /// read (`per_texel` bytes a texel: the decoder's buffer and the texels made from it) within
 /// the memory limit. Checked from the file's header, before its texels are read.
-fn fits(w: usize, h: usize, per_texel: u64) -> Result<(), String> {
+fn fits(path: &std::path::Path, w: usize, h: usize, per_texel: u64) -> crate::Result<()> {
+    let bad = |m: String| crate::Error::image(path, m, None);
     let n = w as u64 * h as u64;
     if n == 0 || n > MAX_TEXELS {
-        return Err(format!("it is {w}x{h}; a texture has 1 to 2^28 texels"));
+        return Err(bad(format!(
+            "it is {w}x{h}; a texture has 1 to 2^28 texels"
+        )));
     }
     let what = format!("a {w}x{h} texture");
     match crate::memory::too_much(n.saturating_mul(per_texel), &what) {
-        Some(why) => Err(why),
+        Some(why) => Err(bad(why)),
         None => Ok(()),
     }
 }
@@ -256,32 +259,34 @@ fn fits(w: usize, h: usize, per_texel: u64) -> Result<(), String> {
 /// channels, or Y as grey). Made straight into the shared buffer a texture holds (no copy of
 /// them at any time); the size the header claims is checked before anything is decoded. Why
 /// not, in words.
-pub(crate) fn read_image(path: &std::path::Path) -> Result<(usize, usize, Texels), String> {
+pub(crate) fn read_image(path: &std::path::Path) -> crate::Result<(usize, usize, Texels)> {
+    let bad = |m: String| crate::Error::image(path, m, None);
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let meta = std::fs::metadata(path).map_err(|e| format!("cannot read it: {e}"))?;
+    let meta = std::fs::metadata(path).map_err(|e| bad(format!("cannot read it: {e}")))?;
     if !meta.is_file() {
-        return Err("it is not a regular file".into());
+        return Err(bad("it is not a regular file".into()));
     }
     // 12 bytes a texel stay (three f32); the decoders' own buffers come on top.
     const TEXEL: u64 = 12;
     match ext.as_deref() {
         Some("png") => {
-            let file = std::fs::File::open(path).map_err(|e| format!("cannot read it: {e}"))?;
+            let file =
+                std::fs::File::open(path).map_err(|e| bad(format!("cannot read it: {e}")))?;
             let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
             decoder.set_transformations(png::Transformations::EXPAND);
             let mut reader = decoder
                 .read_info()
-                .map_err(|e| format!("not a readable PNG: {e}"))?;
+                .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
             let (w, h) = (reader.info().width as usize, reader.info().height as usize);
             let n = (w as u64 * h as u64).max(1);
-            fits(w, h, TEXEL + reader.output_buffer_size() as u64 / n)?;
+            fits(path, w, h, TEXEL + reader.output_buffer_size() as u64 / n)?;
             let mut buf = vec![0; reader.output_buffer_size()];
             let frame = reader
                 .next_frame(&mut buf)
-                .map_err(|e| format!("not a readable PNG: {e}"))?;
+                .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
             let channels = frame.color_type.samples();
             let wide = frame.bit_depth == png::BitDepth::Sixteen;
             let value = |i: usize| -> f32 {
@@ -306,8 +311,11 @@ pub(crate) fn read_image(path: &std::path::Path) -> Result<(usize, usize, Texels
         Some("exr") => {
             // The header first: its data window says how large the image claims to be.
             let header = exr::meta::MetaData::read_from_file(path, false)
-                .map_err(|e| format!("not a readable EXR: {e}"))?;
-            let first = header.headers.first().ok_or("it has no layer")?;
+                .map_err(|e| bad(format!("not a readable EXR: {e}")))?;
+            let first = header
+                .headers
+                .first()
+                .ok_or_else(|| bad("it has no layer".into()))?;
             let (w, h) = (first.layer_size.width(), first.layer_size.height());
             // As decoded (each channel as stored), each channel as f32 again, and the texels.
             let stored: u64 = first
@@ -316,19 +324,20 @@ pub(crate) fn read_image(path: &std::path::Path) -> Result<(usize, usize, Texels
                 .iter()
                 .map(|c| c.sample_type.bytes_per_sample() as u64 + 4)
                 .sum();
-            fits(w, h, TEXEL + stored)?;
-            let (w, h, ch) = crate::exr_read::read_channels(path).map_err(|e| e.to_string())?;
+            fits(path, w, h, TEXEL + stored)?;
+            let (w, h, ch) =
+                crate::exr_read::read_channels(path).map_err(|e| bad(e.to_string()))?;
             let pick =
                 |names: [&str; 3]| names.iter().map(|n| ch.get(*n)).collect::<Option<Vec<_>>>();
             let planes = pick(["R", "G", "B"])
                 .or_else(|| pick(["Y", "Y", "Y"]))
-                .ok_or("it has neither R, G, B nor Y channels")?;
+                .ok_or_else(|| bad("it has neither R, G, B nor Y channels".into()))?;
             if let Some(p) = (0..w * h).find(|&p| planes.iter().any(|c| c[p].is_nan())) {
-                return Err(format!(
+                return Err(bad(format!(
                     "texel ({}, {}) (column, row from the top) is not a number",
                     p % w,
                     p / w
-                ));
+                )));
             }
             // As a colour may be: 0 to MAX_TEXEL. Negative texels (a filter's ringing in an HDR
             // map) would give negative light, infinite ones infinite light.
@@ -347,7 +356,9 @@ pub(crate) fn read_image(path: &std::path::Path) -> Result<(usize, usize, Texels
                     .collect(),
             ))
         }
-        _ => Err("cannot tell its format: the name must end in .png or .exr".into()),
+        _ => Err(bad(
+            "cannot tell its format: the name must end in .png or .exr".into(),
+        )),
     }
 }
 

@@ -3,8 +3,16 @@
 //! its film: the viewer shows one instant), and "render this view" saves exactly that text, so
 //! `rest-embree render` of it gives the viewer's final frame.
 
+use crate::Error;
 use serde_json::Value;
 use toml_edit::{DocumentMut, Item, Table};
+
+/// A view's value refused: the crate's `Error::Invalid`, its message formatted.
+macro_rules! refuse {
+    ($($t:tt)*) => {
+        crate::Error::invalid(format!($($t)*))
+    };
+}
 
 /// The most a coordinate or a time may be (the scene loader refuses more anyway).
 const MAX_MAGNITUDE: f64 = 1e12;
@@ -36,18 +44,20 @@ pub(crate) struct Editable {
 }
 
 /// A view's values checked, as edits; an error names the value and says why.
-pub(crate) fn edits(view: &Value, editable: &Editable) -> Result<Vec<Edit>, String> {
-    let view = view.as_object().ok_or("the view must be a JSON object")?;
+pub(crate) fn edits(view: &Value, editable: &Editable) -> crate::Result<Vec<Edit>> {
+    let view = view
+        .as_object()
+        .ok_or_else(|| Error::invalid("the view must be a JSON object"))?;
     let mut out = Vec::new();
     for (key, value) in view {
         match key.as_str() {
             "groups" => {
                 let groups = value
                     .as_object()
-                    .ok_or("`groups` must map names to velocities")?;
+                    .ok_or_else(|| Error::invalid("`groups` must map names to velocities"))?;
                 for (name, v) in groups {
                     if !editable.groups.contains(name) {
-                        return Err(format!(
+                        return Err(refuse!(
                             "group `{}`: no uniformly moving group of that name",
                             clip(name)
                         ));
@@ -55,7 +65,7 @@ pub(crate) fn edits(view: &Value, editable: &Editable) -> Result<Vec<Edit>, Stri
                     let b = vec3(v, &format!("groups.{name}"))?;
                     let speed = b.iter().map(|x| x * x).sum::<f64>().sqrt();
                     if speed.is_nan() || speed >= 1.0 {
-                        return Err(format!(
+                        return Err(refuse!(
                             "groups.{name}: the speed |β| = {speed} must be below 1 (the speed of light)"
                         ));
                     }
@@ -70,7 +80,7 @@ pub(crate) fn edits(view: &Value, editable: &Editable) -> Result<Vec<Edit>, Stri
             "doppler" | "searchlight" => {
                 let on = value
                     .as_bool()
-                    .ok_or_else(|| format!("`{key}` must be true or false"))?;
+                    .ok_or_else(|| refuse!("`{key}` must be true or false"))?;
                 out.push(Edit {
                     place: Place::Render,
                     key: if key == "doppler" {
@@ -81,14 +91,16 @@ pub(crate) fn edits(view: &Value, editable: &Editable) -> Result<Vec<Edit>, Stri
                     value: on.to_string(),
                 });
             }
-            other => return Err(format!("unknown view value `{}`", clip(other))),
+            other => return Err(refuse!("unknown view value `{}`", clip(other))),
         }
     }
     Ok(out)
 }
 
-fn camera(value: &Value, editable: &Editable) -> Result<Vec<Edit>, String> {
-    let cam = value.as_object().ok_or("`camera` must be an object")?;
+fn camera(value: &Value, editable: &Editable) -> crate::Result<Vec<Edit>> {
+    let cam = value
+        .as_object()
+        .ok_or_else(|| Error::invalid("`camera` must be an object"))?;
     let mut out = Vec::new();
     for (key, v) in cam {
         let shown = format!("camera.{key}");
@@ -97,7 +109,7 @@ fn camera(value: &Value, editable: &Editable) -> Result<Vec<Edit>, String> {
             "direction" | "up" => {
                 let d = vec3(v, &shown)?;
                 if d.iter().all(|&x| x == 0.0) {
-                    return Err(format!("{shown} must not be zero"));
+                    return Err(refuse!("{shown} must not be zero"));
                 }
                 (if key == "up" { "up" } else { "direction" }, literal3(d))
             }
@@ -105,16 +117,16 @@ fn camera(value: &Value, editable: &Editable) -> Result<Vec<Edit>, String> {
             "fov_y" => {
                 let f = number(v, &shown)?;
                 if !editable.pinhole {
-                    return Err(format!("{shown}: the camera is not a pinhole"));
+                    return Err(refuse!("{shown}: the camera is not a pinhole"));
                 }
                 if !(1e-6..180.0).contains(&f) {
-                    return Err(format!(
+                    return Err(refuse!(
                         "{shown} = {f}: at least 1e-6 and below 180 degrees"
                     ));
                 }
                 ("fov_y", literal(f))
             }
-            other => return Err(format!("unknown camera value `{}`", clip(other))),
+            other => return Err(refuse!("unknown camera value `{}`", clip(other))),
         };
         out.push(Edit {
             place: Place::Camera,
@@ -147,23 +159,23 @@ pub(crate) fn follow_worldline(edits: &mut Vec<Edit>, camera: &crate::scene::Cam
 }
 
 /// A finite number of moderate size.
-fn number(v: &Value, shown: &str) -> Result<f64, String> {
+fn number(v: &Value, shown: &str) -> crate::Result<f64> {
     let x = v
         .as_f64()
-        .ok_or_else(|| format!("{shown} must be a number"))?;
+        .ok_or_else(|| refuse!("{shown} must be a number"))?;
     if !x.is_finite() || x.abs() > MAX_MAGNITUDE {
-        return Err(format!(
+        return Err(refuse!(
             "{shown} = {x}: must be finite and at most {MAX_MAGNITUDE:e} in size"
         ));
     }
     Ok(x)
 }
 
-fn vec3(v: &Value, shown: &str) -> Result<[f64; 3], String> {
+fn vec3(v: &Value, shown: &str) -> crate::Result<[f64; 3]> {
     let a = v
         .as_array()
         .filter(|a| a.len() == 3)
-        .ok_or_else(|| format!("{shown} must be three numbers"))?;
+        .ok_or_else(|| refuse!("{shown} must be three numbers"))?;
     let mut out = [0.0; 3];
     for (o, x) in out.iter_mut().zip(a) {
         *o = number(x, shown)?;
@@ -188,13 +200,13 @@ fn clip(s: &str) -> String {
 
 /// The scene text with `edits` made (each edit's other ways of giving the same setting taken
 /// out, as `--set` does), without its `[film]`, and a first line saying where it came from.
-pub(crate) fn saved_text(original: &str, source: &str, edits: &[Edit]) -> Result<String, String> {
+pub(crate) fn saved_text(original: &str, source: &str, edits: &[Edit]) -> crate::Result<String> {
     let mut doc: DocumentMut = original
         .parse()
-        .map_err(|e| format!("{source} is not TOML the viewer can edit: {e}"))?;
+        .map_err(|e| refuse!("{source} is not TOML the viewer can edit: {e}"))?;
     doc.remove("film");
     for e in edits {
-        let value: toml_edit::Value = e.value.parse().map_err(|err| format!("{}: {err}", e.key))?;
+        let value: toml_edit::Value = e.value.parse().map_err(|err| refuse!("{}: {err}", e.key))?;
         let (path, table): (Vec<&str>, &mut Table) = match &e.place {
             Place::Camera => (vec!["camera"], table_in(&mut doc, "camera")),
             Place::Render => (vec!["render"], table_in(&mut doc, "render")),
@@ -275,7 +287,7 @@ fn table_in<'a>(doc: &'a mut DocumentMut, name: &str) -> &'a mut Table {
 }
 
 /// The `[[group]]` named `name`.
-fn group_in<'a>(doc: &'a mut DocumentMut, name: &str) -> Result<&'a mut Table, String> {
+fn group_in<'a>(doc: &'a mut DocumentMut, name: &str) -> crate::Result<&'a mut Table> {
     doc.get_mut("group")
         .and_then(|g| g.as_array_of_tables_mut())
         .and_then(|groups| {
@@ -283,7 +295,7 @@ fn group_in<'a>(doc: &'a mut DocumentMut, name: &str) -> Result<&'a mut Table, S
                 .iter_mut()
                 .find(|t| t.get("name").and_then(|n| n.as_str()) == Some(name))
         })
-        .ok_or_else(|| format!("no [[group]] named `{}` in the file", clip(name)))
+        .ok_or_else(|| refuse!("no [[group]] named `{}` in the file", clip(name)))
 }
 
 #[cfg(test)]
@@ -418,7 +430,7 @@ mod tests {
         ];
         for (view, needle) in bad {
             let e = edits(&view, &editable()).unwrap_err();
-            assert!(e.contains(needle), "{view}: {e}");
+            assert!(e.to_string().contains(needle), "{view}: {e}");
         }
     }
 }

@@ -168,15 +168,16 @@ pub(crate) fn pass_rgb(frame: &Frame, pass: &str) -> Option<Vec<u8>> {
 
 /// One pass of a frame as PNG bytes; an error names an unknown pass. The colour of a
 /// transparent scene is RGBA with straight alpha, as `rest-embree render` writes it.
-pub(crate) fn png(frame: &Frame, pass: &str, transparent: bool) -> Result<Vec<u8>, String> {
+pub(crate) fn png(frame: &Frame, pass: &str, transparent: bool) -> crate::Result<Vec<u8>> {
     let encoded = if pass == "colour" && transparent {
         let rgba = crate::output::png_out::srgb_bytes(&frame.pixels, true);
         crate::output::png_out::rgba_png(frame.width, frame.height, &rgba)
     } else {
-        let rgb = pass_rgb(frame, pass).ok_or_else(|| format!("no pass `{pass}`"))?;
+        let rgb = pass_rgb(frame, pass)
+            .ok_or_else(|| crate::Error::invalid(format!("no pass `{pass}`")))?;
         crate::output::png_out::rgb_png(frame.width, frame.height, &rgb)
     };
-    encoded.map_err(|e| format!("encoding the frame: {e}"))
+    encoded.map_err(|e| crate::Error::invalid(format!("encoding the frame: {e}")))
 }
 
 /// What a pixel shows, for the page's click: the object, its emission event, lookback,

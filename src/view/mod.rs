@@ -230,8 +230,7 @@ impl Viewer {
         allow_hosts: Vec<String>,
     ) -> crate::Result<Viewer> {
         // The scene as the viewer will render it: loaded now so that a bad file is said at once.
-        let base =
-            edits::saved_text(&text, &source, &[]).map_err(|e| crate::Error::flag("view", e))?;
+        let base = edits::saved_text(&text, &source, &[]).map_err(|e| e.on_flag("view"))?;
         let mut scene = crate::scene::load_str(&source, &base, &[])?;
         scene.film = None;
         let backend =
@@ -285,9 +284,9 @@ impl Viewer {
 
     /// The scene file a view's values make: the user's file with their edits.
     fn view_text(&self, view: &serde_json::Value) -> Result<String, (u16, String)> {
-        let mut edits = edits::edits(view, &self.editable).map_err(|e| (400, e))?;
+        let mut edits = edits::edits(view, &self.editable).map_err(|e| (400, e.to_string()))?;
         edits::follow_worldline(&mut edits, &self.camera);
-        edits::saved_text(&self.text, &self.source, &edits).map_err(|e| (400, e))
+        edits::saved_text(&self.text, &self.source, &edits).map_err(|e| (400, e.to_string()))
     }
 }
 
@@ -318,8 +317,7 @@ pub(crate) fn latency(quick: bool, backend: &str) -> crate::Result<String> {
                 frames::Stopped::Failed(e) => e,
                 frames::Stopped::Superseded => crate::Error::flag("bench", "stopped"),
             })?;
-        let png =
-            frames::png(&frame, "colour", false).map_err(|e| crate::Error::flag("bench", e))?;
+        let png = frames::png(&frame, "colour", false).map_err(|e| e.on_flag("bench"))?;
         ms.push(t.elapsed().as_secs_f64() * 1e3);
         std::hint::black_box(png);
         (w, h) = (frame.width, frame.height);

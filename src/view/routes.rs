@@ -222,7 +222,8 @@ fn frame(v: &Viewer, body: &Value) -> Answer {
         Err(frames::Stopped::Superseded) => return Err(superseded()),
         Err(frames::Stopped::Failed(e)) => return Err((500, e.to_string())),
     };
-    let png = frames::png(&frame, pass, scene.image.is_transparent()).map_err(|e| (500, e))?;
+    let png = frames::png(&frame, pass, scene.image.is_transparent())
+        .map_err(|e| (500, e.to_string()))?;
     let (w, h, l, last) = (frame.width, frame.height, v.levels[level], level + 1 == n);
     {
         let mut clients = v.clients.lock().expect("not poisoned");

@@ -145,6 +145,55 @@ fn every_cited_section_of_the_physics_exists() {
 /// `rest-embree`, `$o/` for `docs/img/`, `$q` for its --quiet), the same set both ways; each
 /// film's six frames and their mosaic name the frames the script joins; and every picture the
 /// README shows is made by one of them.
+/// Errors are the crate's `Error` (or a scene's `SceneError`); a bare `String` as the error
+/// is left to the parsers clap calls for a flag's value (`value_parser = name`), and to at
+/// most three functions besides.
+#[test]
+fn errors_are_the_crates_own() {
+    let files = sources(&["src"]);
+    let parsers: Vec<String> = files
+        .iter()
+        .flat_map(|(_, text)| {
+            text.match_indices("value_parser = ")
+                .map(|(at, _)| {
+                    let rest = &text[at + "value_parser = ".len()..];
+                    let path: String = rest
+                        .chars()
+                        .take_while(|c| c.is_alphanumeric() || *c == '_' || *c == ':')
+                        .collect();
+                    path.rsplit("::").next().unwrap_or("").to_string()
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let mut others = Vec::new();
+    for (path, text) in &files {
+        if path.components().any(|c| c.as_os_str() == "tests") {
+            continue;
+        }
+        // A signature may span lines: from each `fn` to its body's brace.
+        for (at, _) in text.match_indices("fn ") {
+            let sig = &text[at..];
+            let sig = &sig[..sig.find('{').unwrap_or(sig.len()).min(600)];
+            let compact: String = sig.split_whitespace().collect::<Vec<_>>().join(" ");
+            let returns = compact.rsplit_once("->").map(|(_, r)| r.trim());
+            if returns.is_some_and(|r| r.starts_with("Result<") && r.ends_with(", String>")) {
+                let name: String = compact[3..]
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                if !parsers.contains(&name) {
+                    others.push(format!("{}: {name}", path.display()));
+                }
+            }
+        }
+    }
+    assert!(
+        others.len() <= 3,
+        "functions returning Result<_, String> outside clap's parsers: {others:#?}"
+    );
+}
+
 #[test]
 fn every_readme_picture_says_the_command_that_makes_it() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
