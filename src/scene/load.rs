@@ -145,7 +145,14 @@ pub(crate) fn superseded(table: &[&str], key: &str) -> &'static [&'static str] {
     let in_group = table.first() == Some(&"group") && table.len() == 2;
     let in_camera = table == ["camera"];
     match key {
-        "velocity" if in_group => &["beta", "rapidity", "one_minus_beta", "direction"],
+        // A group's velocity replaces its worldline too.
+        "velocity" if in_group => &[
+            "beta",
+            "rapidity",
+            "one_minus_beta",
+            "direction",
+            "worldline",
+        ],
         "velocity" => &["beta", "rapidity", "one_minus_beta", "velocity_direction"],
         "beta" => &["velocity", "rapidity", "one_minus_beta"],
         "rapidity" => &["velocity", "beta", "one_minus_beta"],

@@ -34,6 +34,19 @@ pub(crate) struct Edit {
     pub value: String,
 }
 
+impl Edit {
+    /// The edit as a `--set` assignment, `TABLE.KEY=VALUE`: the scene a view renders is the
+    /// file read once with these, as `rest-embree render --set` reads it.
+    pub fn assignment(&self) -> String {
+        let table = match &self.place {
+            Place::Camera => "camera".to_string(),
+            Place::Render => "render".to_string(),
+            Place::Group(name) => format!("group.{name}"),
+        };
+        format!("{table}.{}={}", self.key, self.value)
+    }
+}
+
 /// What the viewer may change of the scene it was started on.
 #[derive(Clone, Debug)]
 pub(crate) struct Editable {
@@ -214,10 +227,6 @@ pub(crate) fn saved_text(original: &str, source: &str, edits: &[Edit]) -> crate:
         };
         for gone in crate::scene::superseded(&path, e.key) {
             table.remove(gone);
-        }
-        // A group's velocity replaces a worldline of one segment (the only kind it may edit).
-        if matches!(e.place, Place::Group(_)) && e.key == "velocity" {
-            table.remove("worldline");
         }
         table.insert(e.key, Item::Value(value));
     }

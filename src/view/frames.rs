@@ -4,7 +4,7 @@
 //! pass in 8-bit colour.
 
 use crate::accel::Backend;
-use crate::render::{Frame, Passes, World, DEPTH_FAR};
+use crate::render::{Frame, Passes, RestGroups, World, DEPTH_FAR};
 use crate::scene::{ImageSettings, Scene};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -63,17 +63,18 @@ impl From<crate::Error> for Stopped {
     }
 }
 
-/// Render `scene` (already at the level's size) with every pass, strip by strip, stopping
+/// Render `scene` (already at the level's size; `rest`: its world's groups) with every pass, strip by strip, stopping
 /// between strips once `cancel` is set. The colour is what `rest-embree render` writes to a
 /// PNG: the background composited where nothing is hit.
 pub(crate) fn render(
     scene: &mut Scene,
+    rest: &RestGroups,
     backend: &dyn Backend,
     cancel: &AtomicBool,
 ) -> Result<Frame, Stopped> {
     scene.image.transparent.get_or_insert(false);
     scene.film = None;
-    let world = World::build(scene, backend)?;
+    let world = World::aim(scene, rest, backend)?;
     let (w, h) = scene.image.frame_size();
     let mut frame = Frame::new(w, h);
     frame.pixels.clear();

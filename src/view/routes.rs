@@ -9,7 +9,7 @@
 //!   file rendered to an EXR in the background; `GET /api/job?id`: how far it is;
 //! - `GET /files/NAME`: a file a render of a view wrote.
 
-use super::{frames, jobs, Client, Viewer, MAX_CLIENTS};
+use super::{edits, frames, jobs, Client, Viewer, MAX_CLIENTS};
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
@@ -189,7 +189,7 @@ fn frame(v: &Viewer, body: &Value) -> Answer {
     };
     let view = body.get("view").ok_or((400, "no `view`".to_string()))?;
     // The view's values checked before it supersedes anything (the scene is read later).
-    v.view_text(view)?;
+    edits::edits(view, &v.editable).map_err(|e| (400, e.to_string()))?;
     // This request supersedes the client's earlier ones: their renders stop at their next
     // strip; an earlier one arriving late is refused here.
     let (seq, cancel) = register(v, &client, seq)?;
@@ -213,7 +213,9 @@ fn frame(v: &Viewer, body: &Value) -> Answer {
     let t0 = Instant::now();
     let rendered = {
         let _rendering = Count::new(&v.rendering);
-        frames::render(&mut scene, v.backend.as_ref(), &cancel)
+        v.rest_groups(&scene)
+            .map_err(frames::Stopped::Failed)
+            .and_then(|rest| frames::render(&mut scene, &rest, v.backend.as_ref(), &cancel))
     };
     let ms = t0.elapsed().as_secs_f64() * 1e3;
     drop(turn);
