@@ -33,7 +33,9 @@ pub(crate) use tile::TileScratch;
 pub(crate) use world::{RestGroups, World};
 // What the bench's passes of primary rays alone reach (src/bench/primary.rs).
 #[cfg(feature = "cli")]
-pub(crate) use tile::{image_points, primary_rays, tile_pixels};
+pub(crate) use tile::image_points;
+#[cfg(all(feature = "cli", feature = "embree"))]
+pub(crate) use tile::{primary_rays, tile_pixels};
 // What the tests of the internals reach (src/tests/).
 #[cfg(test)]
 pub(crate) use {
