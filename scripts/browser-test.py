@@ -96,6 +96,11 @@ try:
     wait("document.body && document.body.dataset.final === 'true'", "the first final frame")
     print("browser-test: the page drew the scene:", js("document.getElementById('status').textContent"))
 
+    # A group at rest starts moving along +x, away from this camera: type -1 into the first
+    # direction box, as a user does, so that the lattice approaches.
+    js("""(() => { const n = document.querySelector('input.beta[data-group="lattice"]')
+            .closest('div').querySelector('label.dir input');
+            n.value = '-1'; n.dispatchEvent(new Event('change', { bubbles: true })); })()""")
     # Move the slider as a hand does: a run of input events to 0.9.
     before = int(js("document.body.dataset.version"))
     for b in ["0.3", "0.6", "0.8", "0.9"]:
@@ -109,8 +114,8 @@ try:
          "the final frame at beta 0.9")
     sent = js("JSON.stringify(viewer.state.groups.lattice)")
     state = json.loads(sent)
-    if abs(state["beta"] - 0.9) > 1e-12:
-        fail(f"the slider set {sent}")
+    if abs(state["beta"] - 0.9) > 1e-12 or state["direction"] != [-1, 0, 0]:
+        fail(f"the slider and direction box set {sent}")
 
     # Click pixels of the image until one shows the lattice.
     rect = js("(() => { const r = document.getElementById('frame').getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; })()")

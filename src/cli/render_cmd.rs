@@ -220,6 +220,11 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     if let Some(w) = render::extrapolation_warning(&scene).filter(|_| !args.quiet) {
         eprintln!("{w}");
     }
+    if !args.quiet {
+        for w in &scene.warnings {
+            eprintln!("warning: {}", crate::text::shown(w));
+        }
+    }
     // One frame of a film to a plain name (no run of #): a still of that frame.
     let plain = !args
         .output

@@ -197,6 +197,7 @@ pub(crate) fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> S
         sky,
         fog,
         image: _,
+        warnings: _,
     } = scene;
     let _ = write!(
         feed,

@@ -2,9 +2,10 @@
 
 use super::camera_keys::{camera, film};
 use super::doc::Doc;
+use super::gltf_object;
 use super::lights::light;
 use super::model::*;
-use super::objects::{add_object, OBJECT_KEYS};
+use super::objects::{add_mesh_data, add_object, material_and_transform, OBJECT_KEYS};
 use super::reader::{SceneResult, Table};
 use super::speed::velocity;
 use super::surfaces::{material, sky, textures};
@@ -165,10 +166,6 @@ pub(crate) fn superseded(table: &[&str], key: &str) -> &'static [&'static str] {
 
 fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     let root = Table::root(doc)?;
-    let (camera, flash) = match root.table("camera")? {
-        Some(t) => camera(&t)?,
-        None => return Err(root.missing_table("camera", "the scene needs a [camera] table")),
-    };
     let image = match root.table("image")? {
         Some(t) => image(&t, frame)?,
         None => ImageSettings {
@@ -187,19 +184,54 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     };
     let textures = textures(&root)?;
     let (mut materials, material_ids) = materials(&root, &textures)?;
-    let mut groups = Vec::new();
+    let mut groups: Vec<Group> = Vec::new();
     let mut objects = Vec::new();
     let mut total: u64 = 0;
     let mut group_names = std::collections::HashSet::new();
+    let mut imports = gltf_object::Imports::default();
     for t in &root.tables("group")? {
         let name = t.req_string("name")?;
         if !group_names.insert(name.to_string()) {
             return Err(t.error("name", format!("a group named `{name}` is defined twice")));
         }
         let (ids, index) = (&material_ids, groups.len());
-        let g = group(t, name, ids, &materials, &mut objects, index, &mut total)?;
+        let g = group(
+            t,
+            name,
+            ids,
+            &mut materials,
+            &mut objects,
+            index,
+            &mut total,
+            &mut imports,
+        )?;
+        // A glTF node's own group, named `<group>/<node>`: its name once among the groups.
+        let mut own: Vec<&str> = g
+            .iter()
+            .map(|x| x.name.as_str())
+            .filter(|n| *n != name)
+            .collect();
+        own.dedup();
+        for n in own {
+            if !group_names.insert(n.to_string()) {
+                return Err(t.error("object", format!("two groups are named `{n}` (a glTF file's nodes of one name, or a [[group]] named so)")));
+            }
+        }
         groups.extend(g);
     }
+    // The camera: the scene's own, else a glTF file's.
+    let (camera, flash) = match root.table("camera")? {
+        Some(t) => camera(&t)?,
+        None => match gltf_object::camera(&imports) {
+            Some(c) => (c, None),
+            None => {
+                return Err(root.missing_table(
+                    "camera",
+                    "the scene needs a [camera] table (or a glTF object whose file holds a perspective camera)",
+                ))
+            }
+        },
+    };
     // Without objects only a sky is worth rendering.
     if groups.iter().all(|g| g.geometry.is_empty()) && !root.has("sky") {
         return Err(root.error(
@@ -224,6 +256,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         lights.push(light(&t, &groups)?);
     }
     lights.extend(flash);
+    lights.extend(imports.lights);
     let film = root.table("film")?.map(|t| film(&t, &camera)).transpose()?;
     let sky = root.table("sky")?.map(|t| sky(&t)).transpose()?;
     let fog = match root.table("fog")? {
@@ -249,6 +282,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         film,
         sky,
         fog,
+        warnings: imports.warnings,
     })
 }
 
@@ -275,31 +309,48 @@ fn materials(
 
 /// A `[[group]]` (its first group the `index`th, named `name`) and its objects, appended to
 /// `objects`; `total` counts the scene's primitives. A group with a worldline of several
-/// segments is a group per segment.
+/// segments is a group per segment; a glTF file's top-level nodes that are groups of their own
+/// (`groups = "nodes"`, or keyframed) follow, named `<name>/<node>`.
+#[allow(clippy::too_many_arguments)]
 fn group(
     t: &Table,
     name: &str,
     material_ids: &HashMap<String, u32>,
-    materials: &[Material],
+    materials: &mut Vec<Material>,
     objects: &mut Vec<ObjectInfo>,
     index: usize,
     total: &mut u64,
+    imports: &mut gltf_object::Imports,
 ) -> SceneResult<Vec<Group>> {
     let segments = worldline::read(t, "direction", super::segments::Whose::Group)?;
     let velocity = match segments {
         Some(_) => Velocity::ZERO,
         None => velocity(t, "direction")?.unwrap_or(Velocity::ZERO),
     };
+    let moves = segments.is_some() || velocity != Velocity::ZERO;
     let mut geometry = Geometry::default();
-    for o in t.tables("object")? {
+    let entries = t.tables("object")?;
+    let mut own_groups = Vec::new();
+    for (k, o) in entries.iter().enumerate() {
         let id = objects.len() as u32;
         let (first, implicit, parts) = (
             geometry.prims.len(),
             geometry.implicit.len(),
             geometry.parts.len(),
         );
-        let kind = add_object(&o, id, material_ids, &mut geometry, total)?;
-        check_object(&o, &kind, &geometry, materials, (first, implicit, parts))?;
+        let kind = if o.string("type")? == Some("gltf") {
+            let placed = gltf_object::place(o, velocity, moves, materials, material_ids, imports)?;
+            let (mat, place) = material_and_transform(o, material_ids)?;
+            if let Some(mesh) = placed.stays {
+                let (geo, chosen) = (&mut geometry, placed.chosen.clone());
+                add_mesh_data(o, id, mat, place, geo, total, mesh, chosen, material_ids)?;
+            }
+            own_groups.push((k, placed.own, placed.chosen, mat, place));
+            "gltf".to_string()
+        } else {
+            add_object(o, id, material_ids, &mut geometry, total)?
+        };
+        check_object(o, &kind, &geometry, materials, (first, implicit, parts))?;
         objects.push(ObjectInfo {
             name: o.string("name")?.map(str::to_string),
             kind,
@@ -325,6 +376,50 @@ fn group(
         "object",
         "worldline",
     ])?;
+    let mut out = groups_of(
+        t,
+        name,
+        geometry,
+        segments.clone(),
+        velocity,
+        materials,
+        total,
+    )?;
+    for (k, own, chosen, mat, place) in own_groups {
+        let o = &entries[k];
+        for g in own {
+            let id = objects.len() as u32;
+            let mut geometry = Geometry::default();
+            let (geo, chosen) = (&mut geometry, chosen.clone());
+            add_mesh_data(o, id, mat, place, geo, total, g.mesh, chosen, material_ids)?;
+            check_object(o, "gltf", &geometry, materials, (0, 0, 0))?;
+            objects.push(ObjectInfo {
+                name: Some(g.node.clone()),
+                kind: "gltf".into(),
+                group: index + out.len(),
+            });
+            // A node of a moving group that is not keyframed moves with the group.
+            let line = g.segments.or_else(|| segments.clone());
+            let named = format!("{name}/{}", g.node);
+            out.extend(groups_of(
+                o, &named, geometry, line, velocity, materials, total,
+            )?);
+        }
+    }
+    Ok(out)
+}
+
+/// The groups one group's geometry makes: one, or one per piece of its worldline (`segments`),
+/// with what such groups cannot hold refused (`t` names where).
+fn groups_of(
+    t: &Table,
+    name: &str,
+    geometry: Geometry,
+    segments: Option<Vec<super::worldline::Segment>>,
+    velocity: Velocity,
+    materials: &[Material],
+    total: &mut u64,
+) -> SceneResult<Vec<Group>> {
     let count = segments.as_deref().map_or(1, worldline::group_count);
     if count > 1 {
         // Each segment holds a copy of the group's listed primitives.

@@ -5,6 +5,8 @@ mod camera_keys;
 mod colour;
 pub(crate) mod doc;
 mod envelope;
+mod gltf_file;
+mod gltf_object;
 mod lights;
 mod load;
 mod mesh_file;

@@ -429,6 +429,9 @@ pub struct Scene {
     pub sky: Option<super::Sky>,
     /// A fog filling all space outside objects (`[fog]`), at rest in a group's frame.
     pub fog: Option<Fog>,
+    /// What the scene's files hold that it does not take (a glTF file's unmapped extensions,
+    /// say), one sentence each, for the user to be told.
+    pub warnings: Vec<String>,
 }
 
 /// A homogeneous medium everywhere outside objects, at rest in a group's frame. Its medium is

@@ -43,6 +43,9 @@ pub(super) const OBJECT_KEYS: &[&str] = &[
     "spokes",
     "rim_segments",
     "hub_radius",
+    "groups",
+    "time_scale",
+    "camera",
 ];
 
 fn material_ref(
@@ -173,11 +176,8 @@ fn file_materials(
     in_file: &[String],
     mats: &HashMap<String, u32>,
     default: u32,
+    mut chosen: Vec<u32>,
 ) -> SceneResult<Vec<u32>> {
-    let mut chosen: Vec<u32> = in_file
-        .iter()
-        .map(|n| mats.get(n).copied().unwrap_or(default))
-        .collect();
     if let Some(map) = t.table("materials")? {
         let keys: Vec<&str> = map.keys().collect();
         for k in keys {
@@ -286,7 +286,7 @@ pub(super) fn add_object(
                 n,
                 "type",
                 format!(
-                    "unknown object type `{other}` (box, sphere, rod, mesh, lattice, bar_array, wheel)"
+                    "unknown object type `{other}` (box, sphere, rod, mesh, gltf, lattice, bar_array, wheel)"
                 ),
             ));
         }
@@ -497,65 +497,98 @@ impl Adding<'_, '_> {
                 "a mesh is given by `file` or by `vertices` and `indices`, not both",
             ));
         }
-        let mut mesh = read_mesh_file(t)?;
-        mesh_budget(t, total, &mesh)?;
-        // The corner data, moved out of the mesh as read; normals turn with the mesh and
-        // take the inverse of its scale.
-        let normals = match transform {
-            Some(x) => mesh.normals.take().map(|n| {
-                let turn = |n: DVec3| (x.rotation * (n / x.scale)).normalize_or_zero();
-                n.into_iter().map(|c| c.map(turn)).collect()
-            }),
-            None => mesh.normals.take(),
-        };
-        let uvs = mesh.uvs.take();
-        let corners = (normals.is_some() || uvs.is_some())
-            .then_some(crate::geometry::Corners { normals, uvs });
-        // Runs of triangles of one material, each a part of the object.
-        let chosen = file_materials(t, &mesh.materials, mats, mat)?;
-        let material_of = |i: usize| match mesh.material_of.get(i) {
-            Some(&m) if m != super::mesh_file::NO_MATERIAL => chosen[m as usize],
-            _ => mat,
-        };
-        let n = mesh.triangles.len();
-        let mut bounds = Vec::new();
-        let mut start = 0;
-        while start < n {
-            let m = material_of(start);
-            let end = (start + 1..n).find(|&i| material_of(i) != m).unwrap_or(n);
-            bounds.push((start, end, m));
-            start = end;
-        }
-        // One material: the corner data as read, not a copy of it.
-        let runs: Vec<_> = match (bounds.as_slice(), corners) {
-            ([(_, _, m)], c) => vec![(n as u64, *m, c.map(std::sync::Arc::new))],
-            (_, c) => bounds
-                .iter()
-                .map(|&(start, end, m)| {
-                    let part = c.as_ref().map(|c| {
-                        std::sync::Arc::new(crate::geometry::Corners {
-                            normals: c.normals.as_ref().map(|v| v[start..end].to_vec()),
-                            uvs: c.uvs.as_ref().map(|v| v[start..end].to_vec()),
-                        })
-                    });
-                    ((end - start) as u64, m, part)
-                })
-                .collect(),
-        };
-        // Held as itself: its vertices once, placed, and its triangles' indices.
-        let positions = match transform {
-            Some(x) => mesh.positions.iter().map(|&p| x.point(p)).collect(),
-            None => mesh.positions,
-        };
-        let shape = Implicit::Mesh(std::sync::Arc::new(crate::geometry::IndexedMesh::new(
-            positions,
-            mesh.triangles,
-        )));
-        geo.push_implicit_with(id, &runs, shape)
-            .map_err(|why| at_value(t, "file", why.to_string()))?;
-        Ok(())
+        let mesh = read_mesh_file(t)?;
+        let chosen = mesh
+            .materials
+            .iter()
+            .map(|n| mats.get(n).copied().unwrap_or(mat))
+            .collect();
+        add_mesh_data(t, id, mat, transform, geo, total, mesh, chosen, mats)
     }
+}
 
+/// The entry `t`'s `material` (for triangles its file gives none) and transform.
+pub(super) fn material_and_transform(
+    t: &Table,
+    mats: &HashMap<String, u32>,
+) -> SceneResult<(u32, Option<Transform>)> {
+    Ok((material_ref(t, "material", mats, 0)?, Transform::read(t)?))
+}
+
+/// A mesh as read (from any file) as an object held as itself in `geo`: placed by `transform`,
+/// its file's materials `chosen` (by index), remapped by the entry's `materials` table, those
+/// it names none `mat`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn add_mesh_data(
+    t: &Table,
+    id: u32,
+    mat: u32,
+    transform: Option<Transform>,
+    geo: &mut Geometry,
+    total: &mut u64,
+    mut mesh: super::mesh_file::MeshData,
+    chosen: Vec<u32>,
+    mats: &HashMap<String, u32>,
+) -> SceneResult<()> {
+    mesh_budget(t, total, &mesh)?;
+    // The corner data, moved out of the mesh as read; normals turn with the mesh and
+    // take the inverse of its scale.
+    let normals = match transform {
+        Some(x) => mesh.normals.take().map(|n| {
+            let turn = |n: DVec3| (x.rotation * (n / x.scale)).normalize_or_zero();
+            n.into_iter().map(|c| c.map(turn)).collect()
+        }),
+        None => mesh.normals.take(),
+    };
+    let uvs = mesh.uvs.take();
+    let corners =
+        (normals.is_some() || uvs.is_some()).then_some(crate::geometry::Corners { normals, uvs });
+    // Runs of triangles of one material, each a part of the object.
+    let chosen = file_materials(t, &mesh.materials, mats, mat, chosen)?;
+    let material_of = |i: usize| match mesh.material_of.get(i) {
+        Some(&m) if m != super::mesh_file::NO_MATERIAL => chosen[m as usize],
+        _ => mat,
+    };
+    let n = mesh.triangles.len();
+    let mut bounds = Vec::new();
+    let mut start = 0;
+    while start < n {
+        let m = material_of(start);
+        let end = (start + 1..n).find(|&i| material_of(i) != m).unwrap_or(n);
+        bounds.push((start, end, m));
+        start = end;
+    }
+    // One material: the corner data as read, not a copy of it.
+    let runs: Vec<_> = match (bounds.as_slice(), corners) {
+        ([(_, _, m)], c) => vec![(n as u64, *m, c.map(std::sync::Arc::new))],
+        (_, c) => bounds
+            .iter()
+            .map(|&(start, end, m)| {
+                let part = c.as_ref().map(|c| {
+                    std::sync::Arc::new(crate::geometry::Corners {
+                        normals: c.normals.as_ref().map(|v| v[start..end].to_vec()),
+                        uvs: c.uvs.as_ref().map(|v| v[start..end].to_vec()),
+                    })
+                });
+                ((end - start) as u64, m, part)
+            })
+            .collect(),
+    };
+    // Held as itself: its vertices once, placed, and its triangles' indices.
+    let positions = match transform {
+        Some(x) => mesh.positions.iter().map(|&p| x.point(p)).collect(),
+        None => mesh.positions,
+    };
+    let shape = Implicit::Mesh(std::sync::Arc::new(crate::geometry::IndexedMesh::new(
+        positions,
+        mesh.triangles,
+    )));
+    geo.push_implicit_with(id, &runs, shape)
+        .map_err(|why| at_value(t, "file", why.to_string()))?;
+    Ok(())
+}
+
+impl Adding<'_, '_> {
     /// A mesh given inline (`vertices`, `indices`), one primitive per triangle.
     fn add_inline_mesh(&mut self) -> SceneResult<()> {
         let (t, id, mat, transform) = (self.t, self.id, self.mat, self.transform);

@@ -275,38 +275,7 @@ pub(crate) fn read_image(path: &std::path::Path) -> crate::Result<(usize, usize,
         Some("png") => {
             let file =
                 std::fs::File::open(path).map_err(|e| bad(format!("cannot read it: {e}")))?;
-            let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
-            decoder.set_transformations(png::Transformations::EXPAND);
-            let mut reader = decoder
-                .read_info()
-                .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
-            let (w, h) = (reader.info().width as usize, reader.info().height as usize);
-            let n = (w as u64 * h as u64).max(1);
-            fits(path, w, h, TEXEL + reader.output_buffer_size() as u64 / n)?;
-            let mut buf = vec![0; reader.output_buffer_size()];
-            let frame = reader
-                .next_frame(&mut buf)
-                .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
-            let channels = frame.color_type.samples();
-            let wide = frame.bit_depth == png::BitDepth::Sixteen;
-            let value = |i: usize| -> f32 {
-                let v = if wide {
-                    f32::from(u16::from_be_bytes([buf[2 * i], buf[2 * i + 1]])) / 65535.0
-                } else {
-                    f32::from(buf[i]) / 255.0
-                };
-                srgb_to_linear(v)
-            };
-            let texels = (0..w * h)
-                .map(|p| {
-                    let at = p * channels;
-                    match channels {
-                        1 | 2 => [value(at); 3],
-                        _ => [value(at), value(at + 1), value(at + 2)],
-                    }
-                })
-                .collect();
-            Ok((w, h, texels))
+            read_png(std::io::BufReader::new(file), path)
         }
         Some("exr") => {
             // The header first: its data window says how large the image claims to be.
@@ -402,6 +371,48 @@ impl Sky {
         let (u, v) = (lon / (2.0 * PI) + 0.5, 0.5 - lat / PI);
         Some(map.bilinear(u, v) * self.intensity)
     }
+}
+
+/// A PNG's linear RGB texels (see [`read_image`]) from `r`, its bytes; `path` names it in
+/// errors (a file, or a glTF file's image).
+pub(crate) fn read_png(
+    r: impl std::io::Read,
+    path: &std::path::Path,
+) -> crate::Result<(usize, usize, Texels)> {
+    let bad = |m: String| crate::Error::image(path, m, None);
+    const TEXEL: u64 = 12;
+    let mut decoder = png::Decoder::new(r);
+    decoder.set_transformations(png::Transformations::EXPAND);
+    let mut reader = decoder
+        .read_info()
+        .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
+    let (w, h) = (reader.info().width as usize, reader.info().height as usize);
+    let n = (w as u64 * h as u64).max(1);
+    fits(path, w, h, TEXEL + reader.output_buffer_size() as u64 / n)?;
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let frame = reader
+        .next_frame(&mut buf)
+        .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
+    let channels = frame.color_type.samples();
+    let wide = frame.bit_depth == png::BitDepth::Sixteen;
+    let value = |i: usize| -> f32 {
+        let v = if wide {
+            f32::from(u16::from_be_bytes([buf[2 * i], buf[2 * i + 1]])) / 65535.0
+        } else {
+            f32::from(buf[i]) / 255.0
+        };
+        srgb_to_linear(v)
+    };
+    let texels = (0..w * h)
+        .map(|p| {
+            let at = p * channels;
+            match channels {
+                1 | 2 => [value(at); 3],
+                _ => [value(at), value(at + 1), value(at + 2)],
+            }
+        })
+        .collect();
+    Ok((w, h, texels))
 }
 
 #[cfg(test)]

@@ -22,6 +22,7 @@ mod extreme;
 mod farm;
 mod film;
 mod fuzz;
+mod gltf;
 mod house;
 mod media;
 mod meshes;

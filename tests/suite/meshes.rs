@@ -12,7 +12,7 @@ use rest_embree::render::Frame;
 
 /// The unit box of GOOD, from (-0.5, 10, -0.5) to (0.5, 11, 0.5): its corners, and its faces
 /// counter-clockwise seen from outside (1-based, as OBJ counts).
-fn box_corners() -> Vec<DVec3> {
+pub(crate) fn box_corners() -> Vec<DVec3> {
     (0..8)
         .map(|i| {
             DVec3::new(
@@ -23,7 +23,7 @@ fn box_corners() -> Vec<DVec3> {
         })
         .collect()
 }
-const BOX_FACES: [[u32; 4]; 6] = [
+pub(crate) const BOX_FACES: [[u32; 4]; 6] = [
     [1, 3, 4, 2],
     [5, 6, 8, 7],
     [1, 2, 6, 5],
@@ -101,7 +101,7 @@ fn ply_binary(corners: &[DVec3]) -> Vec<u8> {
 }
 
 /// GOOD with its box replaced by `object` (the lines after `type = ...`).
-fn with_object(object: &str) -> String {
+pub(crate) fn with_object(object: &str) -> String {
     let text = GOOD.replace(
         "type = \"box\"\nmin = [-0.5, 10, -0.5]\nmax = [0.5, 11, 0.5]",
         object,
@@ -110,7 +110,7 @@ fn with_object(object: &str) -> String {
     text
 }
 
-fn load(d: &Dir, name: &str, text: &str, sets: &[&str]) -> rest_embree::scene::Scene {
+pub(crate) fn load(d: &Dir, name: &str, text: &str, sets: &[&str]) -> rest_embree::scene::Scene {
     let path = d.file(name, text);
     let sets: Vec<(String, String)> = sets
         .iter()
@@ -121,7 +121,7 @@ fn load(d: &Dir, name: &str, text: &str, sets: &[&str]) -> rest_embree::scene::S
 
 /// Pixels whose colour or coverage differ, and of those, how many are not on a silhouette (a
 /// pixel with a neighbour, in `a`, of another object id or coverage).
-fn differing(a: &Frame, b: &Frame) -> (usize, usize) {
+pub(crate) fn differing(a: &Frame, b: &Frame) -> (usize, usize) {
     let (w, h) = (a.width as i64, a.height as i64);
     fn at(f: &Frame, x: i64, y: i64) -> &rest_embree::render::PixelValue {
         &f.pixels[(y * i64::from(f.width) + x) as usize]

@@ -1,0 +1,547 @@
+//! glTF scenes (docs/scene-format.md, "glTF files"): a box placed by a node hierarchy, in a
+//! `.gltf` with a data URI, a `.gltf` with a `.bin` beside it and a `.glb`, renders as the
+//! `box` object on both backends, at rest and moving; a node keyframed at constant velocity
+//! renders, between its keys, as the object given that velocity, pixel for pixel; materials,
+//! point lights and cameras map as documented; bad files are clear errors.
+
+use crate::common::cli::{status, Dir, GOOD};
+use crate::common::*;
+use crate::meshes::{box_corners, differing, load, with_object, BOX_FACES};
+use base64::Engine;
+use glam::DVec3;
+use serde_json::{json, Value};
+
+/// A glTF document being written: its JSON and its one buffer.
+struct Doc {
+    json: Value,
+    bin: Vec<u8>,
+}
+
+impl Doc {
+    /// The unit box centred on its origin as mesh 0 (12 triangles, counter-clockwise from
+    /// outside), in buffer 0, with `nodes` as the scene's nodes (node 0 the top).
+    fn unit_box(nodes: Value) -> Doc {
+        let mut bin = Vec::new();
+        let centre = DVec3::new(0.0, 10.5, 0.0);
+        for c in box_corners() {
+            for x in (c - centre).to_array() {
+                bin.extend_from_slice(&(x as f32).to_le_bytes());
+            }
+        }
+        let positions = bin.len();
+        for f in BOX_FACES {
+            for t in [[f[0], f[1], f[2]], [f[0], f[2], f[3]]] {
+                for i in t {
+                    bin.extend_from_slice(&(i - 1).to_le_bytes());
+                }
+            }
+        }
+        let json = json!({
+            "asset": {"version": "2.0"},
+            "scene": 0,
+            "scenes": [{"nodes": [0]}],
+            "nodes": nodes,
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+            "buffers": [{"byteLength": bin.len()}],
+            "bufferViews": [
+                {"buffer": 0, "byteOffset": 0, "byteLength": positions},
+                {"buffer": 0, "byteOffset": positions, "byteLength": bin.len() - positions}
+            ],
+            "accessors": [
+                {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3",
+                 "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]},
+                {"bufferView": 1, "componentType": 5125, "count": 36, "type": "SCALAR"}
+            ]
+        });
+        Doc { json, bin }
+    }
+
+    /// Append f32 data as a new accessor of `kind` ("SCALAR", "VEC3"); its index.
+    fn accessor(&mut self, values: &[f32], kind: &str, count: usize) -> usize {
+        let offset = self.bin.len();
+        for v in values {
+            self.bin.extend_from_slice(&v.to_le_bytes());
+        }
+        let views = self.json["bufferViews"].as_array_mut().unwrap();
+        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": values.len() * 4}));
+        let view = views.len() - 1;
+        self.json["buffers"][0]["byteLength"] = json!(self.bin.len());
+        let mut acc =
+            json!({"bufferView": view, "componentType": 5126, "count": count, "type": kind});
+        if kind == "SCALAR" {
+            let (lo, hi) = values
+                .iter()
+                .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+            acc["min"] = json!([lo]);
+            acc["max"] = json!([hi]);
+        }
+        let accessors = self.json["accessors"].as_array_mut().unwrap();
+        accessors.push(acc);
+        accessors.len() - 1
+    }
+
+    /// As a `.gltf` with its buffer in a data URI.
+    fn embedded(&self) -> String {
+        let mut j = self.json.clone();
+        let data = base64::engine::general_purpose::STANDARD.encode(&self.bin);
+        j["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{data}"));
+        j.to_string()
+    }
+
+    /// As a `.gltf` naming `bin` beside it.
+    fn beside(&self, bin: &str) -> String {
+        let mut j = self.json.clone();
+        j["buffers"][0]["uri"] = json!(bin);
+        j.to_string()
+    }
+
+    /// As a `.glb`.
+    fn glb(&self) -> Vec<u8> {
+        let mut text = self.json.to_string().into_bytes();
+        while !text.len().is_multiple_of(4) {
+            text.push(b' ');
+        }
+        let mut bin = self.bin.clone();
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        let total = 12 + 8 + text.len() + 8 + bin.len();
+        let mut out = Vec::new();
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&(total as u32).to_le_bytes());
+        out.extend_from_slice(&(text.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"JSON");
+        out.extend_from_slice(&text);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&bin);
+        out
+    }
+}
+
+/// The box of GOOD placed by two levels of nodes: a parent at (0, 10, 0) scaling by 2, its
+/// child at (0, 0.25, 0) scaling by 1/2 (every number exact in binary).
+fn nested_nodes() -> Value {
+    json!([
+        {"name": "holder", "translation": [0, 10, 0], "scale": [2, 2, 2], "children": [1]},
+        {"name": "box", "translation": [0, 0.25, 0], "scale": [0.5, 0.5, 0.5], "mesh": 0}
+    ])
+}
+
+#[test]
+fn a_box_from_gltf_renders_as_the_box_in_every_container() {
+    let d = Dir::new("gltf-box");
+    let doc = Doc::unit_box(nested_nodes());
+    d.file("embedded.gltf", &doc.embedded());
+    d.file("beside.gltf", &doc.beside("the%20box.bin"));
+    std::fs::write(d.0.join("the box.bin"), &doc.bin).unwrap();
+    std::fs::write(d.0.join("box.glb"), doc.glb()).unwrap();
+    for velocity in ["[0, 0, 0]", "[0.5, 0, 0]"] {
+        let set = format!("group.cube.velocity={velocity}");
+        let sets = ["image.width=96", "image.height=64", set.as_str()];
+        let reference = load(&d, "box.toml", GOOD, &sets);
+        for file in ["embedded.gltf", "beside.gltf", "box.glb"] {
+            let text = with_object(&format!("type = \"gltf\"\nfile = \"{file}\""));
+            let scene = load(&d, "gltf.toml", &text, &sets);
+            for b in backends() {
+                let (a, m) = (render_with(&reference, b), render_with(&scene, b));
+                let hit = a.pixels.iter().filter(|p| p.object_id == 1).count();
+                assert!(hit > 100, "the box is in view ({hit} pixels)");
+                let (all, inside) = differing(&a, &m);
+                eprintln!("{file} on {b} at {velocity}: {all} of {hit} box pixels differ");
+                assert_eq!(
+                    inside, 0,
+                    "{file} on {b} at {velocity}: {all} differ, {inside} inside"
+                );
+                assert!(
+                    all * 50 < a.pixels.len(),
+                    "{file} on {b} at {velocity}: {all} differ"
+                );
+            }
+        }
+    }
+}
+
+/// GOOD's box (or `object` in its place) at rest in the world (its light too), seen at camera
+/// time `time`.
+fn at_time(object: &str, velocity: &str, time: f64) -> String {
+    let text = match object {
+        "box" => GOOD.to_string(),
+        _ => with_object(object),
+    };
+    text.replace("group = \"cube\"\n", "")
+        .replace("velocity = [0.5, 0, 0]", velocity)
+        .replace("time = 10", &format!("time = {time}"))
+}
+
+#[test]
+fn a_node_keyed_at_constant_velocity_is_the_box_given_that_velocity() {
+    let d = Dir::new("gltf-keys");
+    // The box's node keyed from (0, 10.5, 0) at the file's time 0 to (20, 10.5, 0) at 40 s:
+    // 0.5c along x, through where GOOD's box is at time 0.
+    let mut doc = Doc::unit_box(json!([{"name": "box", "translation": [0, 10.5, 0], "mesh": 0}]));
+    let times = doc.accessor(&[0.0, 40.0], "SCALAR", 2);
+    let values = doc.accessor(&[0.0, 10.5, 0.0, 20.0, 10.5, 0.0], "VEC3", 2);
+    doc.json["animations"] = json!([{
+        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+        "samplers": [{"input": times, "output": values, "interpolation": "LINEAR"}]
+    }]);
+    std::fs::write(d.0.join("keys.glb"), doc.glb()).unwrap();
+    let sets = ["image.width=96", "image.height=64"];
+    // Seen at camera time 11 the light left the box near time 0.5, between the keys.
+    let reference = load(
+        &d,
+        "v.toml",
+        &at_time("box", "velocity = [0.5, 0, 0]", 11.0),
+        &sets,
+    );
+    let keyed = load(
+        &d,
+        "k.toml",
+        &at_time(
+            "type = \"gltf\"\nfile = \"keys.glb\"",
+            "velocity = [0, 0, 0]",
+            11.0,
+        ),
+        &sets,
+    );
+    let names: Vec<&str> = keyed.groups.iter().map(|g| g.name.as_str()).collect();
+    assert!(
+        names.contains(&"cube/box"),
+        "the keyed node is a group of its own: {names:?}"
+    );
+    for b in backends() {
+        let (a, k) = (render_with(&reference, b), render_with(&keyed, b));
+        let hit = a.pixels.iter().filter(|p| p.alpha > 0.0).count();
+        assert!(hit > 100, "the box is in view ({hit} pixels)");
+        let same = a
+            .pixels
+            .iter()
+            .zip(&k.pixels)
+            .filter(|(p, q)| p.color == q.color && p.alpha == q.alpha)
+            .count();
+        assert_eq!(
+            same,
+            a.pixels.len(),
+            "on {b}: {} pixels differ",
+            a.pixels.len() - same
+        );
+    }
+    // Keys faster than light are refused, naming the node and the keys.
+    let mut fast = Doc::unit_box(json!([{"name": "box", "translation": [0, 10.5, 0], "mesh": 0}]));
+    let times = fast.accessor(&[0.0, 1.0], "SCALAR", 2);
+    let values = fast.accessor(&[0.0, 10.5, 0.0, 2.0, 10.5, 0.0], "VEC3", 2);
+    fast.json["animations"] = json!([{
+        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+        "samplers": [{"input": times, "output": values}]
+    }]);
+    std::fs::write(d.0.join("fast.glb"), fast.glb()).unwrap();
+    let path = d.file(
+        "fast.toml",
+        &at_time(
+            "type = \"gltf\"\nfile = \"fast.glb\"",
+            "velocity = [0, 0, 0]",
+            11.0,
+        ),
+    );
+    let err = rest_embree::scene::load_file(&path, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("fast.toml")
+            && err.contains("`box`")
+            && err.contains("2.000000c")
+            && err.contains("time_scale"),
+        "{err}"
+    );
+    // Ten scene units a second, it moves at 0.2c.
+    let sets = ["group.cube.object.0.time_scale=10"];
+    let slow = load(
+        &d,
+        "fast.toml",
+        &std::fs::read_to_string(&path).unwrap(),
+        &sets,
+    );
+    let moving = slow
+        .groups
+        .iter()
+        .filter(|g| g.name == "cube/box")
+        .map(|g| g.velocity.beta())
+        .fold(0.0, f64::max);
+    assert!((moving - 0.2).abs() < 1e-12, "{moving}");
+}
+
+#[test]
+fn materials_lights_and_cameras_map_as_documented() {
+    let d = Dir::new("gltf-map");
+    let mut doc = Doc::unit_box(json!([
+        {"name": "box", "translation": [0, 10.5, 0], "mesh": 0},
+        {"name": "lamp", "translation": [1, 2, 3], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        // Looking down -z turned to look along +y: a quarter turn about x.
+        {"name": "eye", "translation": [0, 0, 0], "rotation": [std::f64::consts::FRAC_1_SQRT_2, 0, 0, std::f64::consts::FRAC_1_SQRT_2], "camera": 0}
+    ]));
+    doc.json["scenes"][0]["nodes"] = json!([0, 1, 2]);
+    doc.json["meshes"][0]["primitives"][0]["material"] = json!(0);
+    doc.json["materials"] = json!([{
+        "name": "paint",
+        "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 1.0], "metallicFactor": 0.25, "roughnessFactor": 0.5},
+        "emissiveFactor": [1.0, 0.5, 0.0],
+        "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0},
+                        "KHR_materials_transmission": {"transmissionFactor": 0.5},
+                        "KHR_materials_ior": {"ior": 1.33}}
+    }]);
+    doc.json["extensionsUsed"] = json!([
+        "KHR_lights_punctual",
+        "KHR_materials_emissive_strength",
+        "KHR_materials_transmission",
+        "KHR_materials_ior",
+        "KHR_materials_clearcoat"
+    ]);
+    doc.json["extensions"] = json!({"KHR_lights_punctual": {"lights": [{"type": "point", "color": [1.0, 0.5, 0.25], "intensity": 8.0}]}});
+    doc.json["cameras"] =
+        json!([{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}]);
+    std::fs::write(d.0.join("all.glb"), doc.glb()).unwrap();
+    let no_camera = GOOD
+        .replace(
+            "[camera]\nposition = [0, 0, 0]\nlook_at = [0, 10, 0]\nfov_y = 30\ntime = 10\n",
+            "",
+        )
+        .replace(
+            "type = \"box\"\nmin = [-0.5, 10, -0.5]\nmax = [0.5, 11, 0.5]",
+            "type = \"gltf\"\nfile = \"all.glb\"",
+        );
+    let scene = load(&d, "all.toml", &no_camera, &[]);
+    // The camera: at its node, looking along the node's -z turned to +y, up +z.
+    let c = &scene.camera;
+    assert!(
+        c.position.length() < 1e-12
+            && (c.forward - DVec3::Y).length() < 1e-6
+            && (c.up - DVec3::Z).length() < 1e-6,
+        "{c:?}"
+    );
+    match c.projection {
+        rest_embree::scene::Projection::Pinhole { fov_y } => assert!((fov_y - 0.5).abs() < 1e-7),
+        ref p => panic!("{p:?}"),
+    }
+    // The light: at its node, colour times candela, falling off as 1/r², resting in the group.
+    let l = scene.lights.last().unwrap();
+    assert_eq!(l.position, DVec3::new(1.0, 2.0, 3.0));
+    assert!(l.inverse_square && (l.velocity.beta() - 0.5).abs() < 1e-15);
+    let want = rest_embree::spectrum::Colour::rgb(
+        DVec3::new(1.0, 0.5, 0.25),
+        rest_embree::spectrum::Role::Emitter,
+    )
+    .scaled(8.0);
+    assert_eq!(l.radiance, want);
+    // The material: its own, as the table in the docs maps it.
+    let m = scene
+        .materials
+        .iter()
+        .find(|m| m.name == "paint")
+        .expect("the file's material");
+    assert_eq!(
+        (m.reflect, m.roughness, m.transmit),
+        (0.25, 0.5, 0.5 * 0.75)
+    );
+    assert!((m.ior - 1.33).abs() < 1e-6);
+    let emission = rest_embree::spectrum::Colour::rgb(
+        DVec3::new(4.0, 2.0, 0.0),
+        rest_embree::spectrum::Role::Emitter,
+    );
+    assert_eq!(m.emission.as_ref(), Some(&emission));
+    let paint = scene
+        .materials
+        .iter()
+        .position(|m| m.name == "paint")
+        .unwrap() as u32;
+    assert!(scene.groups[0]
+        .geometry
+        .parts
+        .iter()
+        .all(|p| p.material == paint));
+    // The unmapped extension is named.
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("KHR_materials_clearcoat")),
+        "{:?}",
+        scene.warnings
+    );
+    // A [[material]] of the same name takes the file's material's place.
+    let own = no_camera
+        .replace("name = \"white\"", "name = \"paint\"")
+        .replace("material = \"white\"", "");
+    let scene = load(&d, "own.toml", &own, &[]);
+    let ids: Vec<u32> = scene.groups[0]
+        .geometry
+        .parts
+        .iter()
+        .map(|p| p.material)
+        .collect();
+    assert!(
+        ids.iter().all(|&i| i == 1),
+        "the scene's `paint` (id 1): {ids:?}"
+    );
+    assert_eq!(
+        scene.materials.iter().filter(|m| m.name == "paint").count(),
+        1
+    );
+}
+
+/// The command's exit status and message on the scene with this glTF object.
+fn refused(d: &Dir, file: &str, bytes: &[u8]) -> String {
+    std::fs::write(d.0.join(file), bytes).unwrap();
+    let scene = d.file(
+        "bad.toml",
+        &with_object(&format!("type = \"gltf\"\nfile = \"{file}\"")),
+    );
+    let out = d.0.join("out.png");
+    let (code, err) = status(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(1), "{file}: {err}");
+    assert!(
+        err.contains("bad.toml") && err.contains(file) && err.contains("file"),
+        "{file}: {err}"
+    );
+    err
+}
+
+#[test]
+fn bad_gltf_files_are_clear_errors() {
+    let d = Dir::new("gltf-bad");
+    let good = Doc::unit_box(nested_nodes());
+    // A buffer that is not there.
+    let err = refused(&d, "missing.gltf", good.beside("gone.bin").as_bytes());
+    assert!(err.contains("gone.bin"), "{err}");
+    // An index past the vertices.
+    let mut bad = Doc::unit_box(nested_nodes());
+    let at = bad.bin.len() - 4;
+    bad.bin[at..].copy_from_slice(&99u32.to_le_bytes());
+    let err = refused(&d, "index.glb", &bad.glb());
+    assert!(
+        err.contains("index 99") && err.contains("8 vertices"),
+        "{err}"
+    );
+    // A matrix beyond f32 (infinite when read).
+    let mut inf = Doc::unit_box(nested_nodes());
+    inf.json["nodes"][1] =
+        json!({"mesh": 0, "matrix": [1e39, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]});
+    let err = refused(&d, "matrix.glb", &inf.glb());
+    assert!(
+        err.contains("not finite") || err.contains("not a readable glTF"),
+        "{err}"
+    );
+    // A node cycle.
+    let mut cycle = Doc::unit_box(nested_nodes());
+    cycle.json["nodes"][1]["children"] = json!([0]);
+    let err = refused(&d, "cycle.glb", &cycle.glb());
+    assert!(
+        err.contains("tree") || err.contains("not a readable glTF"),
+        "{err}"
+    );
+    // A buffer that is a FIFO.
+    let fifo = d.0.join("pipe.bin");
+    assert!(std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let err = refused(&d, "fifo.gltf", good.beside("pipe.bin").as_bytes());
+    assert!(err.contains("not a regular file"), "{err}");
+    // A STEP key: a body cannot jump.
+    let mut step = Doc::unit_box(json!([{"name": "box", "translation": [0, 10.5, 0], "mesh": 0}]));
+    let times = step.accessor(&[0.0, 1.0], "SCALAR", 2);
+    let values = step.accessor(&[0.0, 10.5, 0.0, 0.1, 10.5, 0.0], "VEC3", 2);
+    step.json["animations"] = json!([{
+        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+        "samplers": [{"input": times, "output": values, "interpolation": "STEP"}]
+    }]);
+    let err = refused(&d, "step.glb", &step.glb());
+    assert!(err.contains("STEP"), "{err}");
+    // Not glTF at all, and a data URI over the memory limit.
+    let err = refused(&d, "junk.glb", b"glTF\x02\0\0\0junk");
+    assert!(err.contains("not a readable glTF"), "{err}");
+    let big = format!(
+        "data:application/octet-stream;base64,{}",
+        "A".repeat(4 << 20)
+    );
+    let mut j = good.json.clone();
+    j["buffers"][0]["uri"] = json!(big);
+    std::fs::write(d.0.join("big.gltf"), j.to_string()).unwrap();
+    let scene = d.file(
+        "big.toml",
+        &with_object("type = \"gltf\"\nfile = \"big.gltf\""),
+    );
+    let out = d.0.join("out.png");
+    let (code, err) = status(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--max-memory",
+        "50M",
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("big.gltf") && err.contains("max-memory"),
+        "{err}"
+    );
+}
+
+/// Bytes of a `.glb` flipped, cut and replaced at random (a fixed seed), in its JSON and its
+/// buffer: every one loads or is refused, and none panics.
+#[test]
+fn mutated_gltf_files_load_or_are_refused() {
+    let d = Dir::new("gltf-fuzz");
+    let mut doc = Doc::unit_box(nested_nodes());
+    let times = doc.accessor(&[0.0, 40.0], "SCALAR", 2);
+    let values = doc.accessor(&[0.0, 10.0, 0.0, 20.0, 10.0, 0.0], "VEC3", 2);
+    doc.json["animations"] = json!([{
+        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+        "samplers": [{"input": times, "output": values}]
+    }]);
+    let glb = doc.glb();
+    let scene = d.file(
+        "fuzz.toml",
+        &with_object("type = \"gltf\"\nfile = \"fuzz.glb\"").replace("group = \"cube\"\n", ""),
+    );
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let (mut loaded, mut refused) = (0, 0);
+    for _ in 0..1500 {
+        let mut bytes = glb.clone();
+        for _ in 0..1 + next() % 4 {
+            let at = (next() % bytes.len() as u64) as usize;
+            match next() % 3 {
+                0 => bytes[at] ^= 1 << (next() % 8),
+                1 => bytes[at] = b"0123456789-.e,:[]{}\""[(next() % 20) as usize],
+                _ => bytes.truncate(at.max(12)),
+            }
+        }
+        std::fs::write(d.0.join("fuzz.glb"), &bytes).unwrap();
+        match rest_embree::scene::load_file(&scene, &[]) {
+            Ok(_) => loaded += 1,
+            Err(e) => {
+                let e = e.to_string();
+                assert!(e.contains("fuzz.glb"), "{e}");
+                refused += 1;
+            }
+        }
+    }
+    eprintln!("{loaded} loaded, {refused} refused");
+    assert!(
+        loaded > 0 && refused > 0,
+        "{loaded} loaded, {refused} refused"
+    );
+}
