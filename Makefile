@@ -4,7 +4,7 @@
 CARGO ?= cargo
 OUT ?= out
 
-.PHONY: setup demo test bench images docs film
+.PHONY: setup demo test bench images docs film python
 
 setup:
 	@scripts/setup.sh
@@ -33,9 +33,10 @@ test: setup
 	@mkdir -p target && (scripts/blender-test.sh --install >target/bpy-install.log 2>&1 &)
 	@# The code as the house keeps it: formatted, and no lint in the library alone (no Embree,
 	@# no command line: what a program that links it builds) or in the whole program.
-	$(CARGO) fmt --check
+	$(CARGO) fmt --all --check
 	$(CARGO) clippy --release --no-default-features --all-targets -- -D warnings
 	$(CARGO) clippy --release --all-targets -- -D warnings
+	$(CARGO) clippy --release -p rest-embree-python -- -D warnings
 	$(CARGO) test --release --no-default-features --features cli
 	$(CARGO) test --release --workspace
 	@# The backend's conformance suite (grazing packets against single rays, analytic hits)
@@ -51,7 +52,13 @@ test: setup
 	done
 	scripts/slurm-test.sh target/release/rest-embree
 	scripts/browser-test.sh target/release/rest-embree
+	scripts/python-test.sh target/release/rest-embree
 	scripts/blender-test.sh target/release/rest-embree
+
+# The Python package (python/): `import rest_embree` in the virtual environment VENV (default
+# .venv here); see docs/python.md.
+python: setup
+	@scripts/python-install.sh
 
 # A film's frames as an MP4 (ffmpeg): make film FRAMES='film/frame-%04d.png' FPS=24 MP4=film.mp4
 FRAMES ?= film/frame-%04d.png

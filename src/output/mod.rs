@@ -55,6 +55,33 @@ pub fn write(frame: &Frame, path: &Path) -> crate::Result<()> {
     write_with(frame, path, &ExrOptions::default())
 }
 
+/// Write `frame`, rendered from `scene` (loaded from `scene_file` with the overrides shown as
+/// `overrides`) on `backend`, as `rest-embree render` writes it: an EXR with its header's
+/// attributes and Cryptomatte layers, a PNG with its render id and alpha only for a
+/// transparent scene. The same render makes the same bytes as the command's file.
+pub fn write_render(
+    frame: &Frame,
+    path: &Path,
+    scene: &crate::scene::Scene,
+    backend: &str,
+    scene_file: &str,
+    overrides: &[String],
+) -> crate::Result<()> {
+    let size = (frame.width, frame.height);
+    match Format::for_path(path)? {
+        Format::Exr => {
+            let exr = ExrOptions::for_render(scene, backend, scene_file, overrides);
+            let mattes = !frame.mattes.is_empty();
+            write_exr_in_strips(path, size, mattes, &exr, |put| put(frame))
+        }
+        Format::Png => {
+            let id = header::render_id(scene, backend, overrides);
+            let alpha = scene.image.is_transparent();
+            write_png_in_strips(path, size, alpha, Some(&id), |put| put(frame))
+        }
+    }
+}
+
 /// As [`write()`], an EXR with `exr`'s compression, precision and header attributes.
 pub(crate) fn write_with(frame: &Frame, path: &Path, exr: &ExrOptions) -> crate::Result<()> {
     let format = Format::for_path(path)?;

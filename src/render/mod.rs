@@ -119,6 +119,55 @@ pub fn render(
     Ok((frame, stats))
 }
 
+/// As [`render`], a strip of rows at a time, for a caller that shows progress and may stop it
+/// (the Python package): after each strip `go_on(pixels_done, pixels)` says whether to go on.
+/// None if it said no; the frame is the one [`render`] makes.
+pub fn render_watched(
+    scene: &Scene,
+    backend: &dyn Backend,
+    options: &RenderOptions,
+    mut go_on: impl FnMut(u64, u64) -> bool,
+) -> crate::Result<Option<(Frame, RenderStats)>> {
+    /// Why the strips stopped: an error, or the caller.
+    enum Stop {
+        Failed(crate::Error),
+        Asked,
+    }
+    impl From<crate::Error> for Stop {
+        fn from(e: crate::Error) -> Stop {
+            Stop::Failed(e)
+        }
+    }
+    let t0 = Instant::now();
+    let world = World::build_with(scene, backend, options.world)?;
+    let build_time = t0.elapsed();
+    let t1 = Instant::now();
+    let (w, h) = scene.image.frame_size();
+    let pixels = u64::from(w) * u64::from(h);
+    let mut frame = Frame::new(w, 0);
+    frame.pixels.reserve(pixels as usize);
+    // Strips of about a tenth of the image: progress in tenths, a stop within one.
+    let min_pixels = (pixels / 10).max(1);
+    let result = render_world_in_strips(scene, &world, options.passes, min_pixels, None, |s| {
+        frame.pixels.extend_from_slice(&s.pixels);
+        frame.mattes.extend_from_slice(&s.mattes);
+        frame.height += s.height;
+        match go_on(frame.pixels.len() as u64, pixels) {
+            true => Ok(()),
+            false => Err(Stop::Asked),
+        }
+    });
+    match result {
+        Ok(mut stats) => {
+            stats.build_time = build_time;
+            stats.trace_time = t1.elapsed();
+            Ok(Some((frame, stats)))
+        }
+        Err(Stop::Asked) => Ok(None),
+        Err(Stop::Failed(e)) => Err(e),
+    }
+}
+
 /// The top-left pixels of the image's tiles, row by row.
 pub(crate) fn tiles(scene: &Scene) -> Vec<(u32, u32)> {
     let (w, h) = scene.image.frame_size();
