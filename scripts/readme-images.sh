@@ -36,6 +36,8 @@ $r render scenes/planet.toml -o "$o/planet-0.9.png" --width 320 --height 320 --s
 # A flight through the star field at 0.99c, beside the same sky from a camera at rest.
 $r render scenes/star_flight.toml -o "$o/stars-0.png" --width 384 --height 216 --set 'camera.velocity=[0, 0, 0]' $q
 $r render scenes/star_flight.toml -o "$o/stars-0.99.png" --width 384 --height 216 $q
+# A scene modelled and keyed in Blender, exported as glTF, passing at 0.9c.
+$r render scenes/fleet.toml -o "$o/fleet-0.9.png" --width 480 --height 270 $q
 # A textured OBJ model at rest and approaching at 0.9c, against the stars.
 $r render scenes/rocket.toml -o "$o/rocket-0.png" --width 384 --height 216 --samples 4 --set 'group.rocket.velocity=[0, 0, 0]' --set 'camera.direction=[0, 1, 0]' $q
 $r render scenes/rocket.toml -o "$o/rocket-0.9.png" --width 384 --height 216 --samples 4 $q

@@ -11,14 +11,22 @@ use crate::spacetime::{Boost, Event, Velocity};
 use glam::DVec3;
 
 /// The camera, and the light riding with it where it has a `flash`.
-pub(super) fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
-    let position = t.req_vec3("position")?;
+pub(super) fn camera(
+    t: &Table,
+    from_file: Option<&super::gltf_file::CameraView>,
+) -> SceneResult<(Camera, Option<Light>)> {
+    // A glTF file's camera gives what the table leaves out of its place and view.
+    let position = match (t.has("position"), from_file) {
+        (false, Some(c)) => c.position,
+        _ => t.req_vec3("position")?,
+    };
     let forward = match (t.vec3("look_at")?, t.vec3("direction")?) {
         (Some(_), Some(_)) => {
             return Err(t.error("direction", "give either look_at or direction, not both"))
         }
         (Some(p), None) => p - position,
         (None, Some(d)) => d,
+        (None, None) if from_file.is_some() => from_file.expect("matched").forward,
         (None, None) => {
             return Err(t.error(
                 "look_at",
@@ -38,7 +46,10 @@ pub(super) fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
         ));
     }
     let forward = forward.normalize();
-    let up_in = t.vec3("up")?.unwrap_or(DVec3::Z);
+    let up_in = t
+        .vec3("up")?
+        .or(from_file.map(|c| c.up))
+        .unwrap_or(DVec3::Z);
     let right = forward.cross(up_in);
     if right.length() < 1e-9 * up_in.length().max(1e-300) || up_in.length() == 0.0 {
         return Err(t.error(
@@ -52,7 +63,7 @@ pub(super) fn camera(t: &Table) -> SceneResult<(Camera, Option<Light>)> {
     // with --set and keep its file valid.
     let fov_y = t.f64_where(
         "fov_y",
-        Some(40.0),
+        Some(from_file.map_or(40.0, |c| c.fov_y.to_degrees())),
         |v| (super::envelope::MIN_FOV_DEG..180.0).contains(&v),
         "at least 1e-6 and below 180 degrees",
     )?;

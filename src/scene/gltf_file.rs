@@ -431,10 +431,8 @@ fn translations(
                 )
                 .into());
             }
-            if out
-                .insert(node.index(), times.into_iter().zip(values).collect())
-                .is_some()
-            {
+            let keys = thinned(times.into_iter().zip(values).collect());
+            if out.insert(node.index(), keys).is_some() {
                 return Err(format!("{} is the node's second translation", what()).into());
             }
         }
@@ -445,6 +443,33 @@ fn translations(
         );
     }
     Ok(out)
+}
+
+/// `keys` without those that lie on the uniform motion between the keys kept around them (to
+/// a millionth of its displacement): an exporter that samples every frame (Blender's) writes a
+/// straight motion as one key a frame, each rounded to f32, which would otherwise be as many
+/// segments of velocities a part in 10^7 apart. What is left moves through every key given.
+fn thinned(keys: Vec<(f64, DVec3)>) -> Vec<(f64, DVec3)> {
+    let on_line = |a: (f64, DVec3), c: (f64, DVec3), b: (f64, DVec3)| {
+        let at = a.1 + (c.1 - a.1) * ((b.0 - a.0) / (c.0 - a.0));
+        let tolerance = 1e-6
+            * (c.1 - a.1)
+                .length()
+                .max(1e-9 * (a.1.length() + c.1.length()));
+        (b.1 - at).length() <= tolerance
+    };
+    let mut out = vec![keys[0]];
+    let mut from = 0;
+    for j in 2..keys.len() {
+        if !(from + 1..j).all(|i| on_line(keys[from], keys[j], keys[i])) {
+            from = j - 1;
+            out.push(keys[from]);
+        }
+    }
+    if keys.len() > 1 {
+        out.push(keys[keys.len() - 1]);
+    }
+    out
 }
 
 /// Reading the node tree.
@@ -778,6 +803,32 @@ mod tests {
         assert_eq!(translation_at(&k, 0.0), DVec3::X);
         assert_eq!(translation_at(&k, 2.0), DVec3::new(2.0, 1.0, 0.0));
         assert_eq!(translation_at(&k, 9.0), DVec3::new(3.0, 2.0, 0.0));
+    }
+
+    #[test]
+    fn keys_on_a_straight_motion_are_one_segment() {
+        // A baked motion: a key a frame, rounded to f32, then a stop and a turn.
+        let mut keys: Vec<(f64, DVec3)> = (1..=49)
+            .map(|f| {
+                let t = f64::from(f as f32 / 24.0);
+                (t, DVec3::new(f64::from((f - 1) as f32 / 24.0), -1.5, -10.0))
+            })
+            .collect();
+        keys.push((3.0, keys[48].1));
+        keys.push((4.0, keys[48].1 + DVec3::Y));
+        let kept = thinned(keys.clone());
+        assert_eq!(kept, vec![keys[0], keys[48], keys[49], keys[50]]);
+        // A curve keeps its keys.
+        let curve: Vec<(f64, DVec3)> = (0..10)
+            .map(|i| {
+                (
+                    f64::from(i),
+                    DVec3::new(f64::from(i), f64::from(i * i), 0.0),
+                )
+            })
+            .collect();
+        assert_eq!(thinned(curve.clone()), curve);
+        assert_eq!(thinned(vec![curve[0]]), vec![curve[0]]);
     }
 
     #[test]

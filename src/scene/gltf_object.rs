@@ -18,6 +18,9 @@ use glam::DVec3;
 use std::collections::HashMap;
 use std::sync::Arc;
 
+/// The luminous efficacy by which a glTF light's candela become the scene's radiant intensity.
+pub(super) const LUMENS_PER_WATT: f64 = 683.0;
+
 /// What the glTF objects of a scene bring beside their triangles: gathered while the groups
 /// are read, used once they are.
 #[derive(Default)]
@@ -124,7 +127,9 @@ pub(super) fn place(
         }
         imports.lights.push(Light {
             position: place_point(l.position),
-            radiance: Colour::rgb(l.color, Role::Emitter).scaled(l.intensity),
+            // Candela (lm/sr) as radiant intensity (W/sr) at 683 lm/W: how Blender's
+            // exporter turns its watts into candela, undone.
+            radiance: Colour::rgb(l.color, Role::Emitter).scaled(l.intensity / LUMENS_PER_WATT),
             velocity: if moving {
                 Velocity::ZERO
             } else {
@@ -211,10 +216,15 @@ pub(super) fn place(
     Ok(Placed { stays, own, chosen })
 }
 
-/// The camera a scene without `[camera]` takes from its glTF files: the one an entry named,
-/// else the first.
+/// The camera the scene's glTF files offer: the one an entry named, else the first.
+pub(super) fn file_camera(imports: &Imports) -> Option<&CameraView> {
+    imports.chosen_camera.as_ref().or(imports.cameras.first())
+}
+
+/// The camera a scene without `[camera]` takes from its glTF files ([`file_camera`]), at rest at
+/// time 0.
 pub(super) fn camera(imports: &Imports) -> Option<super::Camera> {
-    let c = imports.chosen_camera.as_ref().or(imports.cameras.first())?;
+    let c = file_camera(imports)?;
     let forward = c.forward.normalize_or_zero();
     let right = forward.cross(c.up).normalize_or_zero();
     if forward == DVec3::ZERO

@@ -221,7 +221,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     }
     // The camera: the scene's own, else a glTF file's.
     let (camera, flash) = match root.table("camera")? {
-        Some(t) => camera(&t)?,
+        Some(t) => camera(&t, gltf_object::file_camera(&imports))?,
         None => match gltf_object::camera(&imports) {
             Some(c) => (c, None),
             None => {

@@ -324,7 +324,8 @@ fn materials_lights_and_cameras_map_as_documented() {
         rest_embree::scene::Projection::Pinhole { fov_y } => assert!((fov_y - 0.5).abs() < 1e-7),
         ref p => panic!("{p:?}"),
     }
-    // The light: at its node, colour times candela, falling off as 1/r², resting in the group.
+    // The light: at its node, colour times candela / 683 lm/W, falling off as 1/r², resting in
+    // the group.
     let l = scene.lights.last().unwrap();
     assert_eq!(l.position, DVec3::new(1.0, 2.0, 3.0));
     assert!(l.inverse_square && (l.velocity.beta() - 0.5).abs() < 1e-15);
@@ -332,7 +333,7 @@ fn materials_lights_and_cameras_map_as_documented() {
         DVec3::new(1.0, 0.5, 0.25),
         rest_embree::spectrum::Role::Emitter,
     )
-    .scaled(8.0);
+    .scaled(8.0 / 683.0);
     assert_eq!(l.radiance, want);
     // The material: its own, as the table in the docs maps it.
     let m = scene
