@@ -22,7 +22,9 @@ demo: setup
 # The formatting and the lints (the library alone and the whole program), then every test,
 # optimised, without the Embree backend and with it; then a real one-node SLURM
 # cluster runs a film and a tiled still through `rest-embree farm slurm` (scripts/slurm-test.sh;
-# it needs root, and says so when skipped). `--release` builds the tests in target/release
+# it needs root, and says so when skipped). The Python package's tests follow (pytest, and the
+# example notebook; its virtual environment is filled in the background meanwhile).
+# `--release` builds the tests in target/release
 # beside `make demo`'s binary, on the same optimised dependencies: one optimised build of
 # everything, not a second one in target/debug with full debug info. The build without Embree
 # goes first, so the binary left in target/release is the one with it. Blender 5 (bpy, from
@@ -31,13 +33,16 @@ demo: setup
 # the viewer's page: a slider moved, a frame awaited, a pixel clicked (scripts/browser-test.sh).
 test: setup
 	@mkdir -p target && (scripts/blender-test.sh --install >target/bpy-install.log 2>&1 &)
+	@(scripts/python-test.sh --prepare >target/pyenv-install.log 2>&1 &)
 	@# The code as the house keeps it: formatted, and no lint in the library alone (no Embree,
 	@# no command line: what a program that links it builds) or in the whole program.
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --release --no-default-features --all-targets -- -D warnings
 	$(CARGO) clippy --release --all-targets -- -D warnings
 	$(CARGO) clippy --release -p rest-embree-python -- -D warnings
-	$(CARGO) test --release --no-default-features --features cli
+	@# Without Embree, the library's own tests (internals, and the build's one backend, the
+	@# BVH); the integration suite runs once, below, on every backend of the full build.
+	$(CARGO) test --release --no-default-features --features cli --lib
 	$(CARGO) test --release --workspace
 	@# The backend's conformance suite (grazing packets against single rays, analytic hits)
 	@# and the meshes' (held meshes are Embree triangle geometries) again under each of
@@ -46,7 +51,7 @@ test: setup
 	@for isa in sse2 sse4.2 avx avx2 avx512; do \
 	  if REST_EMBREE_ISA=$$isa ./target/release/rest-embree backends >/dev/null 2>&1; then \
 	    echo "conformance under REST_EMBREE_ISA=$$isa"; \
-	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test suite -q -- backend_conformance:: meshes:: radar:: worldline:: shutter:: spin:: acceleration:: wigner_rotation:: turning:: || exit 1; \
+	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test suite -q -- backend_conformance:: meshes:: gltf::a_ radar:: worldline:: shutter:: spin:: acceleration:: wigner_rotation:: turning:: || exit 1; \
 	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test suite -q -- path::the_lanes_change_no_picture || exit 1; \
 	  fi; \
 	done

@@ -24,7 +24,7 @@ install() {
     if ! python3 -m pip --version >/dev/null 2>&1; then
         echo "blender-test: installing python3-pip" >&2
         if [ "$(id -u)" = 0 ]; then sudo=(); else sudo=(sudo); fi
-        DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -q python3-pip >/dev/null
+        DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get -o DPkg::Lock::Timeout=600 install -y -q python3-pip >/dev/null
     fi
     echo "blender-test: installing bpy 5 (Blender as a Python module) into $site" >&2
     python3 -m pip install -q --disable-pip-version-check --root-user-action=ignore --target "$site" 'bpy>=5,<6' \

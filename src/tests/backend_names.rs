@@ -38,3 +38,21 @@ fn every_backend_name_is_listed_everywhere() {
         );
     }
 }
+
+/// A build without Embree says so when asked for it, and how to get it (the command line
+/// prefixes the flag: the suite checks that in builds with Embree's absence too).
+#[cfg(not(feature = "embree"))]
+#[test]
+fn a_build_without_embree_says_how_to_get_it() {
+    for name in ["embree", "embree-16", "embree-single"] {
+        let why = crate::accel::backend_by_name(name)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            why.contains("not in this build") && why.contains("--features embree"),
+            "{name}: {why}"
+        );
+    }
+    assert_eq!(crate::accel::backend_names(), vec!["bvh"]);
+}
