@@ -47,6 +47,41 @@ pub fn run_command_line() -> std::process::ExitCode {
 }
 pub use render::{render, RenderOptions};
 
+/// Serve the viewer (`rest-embree view`, docs/viewer.md) on the scene `scene` (its text `text`
+/// when given, else the file), with `--set` `overrides`, on 127.0.0.1:`port` (0: a free one),
+/// until [`stop_viewer`]; its URL with the token is sent on `tell_url` once it listens. What the
+/// Python package's `view` runs on a thread of its own.
+#[doc(hidden)]
+#[cfg(feature = "cli")]
+pub fn serve_viewer(
+    scene: std::path::PathBuf,
+    text: Option<String>,
+    overrides: Vec<(String, String)>,
+    port: u16,
+    backend: &str,
+    tell_url: std::sync::mpsc::Sender<String>,
+) -> Result<()> {
+    view::run(&view::Config {
+        scene,
+        text,
+        overrides,
+        tell_url: Some(tell_url),
+        bind: std::net::IpAddr::V4(std::net::Ipv4Addr::LOCALHOST),
+        port,
+        backend: backend.to_string(),
+        out: std::path::PathBuf::from("."),
+        allow_hosts: Vec::new(),
+        open_browser: false,
+    })
+}
+
+/// Stop the viewer [`serve_viewer`] runs; false if none runs.
+#[doc(hidden)]
+#[cfg(feature = "cli")]
+pub fn stop_viewer() -> bool {
+    view::interrupt()
+}
+
 // The helpers shared with tests/ name the crate `rest_embree`, as the integration tests do.
 #[cfg(test)]
 extern crate self as rest_embree;

@@ -32,7 +32,8 @@ from . import _native
 
 __version__: str = _native.__version__
 
-__all__ = ["Scene", "Image", "render", "film", "probe", "read_exr", "backends", "to_toml"]
+__all__ = ["Scene", "Image", "Viewer", "render", "film", "probe", "view", "read_exr", "backends",
+           "to_toml"]
 
 
 def backends() -> list:
@@ -58,8 +59,8 @@ def _literal(v: Any) -> str:
             return "inf" if v > 0 else "-inf"
         return repr(v)
     if isinstance(v, str):
-        # TOML's basic strings take JSON's escapes.
-        return json.dumps(v, ensure_ascii=False)
+        # TOML's basic strings take JSON's escapes; DEL, which JSON leaves as it is, too.
+        return json.dumps(v, ensure_ascii=False).replace("\x7f", "\\u007f")
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_literal(x) for x in v) + "]"
     if isinstance(v, dict):
@@ -70,7 +71,8 @@ def _literal(v: Any) -> str:
 def _key(k: Any) -> str:
     if not isinstance(k, str):
         raise TypeError(f"scene keys are strings, not {type(k).__name__} {k!r}")
-    bare = k and all(c.isalnum() or c in "_-" for c in k)
+    # TOML's bare keys are ASCII letters, digits, _ and -.
+    bare = k and all((c.isascii() and c.isalnum()) or c in "_-" for c in k)
     return k if bare else json.dumps(k)
 
 
@@ -226,8 +228,9 @@ class Image:
     (``"lookback.V"``, ``"N.X"``). ``image.facts`` says what it ran on and how long it took.
     In a notebook it shows itself."""
 
-    def __init__(self, native, scene: "Scene | _native.Scene"):
+    def __init__(self, native, scene: "Scene | _native.Scene", passes: bool = True):
         self._native = native
+        self.passes: bool = passes
         self.width: int = native.width
         self.height: int = native.height
         self.facts: dict = dict(native.facts())
@@ -347,15 +350,17 @@ def render(
                          "image.samples": samples, "render.seed": seed,
                          "image.transparent": transparent})
     native = _native.render(s._native, backend, threads, passes, _progress_callback(progress))
-    return Image(native, s)
+    return Image(native, s, passes)
 
 
 def film(scene: Scene, **kwargs) -> Iterator[tuple]:
     """The frames of the scene's ``[film]``, rendered one by one: yields (view time, Image).
     Takes :func:`render`'s keywords."""
-    width, height, samples, seed = (kwargs.pop(k, None) for k in ("width", "height", "samples", "seed"))
+    width, height, samples, seed, transparent = (
+        kwargs.pop(k, None) for k in ("width", "height", "samples", "seed", "transparent"))
     s = _with(scene, **{"image.width": width, "image.height": height,
-                         "image.samples": samples, "render.seed": seed})
+                         "image.samples": samples, "render.seed": seed,
+                         "image.transparent": transparent})
     n = s.frame_count
     if n == 0:
         raise ValueError("the scene has no [film] (give it start, end and fps or step)")
@@ -368,7 +373,7 @@ def film(scene: Scene, **kwargs) -> Iterator[tuple]:
     for k in range(n):
         frame = s._native.film_frame(k)
         native = _native.render(frame, backend, threads, passes, _progress_callback(progress))
-        yield frame.time, Image(native, frame)
+        yield frame.time, Image(native, frame, passes)
 
 
 def probe(scene: Scene, x: int, y: int, image: Optional[Image] = None, **kwargs) -> dict:
@@ -377,6 +382,8 @@ def probe(scene: Scene, x: int, y: int, image: Optional[Image] = None, **kwargs)
     and the point on the object in its rest frame. Renders the scene (with :func:`render`'s
     keywords) unless ``image`` is given."""
     img = image if image is not None else render(scene, **kwargs)
+    if not img.passes:
+        raise ValueError("the image was rendered with passes=False: it has no ids or lookback to probe")
     if not (0 <= x < img.width and 0 <= y < img.height):
         raise ValueError(f"pixel ({x}, {y}) is outside the {img.width}x{img.height} image")
     oid = int(img["object_id"][y, x])
@@ -398,6 +405,37 @@ def probe(scene: Scene, x: int, y: int, image: Optional[Image] = None, **kwargs)
         "depth": float(img["depth"][y, x]),
         "rest_position": img["rest_position"][y, x].tolist(),
     }
+
+
+class Viewer:
+    """The viewer (``rest-embree view``, docs/viewer.md) serving a scene from this process: its
+    page is at ``url`` (token included; without it the server answers nothing). In a notebook
+    it shows itself in an IFrame. ``stop()`` ends it; one runs at a time."""
+
+    def __init__(self, url: str):
+        self.url = url
+
+    def stop(self) -> None:
+        """Stop serving (renders in flight are cancelled)."""
+        _native.view_stop()
+
+    def _repr_html_(self) -> str:
+        import html
+
+        src = html.escape(self.url, quote=True)
+        return f'<iframe src="{src}" width="100%" height="720" style="border: 0"></iframe>'
+
+    def __repr__(self) -> str:
+        return f"<rest_embree.Viewer at {self.url}>"
+
+
+def view(scene: Scene, port: int = 0, backend: Optional[str] = None) -> Viewer:
+    """Serve ``scene`` (with its ``set`` overrides) in the viewer on 127.0.0.1:``port`` (0: a
+    free one) from a thread of this process, and return the :class:`Viewer`; in Jupyter the
+    returned object shows the page. Its saved views and renders go to the current folder."""
+    if not isinstance(scene, Scene):
+        raise TypeError(f"view takes a Scene, not {type(scene).__name__}")
+    return Viewer(_native.view_start(scene._path, scene._text, scene._sets, port, backend))
 
 
 def read_exr(path: "os.PathLike | str") -> dict:

@@ -372,6 +372,98 @@ fn read_exr<'py>(
     Ok((w, h, d))
 }
 
+/// The viewer [`view_start`] runs, on a thread of its own. Its lock is never held while the
+/// GIL is released (another Python thread holding the GIL would wait on it for ever).
+static VIEWER: std::sync::Mutex<Option<std::thread::JoinHandle<rest_embree::Result<()>>>> =
+    std::sync::Mutex::new(None);
+/// Whether a start is under way (between its check and its hand-over of the thread).
+static STARTING: AtomicBool = AtomicBool::new(false);
+
+fn viewer_slot() -> PyResult<
+    std::sync::MutexGuard<'static, Option<std::thread::JoinHandle<rest_embree::Result<()>>>>,
+> {
+    VIEWER
+        .lock()
+        .map_err(|_| PyRuntimeError::new_err("the viewer's state was poisoned"))
+}
+
+/// Start the viewer on the scene (its file `path`, or its `text` named so) with `overrides`, on
+/// 127.0.0.1:`port` (0: a free one); its URL with the token once it listens. One at a time.
+#[pyfunction]
+#[pyo3(signature = (path, text, overrides, port=0, backend=None))]
+fn view_start(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+    text: Option<String>,
+    overrides: Vec<(String, String)>,
+    port: u16,
+    backend: Option<String>,
+) -> PyResult<String> {
+    let busy = || {
+        PyRuntimeError::new_err(
+            "a viewer runs already in this process: stop it first (its .stop())",
+        )
+    };
+    if viewer_slot()?.as_ref().is_some_and(|h| !h.is_finished())
+        || STARTING.swap(true, Ordering::SeqCst)
+    {
+        return Err(busy());
+    }
+    let backend = backend.unwrap_or_else(|| rest_embree::accel::default_backend_name().into());
+    let (tx, rx) = std::sync::mpsc::channel();
+    let spawned = std::thread::Builder::new()
+        .name("rest-embree viewer".into())
+        .spawn(move || rest_embree::serve_viewer(path, text, overrides, port, &backend, tx));
+    let handle = match spawned {
+        Ok(h) => h,
+        Err(e) => {
+            STARTING.store(false, Ordering::SeqCst);
+            return Err(PyRuntimeError::new_err(format!(
+                "cannot start the viewer: {e}"
+            )));
+        }
+    };
+    let url = py.allow_threads(move || rx.recv_timeout(Duration::from_secs(120)));
+    let outcome = match url {
+        Ok(url) => {
+            *viewer_slot()? = Some(handle);
+            Ok(url)
+        }
+        Err(wait) => {
+            // It never said it listens: stopped with an error, or still loading (then stop it).
+            if matches!(wait, std::sync::mpsc::RecvTimeoutError::Timeout) {
+                rest_embree::stop_viewer();
+            }
+            let joined = py.allow_threads(|| handle.join());
+            match joined {
+                Ok(Err(e)) => Err(py_err(e)),
+                Ok(Ok(())) => Err(PyRuntimeError::new_err(
+                    "the viewer stopped before it listened (it took more than 120 s to start)",
+                )),
+                Err(_) => Err(PyRuntimeError::new_err(
+                    "the viewer panicked (a bug: please report it)",
+                )),
+            }
+        }
+    };
+    STARTING.store(false, Ordering::SeqCst);
+    outcome
+}
+
+/// Stop the viewer [`view_start`] started (nothing if none runs).
+#[pyfunction]
+fn view_stop(py: Python<'_>) -> PyResult<()> {
+    let handle = viewer_slot()?.take();
+    let Some(handle) = handle else { return Ok(()) };
+    rest_embree::stop_viewer();
+    match py.allow_threads(|| handle.join()) {
+        Ok(result) => result.map_err(py_err),
+        Err(_) => Err(PyRuntimeError::new_err(
+            "the viewer panicked (a bug: please report it)",
+        )),
+    }
+}
+
 /// The backends this build has, the default first.
 #[pyfunction]
 fn backends() -> Vec<&'static str> {
@@ -388,5 +480,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(backends, m)?)?;
+    m.add_function(wrap_pyfunction!(view_start, m)?)?;
+    m.add_function(wrap_pyfunction!(view_stop, m)?)?;
     Ok(())
 }

@@ -206,6 +206,42 @@ def test_a_film_yields_its_frames_and_probe_tells_a_pixel():
         re.probe(scene, 999, 0, image=img)
 
 
+def test_the_viewer_serves_the_scene_with_its_overrides():
+    import json
+    import urllib.error
+    import urllib.request
+    from urllib.parse import parse_qs, urlparse
+
+    scene = re.Scene.load(LATTICE).set("group.lattice.velocity", [-0.5, 0, 0])
+    viewer = re.view(scene)
+    try:
+        u = urlparse(viewer.url)
+        token = parse_qs(u.query)["token"][0]
+        base = f"{u.scheme}://{u.netloc}"
+        assert "<iframe" in viewer._repr_html_() and token in viewer._repr_html_()
+        info = json.load(urllib.request.urlopen(f"{base}/api/scene?token={token}"))
+        text = json.dumps(info)
+        assert "lattice" in text and "0.5" in text, text
+        with pytest.raises(urllib.error.HTTPError) as e:
+            urllib.request.urlopen(f"{base}/api/scene")
+        assert e.value.code == 403
+        with pytest.raises(RuntimeError, match="already"):
+            re.view(scene)
+    finally:
+        viewer.stop()
+    # Stopped, another starts: a scene given as a dict (its text served, named scene.toml).
+    again = re.view(re.Scene.from_dict(CUBE))
+    try:
+        u = urlparse(again.url)
+        token = parse_qs(u.query)["token"][0]
+        info = json.load(urllib.request.urlopen(f"{u.scheme}://{u.netloc}/api/scene?token={token}"))
+        assert "cube" in json.dumps(info)
+    finally:
+        again.stop()
+    # A stop with none running does nothing.
+    again.stop()
+
+
 def test_the_notebook_runs(tmp_path):
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")

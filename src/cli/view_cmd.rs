@@ -29,6 +29,10 @@ pub(crate) struct ViewArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Override a scene value, as `render --set` does (repeatable); the view starts from, and
+    /// saves, the scene with them.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
 }
 
 pub(super) fn run_view(args: &ViewArgs) -> crate::Result<()> {
@@ -39,6 +43,13 @@ pub(super) fn run_view(args: &ViewArgs) -> crate::Result<()> {
         .unwrap_or_else(|| crate::accel::default_backend_name().to_string());
     crate::view::run(&crate::view::Config {
         scene: args.scene.clone(),
+        text: None,
+        overrides: args
+            .set
+            .iter()
+            .map(|s| (format!("--set {s}"), s.clone()))
+            .collect(),
+        tell_url: None,
         bind: args.bind,
         port: args.port,
         backend,

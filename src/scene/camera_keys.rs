@@ -15,10 +15,12 @@ pub(super) fn camera(
     t: &Table,
     from_file: Option<&super::gltf_file::CameraView>,
 ) -> SceneResult<(Camera, Option<Light>)> {
-    // A glTF file's camera gives what the table leaves out of its place and view.
-    let position = match (t.has("position"), from_file) {
-        (false, Some(c)) => c.position,
-        _ => t.req_vec3("position")?,
+    // A table without a position takes the glTF file's camera: its place, view, up and field
+    // of view, each unless the table gives it.
+    let from_file = from_file.filter(|_| !t.has("position"));
+    let position = match from_file {
+        Some(c) => c.position,
+        None => t.req_vec3("position")?,
     };
     let forward = match (t.vec3("look_at")?, t.vec3("direction")?) {
         (Some(_), Some(_)) => {

@@ -108,6 +108,11 @@ pub(crate) struct CameraView {
 /// then positions, indices and corner data in f64), for the check before reading.
 pub(crate) const BYTES_PER_FILE_BYTE: u64 = 24;
 
+/// Bytes a placed vertex and triangle take as read (position, corner normals and texture
+/// coordinates, indices, material), for the running check against the memory limit.
+const BYTES_PER_VERTEX: u64 = 24 + 12 + 8;
+const BYTES_PER_TRIANGLE: u64 = 12 + 72 + 48 + 4;
+
 /// Deepest node hierarchy taken (a guard for the recursion; real files are a few levels).
 const MAX_DEPTH: usize = 256;
 
@@ -156,6 +161,7 @@ pub(crate) fn read(path: &Path) -> Result<GltfData, GltfError> {
     let keys = translations(&gltf, &buffers, &mut warnings)?;
     let mut reading = Reading {
         buffers: &buffers,
+        held: 0,
         seen: vec![false; gltf.nodes().len()],
         lights: Vec::new(),
         cameras: Vec::new(),
@@ -217,10 +223,84 @@ fn parse(bytes: &[u8]) -> Result<gltf::Gltf, GltfError> {
         }
     }
     let document = gltf::Document::from_json(raw.document.into_json()).map_err(unread)?;
+    checked_beyond_validation(document.as_json())?;
     Ok(gltf::Gltf {
         document,
         blob: raw.blob,
     })
+}
+
+/// What the crate's readers unwrap or call unreachable on and its validation lets through:
+/// an image without its MIME type or URI, a camera without the projection its type names, and
+/// accessors of a kind a primitive's indices, positions, normals or texture coordinates cannot
+/// be (FLOAT indices, say), or of no elements.
+fn checked_beyond_validation(root: &gltf::json::Root) -> Result<(), GltfError> {
+    use gltf::json::accessor::{ComponentType as C, Type as T};
+    use gltf::json::mesh::Semantic;
+    use gltf::json::validation::Checked::Valid;
+    for (i, img) in root.images.iter().enumerate() {
+        let whole = match img.buffer_view {
+            Some(_) => img.mime_type.is_some(),
+            None => img.uri.is_some(),
+        };
+        if !whole {
+            return Err(format!(
+                "image {i} names neither a buffer view with its MIME type nor a URI"
+            )
+            .into());
+        }
+    }
+    for (i, cam) in root.cameras.iter().enumerate() {
+        let whole = match cam.type_ {
+            Valid(gltf::json::camera::Type::Perspective) => cam.perspective.is_some(),
+            Valid(gltf::json::camera::Type::Orthographic) => cam.orthographic.is_some(),
+            _ => false,
+        };
+        if !whole {
+            return Err(format!("camera {i} lacks the projection its type names").into());
+        }
+    }
+    let kind = |a: usize| {
+        let acc = &root.accessors[a];
+        let c = match acc.component_type {
+            Valid(g) => Some(g.0),
+            _ => None,
+        };
+        let t = match acc.type_ {
+            Valid(t) => Some(t),
+            _ => None,
+        };
+        (c, t, acc.count.0)
+    };
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let bad = |what: &str| -> GltfError {
+                format!("mesh {m} primitive {p}: its {what} accessor is of a kind this reader does not take").into()
+            };
+            if let Some(ix) = &prim.indices {
+                match kind(ix.value()) {
+                    (Some(C::U8 | C::U16 | C::U32), Some(T::Scalar), n) if n > 0 => {}
+                    _ => return Err(bad("indices")),
+                }
+            }
+            for (semantic, a) in &prim.attributes {
+                let (c, t, n) = kind(a.value());
+                let fine = match semantic {
+                    Valid(Semantic::Positions | Semantic::Normals) => {
+                        c == Some(C::F32) && t == Some(T::Vec3)
+                    }
+                    Valid(Semantic::TexCoords(0)) => {
+                        matches!(c, Some(C::F32 | C::U8 | C::U16)) && t == Some(T::Vec2)
+                    }
+                    _ => true,
+                };
+                if !fine || n == 0 {
+                    return Err(bad(&format!("{semantic:?}")));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A file's bytes, if it is a regular file within the memory limit.
@@ -475,6 +555,8 @@ fn thinned(keys: Vec<(f64, DVec3)>) -> Vec<(f64, DVec3)> {
 /// Reading the node tree.
 struct Reading<'a> {
     buffers: &'a [Vec<u8>],
+    /// Bytes the placed triangles take so far.
+    held: u64,
     /// Nodes already placed: a node reached twice is refused (the nodes of a scene are a tree).
     seen: Vec<bool>,
     lights: Vec<PointLight>,
@@ -512,6 +594,17 @@ impl Reading<'_> {
         let origin = world.transform_point3(DVec3::ZERO);
         if let Some(light) = node.light() {
             match light.kind() {
+                gltf::khr_lights_punctual::Kind::Point
+                    if !(light.intensity().is_finite()
+                        && light.intensity() >= 0.0
+                        && light.color().iter().all(|c| c.is_finite() && *c >= 0.0)) =>
+                {
+                    return Err(format!(
+                        "light {}'s colour or intensity is not a finite number of 0 or more",
+                        light.index()
+                    )
+                    .into())
+                }
                 gltf::khr_lights_punctual::Kind::Point => self.lights.push(PointLight {
                     top,
                     position: origin,
@@ -526,6 +619,17 @@ impl Reading<'_> {
         }
         if let Some(cam) = node.camera() {
             match cam.projection() {
+                gltf::camera::Projection::Perspective(p)
+                    if !(f64::from(p.yfov()) > 0.0
+                        && f64::from(p.yfov()) < std::f64::consts::PI) =>
+                {
+                    return Err(format!(
+                        "camera {}'s yfov {} is not between 0 and π",
+                        cam.index(),
+                        p.yfov()
+                    )
+                    .into())
+                }
                 gltf::camera::Projection::Perspective(p) => {
                     let forward = world.transform_vector3(-DVec3::Z).normalize_or_zero();
                     let up = world.transform_vector3(DVec3::Y).normalize_or_zero();
@@ -588,15 +692,36 @@ impl Reading<'_> {
                 .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))))
                 .collect();
             let n = positions.len();
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..n as u32).collect(),
+            let indices: Vec<u32> = match (reader.read_indices(), prim.indices()) {
+                (Some(i), _) => i.into_u32().collect(),
+                (None, None) => (0..n as u32).collect(),
+                (None, Some(_)) => {
+                    return Err(format!("{}: its indices lie outside their buffer", what()).into())
+                }
             };
+            if !indices.len().is_multiple_of(3) {
+                return Err(format!(
+                    "{}: {} indices, not a whole number of triangles",
+                    what(),
+                    indices.len()
+                )
+                .into());
+            }
             if let Some(&bad) = indices.iter().find(|&&i| i as usize >= n) {
                 return Err(format!("{}: index {bad} is past its {n} vertices", what()).into());
             }
             if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
                 return Err(format!("{}: a vertex is not finite ({p})", what()).into());
+            }
+            let present = |sem: gltf::Semantic| prim.get(&sem).is_some();
+            if (present(gltf::Semantic::Normals) && reader.read_normals().is_none())
+                || (present(gltf::Semantic::TexCoords(0)) && reader.read_tex_coords(0).is_none())
+            {
+                return Err(format!(
+                    "{}: its normals or texture coordinates lie outside their buffer",
+                    what()
+                )
+                .into());
             }
             let normals: Option<Vec<DVec3>> = reader.read_normals().map(|it| {
                 it.map(|v| {
@@ -628,6 +753,14 @@ impl Reading<'_> {
                 .is_some_and(|u| u.iter().any(|c| !c[0].is_finite() || !c[1].is_finite()))
             {
                 return Err(format!("{}: a texture coordinate is not finite", what()).into());
+            }
+            // The file's triangles as placed so far, every placement of a mesh a copy: against
+            // the scene's limits before they are made (a small file can place one big mesh
+            // many times).
+            self.held += (n as u64).saturating_mul(BYTES_PER_VERTEX)
+                + (indices.len() as u64 / 3).saturating_mul(BYTES_PER_TRIANGLE);
+            if let Some(why) = crate::memory::too_much(self.held, "the triangles the file places") {
+                return Err(why.into());
             }
             let material = prim.material().index().map_or(NO_MATERIAL, |i| i as u32);
             let offset = mesh.positions.len() as u32;

@@ -59,6 +59,7 @@ pub(super) fn place(
     t: &Table,
     group_velocity: Velocity,
     group_moves: bool,
+    on_worldline: bool,
     materials: &mut Vec<Material>,
     ids: &HashMap<String, u32>,
     imports: &mut Imports,
@@ -117,6 +118,12 @@ pub(super) fn place(
     let animated: Vec<usize> = (0..nodes.len())
         .filter(|&i| nodes[i].keys.is_some())
         .collect();
+    if on_worldline && !lights.is_empty() {
+        return Err(t.error(
+            "file",
+            format!("{shown} has point lights and the group a worldline: a light resting in a group whose velocity changes is not built yet (as for a [[light]] with `group`)"),
+        ));
+    }
     for l in lights {
         let moving = nodes[l.top].keys.is_some();
         if moving {

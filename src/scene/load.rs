@@ -205,13 +205,13 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
             &mut total,
             &mut imports,
         )?;
-        // A glTF node's own group, named `<group>/<node>`: its name once among the groups.
-        let mut own: Vec<&str> = g
+        // A glTF node's own group, named `<group>/<node>`: its name once among the groups (a
+        // group of several worldline pieces names each piece so).
+        let own: std::collections::BTreeSet<&str> = g
             .iter()
             .map(|x| x.name.as_str())
             .filter(|n| *n != name)
             .collect();
-        own.dedup();
         for n in own {
             if !group_names.insert(n.to_string()) {
                 return Err(t.error("object", format!("two groups are named `{n}` (a glTF file's nodes of one name, or a [[group]] named so)")));
@@ -339,7 +339,9 @@ fn group(
             geometry.parts.len(),
         );
         let kind = if o.string("type")? == Some("gltf") {
-            let placed = gltf_object::place(o, velocity, moves, materials, material_ids, imports)?;
+            let line = segments.is_some();
+            let placed =
+                gltf_object::place(o, velocity, moves, line, materials, material_ids, imports)?;
             let (mat, place) = material_and_transform(o, material_ids)?;
             if let Some(mesh) = placed.stays {
                 let (geo, chosen) = (&mut geometry, placed.chosen.clone());
@@ -385,9 +387,16 @@ fn group(
         materials,
         total,
     )?;
+    let mut own_names = std::collections::HashSet::new();
     for (k, own, chosen, mat, place) in own_groups {
         let o = &entries[k];
         for g in own {
+            if !own_names.insert(g.node.clone()) {
+                return Err(o.error(
+                    "file",
+                    format!("two top-level nodes are named `{}`: each is a group of its own, `{name}/{}`, and groups need names of their own (rename one in the file)", g.node, g.node),
+                ));
+            }
             let id = objects.len() as u32;
             let mut geometry = Geometry::default();
             let (geo, chosen) = (&mut geometry, chosen.clone());

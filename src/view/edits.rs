@@ -295,6 +295,82 @@ fn table_in<'a>(doc: &'a mut DocumentMut, name: &str) -> &'a mut Table {
     item.as_table_mut().expect("made a table")
 }
 
+/// The scene text with `--set` overrides written into it (comments and layout kept), so that
+/// the viewer serves, and a saved view holds, the scene the overrides make. Each is checked by
+/// the scene loader first (its errors are the command line's); then written where the loader
+/// puts it: a table of the path made if missing, an entry of an array of tables found by its
+/// `name` or its index, the keys the value replaces (`superseded`) removed.
+pub(crate) fn with_overrides(
+    text: &str,
+    source: &str,
+    overrides: &[(String, String)],
+) -> crate::Result<String> {
+    if overrides.is_empty() {
+        return Ok(text.to_string());
+    }
+    crate::scene::load_str(source, text, overrides)?;
+    let mut doc: DocumentMut = text
+        .parse()
+        .map_err(|e| refuse!("{source} is not TOML the viewer can edit: {e}"))?;
+    for (shown, assignment) in overrides {
+        let (key, raw) = assignment
+            .split_once('=')
+            .ok_or_else(|| refuse!("{shown}: expected KEY=VALUE"))?;
+        let raw = raw.trim();
+        // As the loader takes a `--set` value: TOML, or a bare word as a string.
+        let value: toml_edit::Value = raw
+            .parse()
+            .unwrap_or_else(|_| toml_edit::Value::from(raw.to_string()));
+        let segs: Vec<&str> = key.trim().split('.').collect();
+        let lost = || refuse!("{shown}: the file has no place for `{}`", key.trim());
+        let mut table: &mut dyn toml_edit::TableLike = doc.as_table_mut();
+        let mut i = 0;
+        while i + 1 < segs.len() {
+            let item = table.entry(segs[i]).or_insert(Item::Table(Table::new()));
+            // An entry of an array of tables: the next segment is its name or index.
+            let pick = |names: Vec<Option<&str>>| {
+                let sel = segs[i + 1];
+                names
+                    .iter()
+                    .position(|n| *n == Some(sel))
+                    .or_else(|| sel.parse::<usize>().ok().filter(|&j| j < names.len()))
+            };
+            table = match item {
+                Item::ArrayOfTables(entries) => {
+                    let names = entries.iter().map(|t| t.get("name").and_then(Item::as_str));
+                    let j = pick(names.collect()).ok_or_else(lost)?;
+                    i += 2;
+                    entries.get_mut(j).ok_or_else(lost)?
+                }
+                Item::Value(toml_edit::Value::Array(entries)) => {
+                    let names = entries.iter().map(|v| {
+                        v.as_inline_table()
+                            .and_then(|t| t.get("name"))
+                            .and_then(|n| n.as_str())
+                    });
+                    let j = pick(names.collect()).ok_or_else(lost)?;
+                    i += 2;
+                    entries
+                        .get_mut(j)
+                        .and_then(|v| v.as_inline_table_mut())
+                        .map(|t| t as &mut dyn toml_edit::TableLike)
+                        .ok_or_else(lost)?
+                }
+                other => {
+                    i += 1;
+                    other.as_table_like_mut().ok_or_else(lost)?
+                }
+            };
+        }
+        let last = *segs.last().ok_or_else(lost)?;
+        for gone in crate::scene::superseded(&segs[..segs.len() - 1], last) {
+            table.remove(gone);
+        }
+        table.insert(last, Item::Value(value));
+    }
+    Ok(doc.to_string())
+}
+
 /// The `[[group]]` named `name`.
 fn group_in<'a>(doc: &'a mut DocumentMut, name: &str) -> crate::Result<&'a mut Table> {
     doc.get_mut("group")
@@ -320,6 +396,44 @@ mod tests {
     }
 
     const TEXT: &str = "# top\n[camera]\nposition = [0, 0, 0]\nlook_at = [1, 0, 0] # aim\nfov_y = 60\n\n[[group]]\nname = \"lattice\"\ndirection = [1, 0, 0]\nbeta = 0.5\n[[group.object]]\ntype = \"sphere\"\n\n[film]\nframes = 3\n";
+
+    #[test]
+    fn overrides_are_written_where_the_loader_puts_them() {
+        let sets = |list: &[&str]| -> Vec<(String, String)> {
+            list.iter()
+                .map(|s| (format!("--set {s}"), s.to_string()))
+                .collect()
+        };
+        let over = sets(&[
+            "group.lattice.velocity=[-0.9, 0, 0]",
+            "group.lattice.object.0.radius=2",
+            "image.width=64",
+            "camera.projection=orthographic",
+            "camera.view_height=3",
+        ]);
+        const SCENE: &str = "# top\n[camera]\nposition = [0, 0, 0]\nlook_at = [10, 0, 0] # aim\n\n[[group]]\nname = \"lattice\"\ndirection = [1, 0, 0]\nbeta = 0.5\n[[group.object]]\ntype = \"sphere\"\ncenter = [10, 0, 0]\nradius = 1\n";
+        let text = with_overrides(SCENE, "v.toml", &over).unwrap();
+        // The text loads as the file with the overrides does, and keeps its comments.
+        let a = crate::scene::load_str("v.toml", SCENE, &over).unwrap();
+        let b = crate::scene::load_str("v.toml", &text, &[]).unwrap();
+        assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        assert!(
+            text.contains("# aim") && !text.contains("beta = 0.5"),
+            "{text}"
+        );
+        // A refused override is the loader's error, and nothing is written.
+        let why = with_overrides(
+            SCENE,
+            "v.toml",
+            &sets(&["group.nothing.velocity=[0.1, 0, 0]"]),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            why.contains("--set group.nothing") && why.contains("nothing"),
+            "{why}"
+        );
+    }
 
     #[test]
     fn edits_replace_the_other_ways_of_giving_a_value_and_keep_the_rest() {

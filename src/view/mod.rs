@@ -20,13 +20,20 @@ use std::collections::HashMap;
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// How the viewer is started (`rest-embree view`'s flags).
 #[derive(Clone, Debug)]
 pub(crate) struct Config {
+    /// The scene file (with `text`: the name its text goes by, its folder where its files are).
     pub scene: PathBuf,
+    /// The scene's text when it is given, not read from `scene` (the Python package's).
+    pub text: Option<String>,
+    /// `--set` overrides written into the scene's text before it is served.
+    pub overrides: Vec<(String, String)>,
+    /// Where the page's URL (with its token) is sent once the server listens.
+    pub tell_url: Option<std::sync::mpsc::Sender<String>>,
     pub bind: IpAddr,
     pub port: u16,
     pub backend: String,
@@ -92,17 +99,18 @@ pub(crate) struct Viewer {
     rest: Mutex<Option<(u64, Arc<crate::render::RestGroups>)>>,
 }
 
-/// What stops the running server (Ctrl-C), once it runs.
-static STOP: OnceLock<Arc<tokio::sync::Notify>> = OnceLock::new();
+/// What stops the running server (Ctrl-C, or the Python package's stop), while one runs: each
+/// run has its own, so a stop asked for when none ran leaves no permit for the next.
+static STOP: Mutex<Option<Arc<tokio::sync::Notify>>> = Mutex::new(None);
 
 /// Ctrl-C while a viewer runs: stop serving and let `run` return (true); false if none runs.
 pub(crate) fn interrupt() -> bool {
-    match STOP.get() {
-        Some(stop) => {
+    match STOP.lock().map(|s| s.clone()) {
+        Ok(Some(stop)) => {
             stop.notify_one();
             true
         }
-        None => false,
+        _ => false,
     }
 }
 
@@ -125,15 +133,20 @@ pub(crate) fn run(config: &Config) -> crate::Result<()> {
         .enable_all()
         .build()
         .map_err(|e| crate::Error::flag("view", format!("cannot start the server: {e}")))?;
-    let stop = STOP
-        .get_or_init(|| Arc::new(tokio::sync::Notify::new()))
-        .clone();
+    let stop = Arc::new(tokio::sync::Notify::new());
+    let stop_mine = stop.clone();
+    *STOP
+        .lock()
+        .map_err(|_| crate::Error::invalid("the viewer's stop was poisoned"))? = Some(stop.clone());
     let host = match config.bind {
         IpAddr::V6(a) if !a.is_unspecified() => format!("[{a}]"),
         a if a.is_unspecified() => "127.0.0.1".to_string(),
         a => a.to_string(),
     };
     let url = format!("http://{host}:{port}/?token={}", viewer.access.token());
+    if let Some(tx) = &config.tell_url {
+        let _ = tx.send(url.clone());
+    }
     crate::text::say(format_args!(
         "rest-embree view: {} at\n  {url}",
         config.scene.display()
@@ -148,7 +161,7 @@ pub(crate) fn run(config: &Config) -> crate::Result<()> {
     if config.open_browser {
         open_browser(&url);
     }
-    runtime.block_on(async {
+    let served = runtime.block_on(async {
         match tokio::net::TcpListener::from_std(listener) {
             Ok(l) => {
                 server::serve(l, viewer.clone(), stop).await;
@@ -159,13 +172,25 @@ pub(crate) fn run(config: &Config) -> crate::Result<()> {
                 format!("cannot listen on {addr}: {e}"),
             )),
         }
-    })?;
+    });
+    // This run's stop, not a later run's (a stop asked for from another thread may have let
+    // the next viewer start while this one shuts down).
+    if let Ok(mut s) = STOP.lock() {
+        if s.as_ref().is_some_and(|n| Arc::ptr_eq(n, &stop_mine)) {
+            *s = None;
+        }
+    }
+    served?;
     // Stop every render, and leave no half-written file.
     for c in viewer.clients.lock().expect("not poisoned").values() {
         c.cancel.store(true, Ordering::Relaxed);
     }
     runtime.shutdown_timeout(std::time::Duration::from_secs(1));
-    crate::output::file::remove_partial_files();
+    // The process ends after the command's viewer: no half-written file is left. In the
+    // Python package's process other files may be being written: left to their writers.
+    if config.tell_url.is_none() {
+        crate::output::file::remove_partial_files();
+    }
     crate::text::say("rest-embree view: stopped");
     Ok(())
 }
@@ -212,8 +237,12 @@ impl Viewer {
                 ),
             ));
         }
-        let text = std::fs::read_to_string(&config.scene)
-            .map_err(|e| crate::Error::flag("view", format!("cannot read {source}: {e}")))?;
+        let text = match &config.text {
+            Some(t) => t.clone(),
+            None => std::fs::read_to_string(&config.scene)
+                .map_err(|e| crate::Error::flag("view", format!("cannot read {source}: {e}")))?,
+        };
+        let text = edits::with_overrides(&text, &source, &config.overrides)?;
         Viewer::from_text(
             source,
             text,

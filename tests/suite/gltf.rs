@@ -465,6 +465,45 @@ fn bad_gltf_files_are_clear_errors() {
     }]);
     let err = refused(&d, "step.glb", &step.glb());
     assert!(err.contains("STEP"), "{err}");
+    // What the crate's readers would unwrap or call unreachable on: FLOAT indices, an image in
+    // a buffer view without its MIME type, a camera without the projection its type names.
+    let mut float_ix = Doc::unit_box(nested_nodes());
+    float_ix.json["accessors"][1]["componentType"] = json!(5126);
+    let err = refused(&d, "float.glb", &float_ix.glb());
+    assert!(err.contains("indices") && err.contains("kind"), "{err}");
+    let mut image = Doc::unit_box(nested_nodes());
+    image.json["images"] = json!([{"bufferView": 0}]);
+    let err = refused(&d, "image.glb", &image.glb());
+    assert!(err.contains("image 0"), "{err}");
+    let mut cam = Doc::unit_box(nested_nodes());
+    cam.json["cameras"] = json!([{"type": "perspective", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 1}}]);
+    cam.json["nodes"][0]["camera"] = json!(0);
+    let err = refused(&d, "camera.glb", &cam.glb());
+    assert!(err.contains("camera 0"), "{err}");
+    let mut fov = Doc::unit_box(nested_nodes());
+    fov.json["cameras"] =
+        json!([{"type": "perspective", "perspective": {"yfov": 4.0, "znear": 0.1}}]);
+    fov.json["nodes"][0]["camera"] = json!(0);
+    let err = refused(&d, "fov.glb", &fov.glb());
+    assert!(err.contains("yfov"), "{err}");
+    // Two top-level nodes of one name, each a group of its own: refused, naming it.
+    let mut twins = Doc::unit_box(json!([
+        {"name": "Ship", "translation": [0, 10.5, 0], "mesh": 0},
+        {"name": "Ship", "translation": [2, 10.5, 0], "mesh": 0}
+    ]));
+    twins.json["scenes"][0]["nodes"] = json!([0, 1]);
+    std::fs::write(d.0.join("twins.glb"), twins.glb()).unwrap();
+    let scene = d.file(
+        "twins.toml",
+        &with_object("type = \"gltf\"\nfile = \"twins.glb\"\ngroups = \"nodes\""),
+    );
+    let err = rest_embree::scene::load_file(&scene, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("`Ship`") && err.contains("twins.toml"),
+        "{err}"
+    );
     // Not glTF at all, and a data URI over the memory limit.
     let err = refused(&d, "junk.glb", b"glTF\x02\0\0\0junk");
     assert!(err.contains("not a readable glTF"), "{err}");
@@ -535,7 +574,12 @@ fn mutated_gltf_files_load_or_are_refused() {
             Ok(_) => loaded += 1,
             Err(e) => {
                 let e = e.to_string();
-                assert!(e.contains("fuzz.glb"), "{e}");
+                // The file, or the entry that places it (a valid file placing a vertex beyond
+                // the envelope is the entry's error).
+                assert!(
+                    e.contains("fuzz.glb") || e.contains("group.cube.object.0"),
+                    "{e}"
+                );
                 refused += 1;
             }
         }
