@@ -43,10 +43,11 @@ test: setup
 	@# Without Embree, the library's own tests (internals, and the build's one backend, the
 	@# BVH); the integration suite runs once, below, on every backend of the full build.
 	$(CARGO) test --release --no-default-features --features cli --lib
-	@# The root package's tests (embree-sys has none). Not --workspace: with the Python crate
-	@# among the packages, its dependencies' features unify differently and the ISA loop below
-	@# rebuilt the library and the suite (57 s).
-	$(CARGO) test --release
+	@# Every package's tests, and the one build of the library the steps below share: the ISA
+	@# loop names the workspace too, and the Python package's build finds the library built
+	@# with the same features (naming the root package alone, the Python crate's dependencies
+	@# unify features otherwise, and one or the other rebuilt the library: 40-57 s).
+	$(CARGO) test --release --workspace
 	@# The backend's conformance suite (grazing packets against single rays, analytic hits)
 	@# and the meshes' (held meshes are Embree triangle geometries) again under each of
 	@# Embree's code paths this CPU has: their packet widths and slab tests differ
@@ -54,8 +55,8 @@ test: setup
 	@for isa in sse2 sse4.2 avx avx2 avx512; do \
 	  if REST_EMBREE_ISA=$$isa ./target/release/rest-embree backends >/dev/null 2>&1; then \
 	    echo "conformance under REST_EMBREE_ISA=$$isa"; \
-	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test suite -q -- backend_conformance:: meshes:: gltf::a_ radar:: worldline:: shutter:: spin:: acceleration:: wigner_rotation:: turning:: || exit 1; \
-	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --test suite -q -- path::the_lanes_change_no_picture || exit 1; \
+	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --workspace --test suite -q -- backend_conformance:: meshes:: gltf::a_ radar:: worldline:: shutter:: spin:: acceleration:: wigner_rotation:: turning:: || exit 1; \
+	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --workspace --test suite -q -- path::the_lanes_change_no_picture || exit 1; \
 	  fi; \
 	done
 	scripts/slurm-test.sh target/release/rest-embree
