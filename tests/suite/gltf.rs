@@ -120,6 +120,21 @@ impl Doc {
     }
 }
 
+/// GOOD's box as one node keyed by `keys` (file time, translation), interpolated by
+/// `interpolation`.
+fn keyed_box(keys: &[(f32, [f32; 3])], interpolation: &str) -> Doc {
+    let mut doc = Doc::unit_box(json!([{"name": "box", "translation": [0, 10.5, 0], "mesh": 0}]));
+    let t: Vec<f32> = keys.iter().map(|k| k.0).collect();
+    let p: Vec<f32> = keys.iter().flat_map(|k| k.1).collect();
+    let times = doc.accessor(&t, "SCALAR", keys.len());
+    let values = doc.accessor(&p, "VEC3", keys.len());
+    doc.json["animations"] = json!([{
+        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+        "samplers": [{"input": times, "output": values, "interpolation": interpolation}]
+    }]);
+    doc
+}
+
 /// The box of GOOD placed by two levels of nodes: a parent at (0, 10, 0) scaling by 2, its
 /// child at (0, 0.25, 0) scaling by 1/2 (every number exact in binary).
 fn nested_nodes() -> Value {
@@ -180,13 +195,10 @@ fn a_node_keyed_at_constant_velocity_is_the_box_given_that_velocity() {
     let d = Dir::new("gltf-keys");
     // The box's node keyed from (0, 10.5, 0) at the file's time 0 to (20, 10.5, 0) at 40 s:
     // 0.5c along x, through where GOOD's box is at time 0.
-    let mut doc = Doc::unit_box(json!([{"name": "box", "translation": [0, 10.5, 0], "mesh": 0}]));
-    let times = doc.accessor(&[0.0, 40.0], "SCALAR", 2);
-    let values = doc.accessor(&[0.0, 10.5, 0.0, 20.0, 10.5, 0.0], "VEC3", 2);
-    doc.json["animations"] = json!([{
-        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
-        "samplers": [{"input": times, "output": values, "interpolation": "LINEAR"}]
-    }]);
+    let doc = keyed_box(
+        &[(0.0, [0.0, 10.5, 0.0]), (40.0, [20.0, 10.5, 0.0])],
+        "LINEAR",
+    );
     std::fs::write(d.0.join("keys.glb"), doc.glb()).unwrap();
     let sets = ["image.width=96", "image.height=64"];
     // Seen at camera time 11 the light left the box near time 0.5, between the keys.
@@ -229,13 +241,10 @@ fn a_node_keyed_at_constant_velocity_is_the_box_given_that_velocity() {
         );
     }
     // Keys faster than light are refused, naming the node and the keys.
-    let mut fast = Doc::unit_box(json!([{"name": "box", "translation": [0, 10.5, 0], "mesh": 0}]));
-    let times = fast.accessor(&[0.0, 1.0], "SCALAR", 2);
-    let values = fast.accessor(&[0.0, 10.5, 0.0, 2.0, 10.5, 0.0], "VEC3", 2);
-    fast.json["animations"] = json!([{
-        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
-        "samplers": [{"input": times, "output": values}]
-    }]);
+    let fast = keyed_box(
+        &[(0.0, [0.0, 10.5, 0.0]), (1.0, [2.0, 10.5, 0.0])],
+        "LINEAR",
+    );
     std::fs::write(d.0.join("fast.glb"), fast.glb()).unwrap();
     let path = d.file(
         "fast.toml",
@@ -456,13 +465,7 @@ fn bad_gltf_files_are_clear_errors() {
     let err = refused(&d, "fifo.gltf", good.beside("pipe.bin").as_bytes());
     assert!(err.contains("not a regular file"), "{err}");
     // A STEP key: a body cannot jump.
-    let mut step = Doc::unit_box(json!([{"name": "box", "translation": [0, 10.5, 0], "mesh": 0}]));
-    let times = step.accessor(&[0.0, 1.0], "SCALAR", 2);
-    let values = step.accessor(&[0.0, 10.5, 0.0, 0.1, 10.5, 0.0], "VEC3", 2);
-    step.json["animations"] = json!([{
-        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
-        "samplers": [{"input": times, "output": values, "interpolation": "STEP"}]
-    }]);
+    let step = keyed_box(&[(0.0, [0.0, 10.5, 0.0]), (1.0, [0.1, 10.5, 0.0])], "STEP");
     let err = refused(&d, "step.glb", &step.glb());
     assert!(err.contains("STEP"), "{err}");
     // What the crate's readers would unwrap or call unreachable on: FLOAT indices, an image in
