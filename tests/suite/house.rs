@@ -140,11 +140,6 @@ fn every_cited_section_of_the_physics_exists() {
     assert!(cited > 10, "the code cites the physics ({cited} citations)");
 }
 
-/// Every README picture's commands are the ones `scripts/readme-images.sh` runs to make it: the
-/// README's `rest-embree render … -o docs/img/NAME.png` lines are the script's (`$r` for
-/// `rest-embree`, `$o/` for `docs/img/`, `$q` for its --quiet), the same set both ways; each
-/// film's six frames and their mosaic name the frames the script joins; and every picture the
-/// README shows is made by one of them.
 /// Errors are the crate's `Error` (or a scene's `SceneError`); a bare `String` as the error
 /// is left to the parsers clap calls for a flag's value (`value_parser = name`), and to at
 /// most three functions besides.
@@ -194,10 +189,17 @@ fn errors_are_the_crates_own() {
     );
 }
 
+/// Every picture's commands (docs/gallery.md, which the README's pictures link to) are the ones
+/// `scripts/readme-images.sh` runs to make it: the gallery's `rest-embree render … -o
+/// docs/img/NAME.png` lines are the script's (`$r` for `rest-embree`, `$o/` for `docs/img/`,
+/// `$q` for its --quiet), the same set both ways; each film's six frames and their mosaic name
+/// the frames the script joins; and every picture the README or the gallery shows is made by
+/// one of them.
 #[test]
 fn every_readme_picture_says_the_command_that_makes_it() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let readme = std::fs::read_to_string(root.join("docs/gallery.md")).unwrap();
+    let front = std::fs::read_to_string(root.join("README.md")).unwrap();
     let script = std::fs::read_to_string(root.join("scripts/readme-images.sh")).unwrap();
     let from_readme: std::collections::BTreeSet<String> = readme
         .lines()
@@ -235,16 +237,20 @@ fn every_readme_picture_says_the_command_that_makes_it() {
         );
     }
     // Every picture shown is made by a command above (or is the viewer's screenshot).
-    for pic in readme
-        .split("](docs/img/")
-        .skip(1)
-        .map(|s| s.split(')').next().unwrap())
-    {
+    let shown = |page: &str, prefix: &str| -> Vec<String> {
+        page.split(prefix)
+            .skip(1)
+            .map(|s| s.split(')').next().unwrap().to_string())
+            .collect()
+    };
+    let pictures = [shown(&front, "](docs/img/"), shown(&readme, "](img/")].concat();
+    assert!(pictures.len() > 30, "{pictures:?}");
+    for pic in &pictures {
         let made = from_readme
             .iter()
             .any(|c| c.contains(&format!("-o docs/img/{pic}")))
             || readme.contains(&format!("-o docs/img/{pic}"))
-            || pic == "viewer.png";
+            || pic.as_str() == "viewer.png";
         assert!(made, "no command makes docs/img/{pic}");
     }
 }

@@ -1,0 +1,318 @@
+//! glTF 2.0 files (`.gltf` with its buffers and images beside it or in data URIs, or `.glb`)
+//! read through the `gltf` crate into what the scene holds: the default scene's top-level
+//! nodes, each with the triangles of its whole subtree placed by every transform below it
+//! (`MeshData`, in the file's coordinates at the file's time 0), the materials, the point
+//! lights and perspective cameras of the subtree, and the keyframed translations of top-level
+//! nodes. The buffers are read here, not by the crate: every file is checked to be a regular
+//! file and against the memory limit before it is read, and every accessor against its data.
+//! What goes wrong is said in words; the caller names the scene's line and key.
+//!
+//! Here the file as a whole (its parts, read, the checks the crate's validation leaves out);
+//! bytes from files and URIs in `files.rs`, the node tree in `nodes.rs`, materials in
+//! `materials.rs`, translation keys in `keys.rs`.
+
+mod files;
+mod keys;
+mod materials;
+mod nodes;
+
+use files::{buffers, read_file};
+use keys::{translation_at, translations};
+use materials::material;
+use nodes::{node_matrix, Reading};
+
+use super::mesh_file::MeshData;
+use super::texture::Texels;
+use glam::DVec3;
+use std::path::Path;
+
+/// Why a glTF file cannot be taken, in words.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct GltfError(pub String);
+
+impl std::fmt::Display for GltfError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl From<String> for GltfError {
+    fn from(s: String) -> GltfError {
+        GltfError(s)
+    }
+}
+
+impl From<&str> for GltfError {
+    fn from(s: &str) -> GltfError {
+        GltfError(s.into())
+    }
+}
+
+/// A glTF file as the scene takes it.
+pub(crate) struct GltfData {
+    /// The default scene's top-level nodes, in the file's order.
+    pub nodes: Vec<TopNode>,
+    /// The file's materials, by index (primitives name them by index).
+    pub materials: Vec<GltfMaterial>,
+    /// Its point lights, where the nodes put them (time 0).
+    pub lights: Vec<PointLight>,
+    /// Its perspective cameras, where the nodes put them (time 0).
+    pub cameras: Vec<CameraView>,
+    /// What the file has that is not taken, one sentence each.
+    pub warnings: Vec<String>,
+}
+
+/// A top-level node and everything below it.
+pub(crate) struct TopNode {
+    pub name: String,
+    /// The subtree's triangles (none where it has no mesh); `material_of` gives the file's
+    /// material by index.
+    pub mesh: Option<MeshData>,
+    /// Its keyframed translation: (file time, translation), times increasing; the node stands
+    /// as at time 0 in `mesh`.
+    pub keys: Option<Vec<(f64, DVec3)>>,
+}
+
+/// A metallic-roughness material (with the transmission, IOR and emissive-strength
+/// extensions), its colours linear RGB.
+pub(crate) struct GltfMaterial {
+    pub name: String,
+    pub base_color: DVec3,
+    pub base_texture: Option<Image>,
+    pub metallic: f64,
+    pub roughness: f64,
+    pub transmission: f64,
+    pub ior: f64,
+    /// The emissive factor times the emissive strength.
+    pub emissive: DVec3,
+    pub emissive_texture: Option<Image>,
+}
+
+/// An image a material uses: where it came from (for messages and the texture's name) and its
+/// linear texels.
+pub(crate) struct Image {
+    pub shown: String,
+    pub width: usize,
+    pub height: usize,
+    pub texels: Texels,
+}
+
+/// A `KHR_lights_punctual` point light.
+pub(crate) struct PointLight {
+    /// The top-level node it is under.
+    pub top: usize,
+    pub position: DVec3,
+    pub color: DVec3,
+    /// Candela.
+    pub intensity: f64,
+}
+
+/// A perspective camera.
+#[derive(Clone)]
+pub(crate) struct CameraView {
+    pub name: String,
+    pub position: DVec3,
+    pub forward: DVec3,
+    pub up: DVec3,
+    /// The vertical field of view, radians.
+    pub fov_y: f64,
+}
+
+/// Bytes of memory the reading takes per byte of the files read, at most (the buffers as read,
+/// then positions, indices and corner data in f64), for the check before reading.
+pub(crate) const BYTES_PER_FILE_BYTE: u64 = 24;
+
+/// Bytes a placed vertex and triangle take as read (position, corner normals and texture
+/// coordinates, indices, material), for the running check against the memory limit.
+const BYTES_PER_VERTEX: u64 = 24 + 12 + 8;
+const BYTES_PER_TRIANGLE: u64 = 12 + 72 + 48 + 4;
+
+/// Deepest node hierarchy taken (a guard for the recursion; real files are a few levels).
+const MAX_DEPTH: usize = 256;
+
+/// The extensions this reader maps (the rest are named in a warning).
+const MAPPED: [&str; 4] = [
+    "KHR_lights_punctual",
+    "KHR_materials_transmission",
+    "KHR_materials_ior",
+    "KHR_materials_emissive_strength",
+];
+
+/// Read the glTF file at `path`.
+pub(crate) fn read(path: &Path) -> Result<GltfData, GltfError> {
+    let bytes = read_file(path)?;
+    let gltf = parse(&bytes)?;
+    drop(bytes);
+    let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let buffers = buffers(&gltf, &base)?;
+    let mut warnings = Vec::new();
+    if let Some(e) = gltf
+        .extensions_required()
+        .find(|e| !MAPPED.contains(e) && *e != "KHR_texture_transform")
+    {
+        return Err(
+            format!("it requires the extension {e}, which this renderer does not read").into(),
+        );
+    }
+    let unmapped: Vec<&str> = gltf
+        .extensions_used()
+        .filter(|e| !MAPPED.contains(e))
+        .collect();
+    if !unmapped.is_empty() {
+        warnings.push(format!(
+            "its extensions {} are not mapped and are ignored",
+            unmapped.join(", ")
+        ));
+    }
+    let materials = gltf
+        .materials()
+        .map(|m| material(&m, &buffers, &base, &mut warnings))
+        .collect::<Result<Vec<_>, GltfError>>()?;
+    let scene = gltf
+        .default_scene()
+        .or_else(|| gltf.scenes().next())
+        .ok_or("it has no scene")?;
+    let keys = translations(&gltf, &buffers, &mut warnings)?;
+    let mut reading = Reading {
+        buffers: &buffers,
+        held: 0,
+        seen: vec![false; gltf.nodes().len()],
+        lights: Vec::new(),
+        cameras: Vec::new(),
+        warnings,
+    };
+    let mut nodes = Vec::new();
+    for (top, node) in scene.nodes().enumerate() {
+        let keys = keys.get(&node.index()).cloned();
+        let mut local = node_matrix(&node)?;
+        if let Some(k) = &keys {
+            // The node as it stands at the file's time 0.
+            let at0 = translation_at(k, 0.0);
+            local.w_axis = at0.extend(1.0);
+        }
+        let mut mesh = MeshData::default();
+        reading.walk(&node, local, top, 0, &mut mesh)?;
+        let name = node
+            .name()
+            .map_or_else(|| format!("node{}", node.index()), str::to_string);
+        nodes.push(TopNode {
+            name,
+            mesh: (!mesh.triangles.is_empty()).then_some(mesh),
+            keys,
+        });
+    }
+    let untaken = gltf.animations().count() > 0
+        && keys
+            .keys()
+            .any(|n| !scene.nodes().any(|top| top.index() == *n));
+    if untaken {
+        reading.warnings.push(
+            "a translation of a node below the top level is animated: only top-level nodes move, the others stand as at time 0".into(),
+        );
+    }
+    Ok(GltfData {
+        nodes,
+        materials,
+        lights: reading.lights,
+        cameras: reading.cameras,
+        warnings: reading.warnings,
+    })
+}
+
+/// The document and binary chunk of a `.gltf` or `.glb`, validated. The crate's validation
+/// indexes the accessors by each primitive's POSITION before checking that index (a bad one
+/// panics): checked first.
+fn parse(bytes: &[u8]) -> Result<gltf::Gltf, GltfError> {
+    let unread = |e: gltf::Error| format!("not a readable glTF: {e}");
+    let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(unread)?;
+    let root = raw.document.as_json();
+    let accessors = root.accessors.len();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            if prim.attributes.values().any(|a| a.value() >= accessors) {
+                return Err(format!(
+                    "not a readable glTF: mesh {m} primitive {p} names an accessor past its {accessors}"
+                ).into());
+            }
+        }
+    }
+    let document = gltf::Document::from_json(raw.document.into_json()).map_err(unread)?;
+    checked_beyond_validation(document.as_json())?;
+    Ok(gltf::Gltf {
+        document,
+        blob: raw.blob,
+    })
+}
+
+/// What the crate's readers unwrap or call unreachable on and its validation lets through:
+/// an image without its MIME type or URI, a camera without the projection its type names, and
+/// accessors of a kind a primitive's indices, positions, normals or texture coordinates cannot
+/// be (FLOAT indices, say), or of no elements.
+fn checked_beyond_validation(root: &gltf::json::Root) -> Result<(), GltfError> {
+    use gltf::json::accessor::{ComponentType as C, Type as T};
+    use gltf::json::mesh::Semantic;
+    use gltf::json::validation::Checked::Valid;
+    for (i, img) in root.images.iter().enumerate() {
+        let whole = match img.buffer_view {
+            Some(_) => img.mime_type.is_some(),
+            None => img.uri.is_some(),
+        };
+        if !whole {
+            return Err(format!(
+                "image {i} names neither a buffer view with its MIME type nor a URI"
+            )
+            .into());
+        }
+    }
+    for (i, cam) in root.cameras.iter().enumerate() {
+        let whole = match cam.type_ {
+            Valid(gltf::json::camera::Type::Perspective) => cam.perspective.is_some(),
+            Valid(gltf::json::camera::Type::Orthographic) => cam.orthographic.is_some(),
+            _ => false,
+        };
+        if !whole {
+            return Err(format!("camera {i} lacks the projection its type names").into());
+        }
+    }
+    let kind = |a: usize| {
+        let acc = &root.accessors[a];
+        let c = match acc.component_type {
+            Valid(g) => Some(g.0),
+            _ => None,
+        };
+        let t = match acc.type_ {
+            Valid(t) => Some(t),
+            _ => None,
+        };
+        (c, t, acc.count.0)
+    };
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let bad = |what: &str| -> GltfError {
+                format!("mesh {m} primitive {p}: its {what} accessor is of a kind this reader does not take").into()
+            };
+            if let Some(ix) = &prim.indices {
+                match kind(ix.value()) {
+                    (Some(C::U8 | C::U16 | C::U32), Some(T::Scalar), n) if n > 0 => {}
+                    _ => return Err(bad("indices")),
+                }
+            }
+            for (semantic, a) in &prim.attributes {
+                let (c, t, n) = kind(a.value());
+                let fine = match semantic {
+                    Valid(Semantic::Positions | Semantic::Normals) => {
+                        c == Some(C::F32) && t == Some(T::Vec3)
+                    }
+                    Valid(Semantic::TexCoords(0)) => {
+                        matches!(c, Some(C::F32 | C::U8 | C::U16)) && t == Some(T::Vec2)
+                    }
+                    _ => true,
+                };
+                if !fine || n == 0 {
+                    return Err(bad(&format!("{semantic:?}")));
+                }
+            }
+        }
+    }
+    Ok(())
+}
