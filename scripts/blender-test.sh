@@ -96,8 +96,8 @@ done
 
 # glTF from Blender: a scene modelled and animated with bpy (scripts/blender_gltf.py), exported
 # as .glb, renders as its twin written by hand in TOML (tests/data/blender_twin.toml) on both
-# backends: every pixel off a silhouette the same (idiff: at most 1.5% of pixels may differ,
-# none by more than 1/255 unless on an edge).
+# backends: every pixel off a silhouette the same (idiff: at most 1.5% of pixels may differ by
+# more than 0.004), and the same coverage (mean alpha) within 3%, so no object goes missing.
 PYTHONPATH=$site python3 "$root/scripts/blender_gltf.py" "$work/blender.glb" test \
     >"$work/gltf.log" 2>&1 || { cat "$work/gltf.log" >&2; exit 1; }
 cp "$root/tests/data/blender_scene.toml" "$work/scene.toml"
@@ -132,6 +132,18 @@ for backend in embree bvh; do
     else
         idiff -fail 0.004 -failpercent 1.5 "$work/gltf-$backend.png" "$work/twin-$backend.png" >&2 || true
         echo "blender-test: FAILED: the Blender-made glTF differs from its TOML twin on $backend" >&2
+        failed=1
+    fi
+    # What the colour check lets pass (a few percent of pixels) could be an object missing:
+    # the two frames' coverage (mean alpha) agree to within 3% of either, silhouettes aside.
+    "$exe" render "$work/scene.toml" -o "$work/gltf-$backend.exr" -q --backend $backend
+    "$exe" render "$work/twin.toml" -o "$work/twin-$backend.exr" -q --backend $backend
+    cover() { oiiotool "$1" --ch A --printstats | awk '/Stats Avg/ {print $3}'; }
+    a=$(cover "$work/gltf-$backend.exr") b=$(cover "$work/twin-$backend.exr")
+    if python3 -c "import sys; a, b = float(sys.argv[1]), float(sys.argv[2]); sys.exit(not (b > 0 and abs(a - b) <= 0.03 * b))" "$a" "$b"; then
+        echo "blender-test: the Blender-made glTF covers what its twin covers on $backend ($a of the frame, $b)" >&2
+    else
+        echo "blender-test: FAILED: the Blender-made glTF covers $a of the frame on $backend, its twin $b" >&2
         failed=1
     fi
 done

@@ -57,6 +57,10 @@ pub(crate) const BYTES_PER_HELD_TRIANGLE: u64 = 160;
 
 /// A mesh triangle's corner normals: three, in f64.
 pub(crate) const BYTES_PER_CORNER_NORMALS: u64 = 72;
+/// What one placement of a shared mesh costs (`Implicit::Instance`): its placement, its run
+/// and parts, and its instance in a backend (Embree's instance geometry, the BVH's entry).
+pub(crate) const BYTES_PER_INSTANCE: u64 = 4096;
+
 /// A mesh triangle's corner texture coordinates: three pairs, in f64.
 pub(crate) const BYTES_PER_CORNER_UVS: u64 = 48;
 
@@ -70,6 +74,10 @@ pub(crate) const BYTES_PER_STAR: u64 = 210;
 /// [`INSTANCE_OVER`](crate::geometry::INSTANCE_OVER) of them) one block's and a placement per
 /// block; a mesh's, its vertices and indices.
 pub(crate) fn implicit_bytes(shape: &crate::geometry::Implicit) -> u64 {
+    if let crate::geometry::Implicit::Instance(_) = shape {
+        // The mesh is counted once, where it is read; a placement costs its own.
+        return BYTES_PER_INSTANCE;
+    }
     if shape.len() <= crate::geometry::INSTANCE_OVER {
         return shape.len().saturating_mul(BYTES_PER_PRIMITIVE);
     }

@@ -2,6 +2,7 @@
 //! Its nodes over the held primitives are a [`NodeSet`]: f64 here, f32 in bvh32.rs (the
 //! benchmark's f32-against-f64 BVH).
 
+use super::instance_tree::{InstanceTree, MeshTrees};
 use super::instanced_tree::InstancedTree;
 use super::mesh_tree::MeshTree;
 use super::{Accelerator, Backend, Hit, Ray};
@@ -14,20 +15,29 @@ pub struct Bvh<N = Nodes64> {
     nodes: N,
     indices: Vec<u32>,
     /// The objects held as themselves: lattices and bar arrays each in two levels, meshes
-    /// each in a tree over its triangles.
+    /// each in a tree over its triangles, placements of a shared mesh each over its mesh's.
     instanced: Vec<Held>,
+    /// A tree over the held objects' boxes, where there are many (a mesh placed a thousand
+    /// times): a ray then visits the objects whose boxes it meets, nearer first.
+    held_tree: Option<BoxTree>,
 }
+
+/// Held objects past this many are found through a tree over their boxes.
+const HELD_TREE_OVER: usize = 8;
 
 /// An object held as itself, as the BVH walks it.
 enum Held {
     Blocks(InstancedTree),
     Mesh(MeshTree),
+    Instance(InstanceTree),
 }
 
 impl Held {
-    fn build(run: &crate::geometry::ImplicitRun) -> Held {
+    fn build(run: &crate::geometry::ImplicitRun, trees: &mut MeshTrees) -> Held {
+        use crate::geometry::Implicit;
         match &run.shape {
-            crate::geometry::Implicit::Mesh(m) => Held::Mesh(MeshTree::build(run.first, m)),
+            Implicit::Mesh(m) => Held::Mesh(MeshTree::build(run.first, m)),
+            Implicit::Instance(m) => Held::Instance(InstanceTree::build(run.first, m, trees)),
             _ => Held::Blocks(InstancedTree::build(run)),
         }
     }
@@ -36,6 +46,7 @@ impl Held {
         match self {
             Held::Blocks(t) => t.traverse(ray, tmax, any),
             Held::Mesh(t) => t.traverse(ray, tmax, any),
+            Held::Instance(t) => t.traverse(ray, tmax, any),
         }
     }
 }
@@ -85,17 +96,60 @@ impl<N: NodeSet> Bvh<N> {
     pub fn build(geometry: Arc<Geometry>) -> Bvh<N> {
         let boxes: Vec<Aabb> = geometry.prims.iter().map(|p| p.bounds()).collect();
         let BoxTree { nodes, indices } = BoxTree::build(&boxes);
-        let instanced = geometry.implicit.iter().map(Held::build).collect();
+        let mut trees = MeshTrees::default();
+        let instanced: Vec<Held> = geometry
+            .implicit
+            .iter()
+            .map(|r| Held::build(r, &mut trees))
+            .collect();
+        let held_tree = (instanced.len() > HELD_TREE_OVER).then(|| {
+            // Padded: the objects' own walks decide, the boxes only pass rays on to them.
+            let boxes: Vec<Aabb> = geometry
+                .implicit
+                .iter()
+                .map(|r| {
+                    let b = r.shape.bounds();
+                    let pad = glam::DVec3::splat(1e-9 * (b.diagonal() + b.max_abs()));
+                    Aabb::new(b.min - pad, b.max + pad)
+                })
+                .collect();
+            BoxTree::build(&boxes)
+        });
         Bvh {
             nodes: N::from_tree(nodes, &geometry.bounds()),
             geometry,
             indices,
             instanced,
+            held_tree,
         }
     }
 
     fn traverse(&self, ray: &Ray, any: bool) -> Option<Hit> {
         let mut best = self.traverse_held(ray, any);
+        if any && best.is_some() {
+            return best;
+        }
+        if let Some(tree) = &self.held_tree {
+            let tmax = best.map_or(ray.tmax, |h| h.t);
+            tree.traverse(
+                ray.origin,
+                ray.dir,
+                ray.tmin,
+                tmax,
+                |item, t_end| match self.instanced[item as usize].traverse(ray, t_end, any) {
+                    Some(h) => {
+                        best = Some(h);
+                        if any {
+                            f64::NEG_INFINITY
+                        } else {
+                            h.t
+                        }
+                    }
+                    None => t_end,
+                },
+            );
+            return best;
+        }
         for l in &self.instanced {
             if any && best.is_some() {
                 break;

@@ -14,6 +14,7 @@ mod bvh32;
 #[cfg(feature = "embree")]
 mod embree;
 mod fan;
+mod instance_tree;
 mod instanced_tree;
 mod mesh_tree;
 

@@ -92,8 +92,30 @@ pub(crate) fn mesh(d: &mut Digest, m: &IndexedMesh) {
     }
 }
 
+/// `item`'s data into `d` the first time it is met, and after that only which one it was:
+/// an item several placements of a mesh share (one `Arc`) is read once, not a thousand times.
+fn once<T>(
+    d: &mut Digest,
+    seen: &mut std::collections::HashMap<*const T, u32>,
+    item: &std::sync::Arc<T>,
+    take: impl FnOnce(&mut Digest, &T),
+) {
+    let n = seen.len() as u32;
+    match seen.entry(std::sync::Arc::as_ptr(item)) {
+        std::collections::hash_map::Entry::Occupied(first) => {
+            d.u32(u32::MAX);
+            d.u32(*first.get());
+        }
+        std::collections::hash_map::Entry::Vacant(slot) => {
+            slot.insert(n);
+            take(d, item);
+        }
+    }
+}
+
 /// The digest of everything in `g`.
 pub(crate) fn geometry(g: &Geometry) -> u64 {
+    let (mut seen_corners, mut seen_meshes) = Default::default();
     let mut d = Digest::new();
     d.u32(g.prims.len() as u32);
     for p in &g.prims {
@@ -104,7 +126,10 @@ pub(crate) fn geometry(g: &Geometry) -> u64 {
             d.u32(x);
         }
         if let Some(c) = &part.corners {
-            corners(&mut d, c);
+            once(&mut d, &mut seen_corners, c, corners);
+        }
+        if let Some(x) = &part.corners_placed {
+            d.bytes(format!("{:?}", **x).as_bytes());
         }
         if let Some(pl) = &part.placement {
             d.bytes(format!("{:?}", **pl).as_bytes());
@@ -117,6 +142,10 @@ pub(crate) fn geometry(g: &Geometry) -> u64 {
         d.u32(run.first);
         match &run.shape {
             Implicit::Mesh(m) => mesh(&mut d, m),
+            Implicit::Instance(m) => {
+                once(&mut d, &mut seen_meshes, &m.mesh, mesh);
+                d.bytes(format!("{:?}", m.place).as_bytes());
+            }
             other => d.bytes(format!("{other:?}").as_bytes()),
         }
     }

@@ -21,6 +21,9 @@ pub struct Part {
     pub placement: Option<std::sync::Arc<Placement>>,
     /// How the object spins in its group's frame, if it does (`spin`).
     pub spin: Option<Spin>,
+    /// For a placement of a shared mesh (`Implicit::Instance`): its corner data is the mesh's
+    /// own, shared by every placement, and its normals are turned by this placement when read.
+    pub corners_placed: Option<std::sync::Arc<super::Affine>>,
 }
 
 /// A rigid rotation in the group's frame: at `omega` radians per unit of the group's time,
@@ -180,6 +183,19 @@ impl Geometry {
         prims: impl IntoIterator<Item = Primitive>,
         corners: Option<std::sync::Arc<Corners>>,
     ) {
+        self.push_part_placed(object, material, prims, corners, None)
+    }
+
+    /// [`push_part_with`](Self::push_part_with) for a placement of a shared mesh listed
+    /// triangle by triangle: its corner data the mesh's own, turned by `corners_placed`.
+    fn push_part_placed(
+        &mut self,
+        object: u32,
+        material: u32,
+        prims: impl IntoIterator<Item = Primitive>,
+        corners: Option<std::sync::Arc<Corners>>,
+        corners_placed: Option<std::sync::Arc<super::Affine>>,
+    ) {
         let start = self.prims.len() as u32;
         self.prims.extend(prims);
         let end = self.prims.len() as u32;
@@ -204,6 +220,7 @@ impl Geometry {
                     corners,
                     placement: None,
                     spin: None,
+                    corners_placed,
                 },
             );
         }
@@ -249,6 +266,12 @@ impl Geometry {
                 corners: corners.clone(),
                 placement: None,
                 spin: None,
+                corners_placed: match &shape {
+                    Implicit::Instance(m) if m.place != super::Affine::IDENTITY => {
+                        Some(std::sync::Arc::new(m.place))
+                    }
+                    _ => None,
+                },
             });
             start = end;
         }
@@ -303,17 +326,18 @@ impl Geometry {
                 .collect(),
             implicit: Vec::new(),
         };
-        for run in &self.implicit {
+        for (run, held_len) in self.implicit.iter().zip(self.held_lens()) {
             let end = run.first as u64 + run.shape.len();
             let parts = self
                 .parts
                 .iter()
                 .filter(|p| p.start >= run.first && p.end as u64 <= end);
-            if run.shape.len() <= max {
+            if held_len <= max {
                 for p in parts {
                     let ids = (p.start - run.first) as u64..(p.end - run.first) as u64;
                     let prims = ids.map(|id| run.shape.prim(id));
-                    g.push_part_with(p.object, p.material, prims, p.corners.clone());
+                    let placed = p.corners_placed.clone();
+                    g.push_part_placed(p.object, p.material, prims, p.corners.clone(), placed);
                 }
             } else {
                 let runs: Vec<_> = parts
@@ -337,6 +361,25 @@ impl Geometry {
             }
         }
         g
+    }
+
+    /// How many primitives listing each run would hold: its own, or for a placement of a
+    /// shared mesh those of every placement of that mesh here (listed all, or none).
+    fn held_lens(&self) -> Vec<u64> {
+        let mut shared: std::collections::HashMap<*const super::IndexedMesh, u64> =
+            std::collections::HashMap::new();
+        for r in &self.implicit {
+            if let Implicit::Instance(m) = &r.shape {
+                *shared.entry(std::sync::Arc::as_ptr(&m.mesh)).or_default() += m.len();
+            }
+        }
+        self.implicit
+            .iter()
+            .map(|r| match &r.shape {
+                Implicit::Instance(m) => shared[&std::sync::Arc::as_ptr(&m.mesh)],
+                other => other.len(),
+            })
+            .collect()
     }
 
     /// This geometry with the primitives of `other` after its own (held ones before the
@@ -414,7 +457,11 @@ impl Geometry {
         let b2 = (d11 * q2 - d12 * q1) / det;
         let w = [1.0 - b1 - b2, b1, b2];
         let normal = c.normals.as_ref().and_then(|n| {
-            let n = n[i];
+            let n = match &part.corners_placed {
+                // Each corner turned as a placed copy's would have been.
+                Some(x) => n[i].map(|c| x.normal(c)),
+                None => n[i],
+            };
             (n[0] * w[0] + n[1] * w[1] + n[2] * w[2]).try_normalize()
         });
         let uv = c.uvs.as_ref().map(|t| {

@@ -6,7 +6,7 @@
 //! does not have (past its far faces) skipped. A mesh has no grid: backends build over its
 //! triangles (its grid methods answer as for an object of no nodes).
 
-use super::{Aabb, BarArray, IndexedMesh, Lattice, Primitive};
+use super::{Aabb, BarArray, IndexedMesh, Lattice, MeshInstance, Primitive};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -25,6 +25,8 @@ pub enum Implicit {
     Bars(BarArray),
     /// A triangle mesh, its vertices shared.
     Mesh(Arc<IndexedMesh>),
+    /// A mesh held once for several placements, at one of them.
+    Instance(Arc<MeshInstance>),
 }
 
 /// One of a block's primitives: the sphere or bar at a local node, or the rod from it along an
@@ -60,6 +62,7 @@ impl Implicit {
             Implicit::Lattice(l) => l.len(),
             Implicit::Bars(b) => b.len(),
             Implicit::Mesh(m) => m.len(),
+            Implicit::Instance(m) => m.len(),
         }
     }
 
@@ -74,6 +77,7 @@ impl Implicit {
             Implicit::Lattice(l) => l.prim(id),
             Implicit::Bars(b) => b.prim(id),
             Implicit::Mesh(m) => m.triangle(id),
+            Implicit::Instance(m) => m.triangle(id),
         }
     }
 
@@ -83,6 +87,7 @@ impl Implicit {
             Implicit::Lattice(l) => Box::new(l.spheres().chain(l.rods())),
             Implicit::Bars(b) => Box::new(b.bars()),
             Implicit::Mesh(m) => Box::new((0..m.len()).map(|i| m.triangle(i))),
+            Implicit::Instance(m) => Box::new((0..m.len()).map(|i| m.triangle(i))),
         }
     }
 
@@ -92,6 +97,7 @@ impl Implicit {
             Implicit::Lattice(l) => l.bounds(),
             Implicit::Bars(b) => b.bounds(),
             Implicit::Mesh(m) => m.bounds(),
+            Implicit::Instance(m) => m.bounds(),
         }
     }
 
@@ -101,6 +107,7 @@ impl Implicit {
             Implicit::Lattice(l) => Implicit::Lattice(l.translated(d)),
             Implicit::Bars(b) => Implicit::Bars(b.translated(d)),
             Implicit::Mesh(m) => Implicit::Mesh(Arc::new(m.translated(d))),
+            Implicit::Instance(m) => Implicit::Instance(Arc::new(m.translated(d))),
         }
     }
 
@@ -109,7 +116,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.counts,
             Implicit::Bars(b) => b.grid(),
-            Implicit::Mesh(_) => [0; 3],
+            Implicit::Mesh(_) | Implicit::Instance(_) => [0; 3],
         }
     }
 
@@ -118,7 +125,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.node_at(n),
             Implicit::Bars(b) => b.node_at(n),
-            Implicit::Mesh(_) => DVec3::ZERO,
+            Implicit::Mesh(_) | Implicit::Instance(_) => DVec3::ZERO,
         }
     }
 
@@ -129,6 +136,7 @@ impl Implicit {
             Implicit::Lattice(l) => l.member_prim(n, m),
             Implicit::Bars(b) => b.member_prim(n, m),
             Implicit::Mesh(mesh) => mesh.triangle(0),
+            Implicit::Instance(mesh) => mesh.triangle(0),
         }
     }
 
@@ -138,7 +146,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.member_id(n, m),
             Implicit::Bars(b) => b.member_id(n, m),
-            Implicit::Mesh(_) => 0,
+            Implicit::Mesh(_) | Implicit::Instance(_) => 0,
         }
     }
 
@@ -147,7 +155,7 @@ impl Implicit {
         match self {
             Implicit::Lattice(l) => l.local_box(m),
             Implicit::Bars(b) => b.local_box(m),
-            Implicit::Mesh(_) => Aabb::EMPTY,
+            Implicit::Mesh(_) | Implicit::Instance(_) => Aabb::EMPTY,
         }
     }
 
@@ -187,7 +195,7 @@ impl Implicit {
                     axis: BAR,
                 })
                 .collect()],
-            Implicit::Mesh(_) => Vec::new(),
+            Implicit::Mesh(_) | Implicit::Instance(_) => Vec::new(),
         }
     }
 
@@ -198,7 +206,7 @@ impl Implicit {
                 u64::from(l.sphere_count() > 0) + 3 * u64::from(l.rod_count() > 0)
             }
             Implicit::Bars(_) => 1,
-            Implicit::Mesh(_) => 0,
+            Implicit::Mesh(_) | Implicit::Instance(_) => 0,
         };
         kinds * u64::from(blocks.nodes())
     }
@@ -217,7 +225,7 @@ impl Implicit {
                 [0, 1, 2].map(|a| (first[a] + blocks.size[a] - 1).min(grid[a] - 1)),
                 bars.reach(),
             ),
-            Implicit::Mesh(_) => return Aabb::EMPTY,
+            Implicit::Mesh(_) | Implicit::Instance(_) => return Aabb::EMPTY,
         };
         Aabb::new(self.node(first) - reach, self.node(last) + reach)
     }

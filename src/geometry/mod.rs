@@ -12,6 +12,7 @@ mod implicit;
 mod indexed_mesh;
 mod lattice;
 mod light_buffer;
+mod mesh_instance;
 mod primitive;
 mod real;
 
@@ -24,6 +25,7 @@ pub use implicit::{Blocks, Implicit, Member};
 pub use indexed_mesh::IndexedMesh;
 pub use lattice::Lattice;
 pub(crate) use light_buffer::LightBuffer;
+pub use mesh_instance::{Affine, MeshInstance};
 pub(crate) use primitive::ball_crossings;
 pub use primitive::Primitive;
 #[cfg(feature = "embree")]

@@ -10,11 +10,12 @@ use super::gltf_file::{self, CameraView, GltfData, GltfMaterial};
 use super::mesh_file::MeshData;
 use super::model::{Light, Material};
 use super::reader::{SceneResult, Table};
+use super::shared_meshes::Shared;
 use super::transform::Transform;
 use super::worldline::{Motion, Segment};
 use crate::spacetime::Velocity;
 use crate::spectrum::{Colour, Role};
-use glam::DVec3;
+use glam::{DMat3, DMat4, DVec3};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -48,6 +49,9 @@ pub(super) struct OwnGroup {
 /// chosen) and the nodes that are groups of their own.
 pub(super) struct Placed {
     pub stays: Option<MeshData>,
+    /// The placements, in the group, of meshes the file places several times: each mesh held
+    /// once, and where each node puts it (before the entry's own transform).
+    pub instances: Vec<(Arc<Shared>, DMat4)>,
     pub own: Vec<OwnGroup>,
     /// The scene material of each of the file's materials, by index.
     pub chosen: Vec<u32>,
@@ -94,6 +98,7 @@ pub(super) fn place(
         lights,
         cameras,
         warnings,
+        shared,
     } = data;
     let shown = path.display().to_string();
     imports
@@ -186,16 +191,40 @@ pub(super) fn place(
             ),
         ));
     }
-    if nodes.iter().all(|n| n.mesh.is_none()) {
+    if nodes
+        .iter()
+        .all(|n| n.mesh.is_none() && n.placements.is_empty())
+    {
         return Err(t.error_at(
             node,
             "file",
             format!("{shown}: its scene places no triangles"),
         ));
     }
+    let names: Vec<String> = file_materials.iter().map(|m| m.name.clone()).collect();
+    let held: HashMap<usize, Arc<Shared>> = shared
+        .into_iter()
+        .map(|(k, mut m)| {
+            m.materials = names.clone();
+            (k, Arc::new(Shared::of(m)))
+        })
+        .collect();
     let mut stays: Option<MeshData> = None;
     let mut own = Vec::new();
-    for n in nodes {
+    let mut instances = Vec::new();
+    for mut n in nodes {
+        let alone = split_all || n.keys.is_some();
+        if alone {
+            // A node that is a group of its own holds copies: its group is built alone.
+            for (k, world) in std::mem::take(&mut n.placements) {
+                let copy = placed_copy(&held[&k].data(), world);
+                match &mut n.mesh {
+                    None => n.mesh = Some(copy),
+                    Some(all) => append(all, copy),
+                }
+            }
+        }
+        instances.extend(n.placements.iter().map(|(k, w)| (held[k].clone(), *w)));
         let segments = match &n.keys {
             Some(keys) => Some(segments(keys, time_scale, transform).map_err(|why| {
                 t.error(
@@ -220,7 +249,82 @@ pub(super) fn place(
             }
         }
     }
-    Ok(Placed { stays, own, chosen })
+    Ok(Placed {
+        stays,
+        instances,
+        own,
+        chosen,
+    })
+}
+
+/// The placements of meshes the entry `t`'s file places several times (`Placed::instances`)
+/// into `geo` as object `id`: each a placement of the mesh held once, placed by its node and
+/// then by the entry's `transform`; the file's materials `chosen`, remapped by the entry's
+/// `materials`, those it names none `mat`. Each mesh counts against the scene's limit once.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn place_instances(
+    t: &Table,
+    id: u32,
+    mat: u32,
+    transform: Option<Transform>,
+    placed: &Placed,
+    ids: &HashMap<String, u32>,
+    geo: &mut crate::geometry::Geometry,
+    total: &mut u64,
+) -> SceneResult<()> {
+    let Some((first, _)) = placed.instances.first() else {
+        return Ok(());
+    };
+    let chosen =
+        super::objects::file_materials(t, first.materials(), ids, mat, placed.chosen.clone())?;
+    let mut counted = std::collections::HashSet::new();
+    for (shared, world) in &placed.instances {
+        if counted.insert(Arc::as_ptr(shared)) {
+            super::objects::budget(t, "file", total, shared.len())?;
+        }
+        super::objects::budget(t, "file", total, 1)?;
+        let (linear, at) = (DMat3::from_mat4(*world), world.w_axis.truncate());
+        let (linear, at) = match transform {
+            Some(x) => (
+                x.rotation * DMat3::from_diagonal(x.scale) * linear,
+                x.point(at),
+            ),
+            None => (linear, at),
+        };
+        let place = crate::geometry::Affine::general(linear, at)
+            .filter(|a| a.inverse.is_finite() && a.translate.is_finite())
+            .ok_or_else(|| {
+                t.error(
+                    "file",
+                    "a node places a mesh by a transform that flattens it",
+                )
+            })?;
+        shared
+            .place_at(id, mat, place, &chosen, geo)
+            .map_err(|why| t.error("file", why.to_string()))?;
+    }
+    Ok(())
+}
+
+/// A copy of mesh `m` (in its own coordinates) placed by `world`, which does not mirror it.
+fn placed_copy(m: &MeshData, world: DMat4) -> MeshData {
+    let normal_matrix = DMat3::from_mat4(world).inverse().transpose();
+    MeshData {
+        positions: m
+            .positions
+            .iter()
+            .map(|&p| world.transform_point3(p))
+            .collect(),
+        triangles: m.triangles.clone(),
+        normals: m.normals.as_ref().map(|v| {
+            v.iter()
+                .map(|c| c.map(|n| (normal_matrix * n).normalize_or_zero()))
+                .collect()
+        }),
+        uvs: m.uvs.clone(),
+        materials: m.materials.clone(),
+        material_of: m.material_of.clone(),
+    }
 }
 
 /// The camera the scene's glTF files offer: the one an entry named, else the first.

@@ -189,7 +189,9 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     let mut total: u64 = 0;
     let mut group_names = std::collections::HashSet::new();
     let mut imports = gltf_object::Imports::default();
-    for t in &root.tables("group")? {
+    let group_tables = root.tables("group")?;
+    let mut meshes = super::shared_meshes::SharedMeshes::scan(&group_tables)?;
+    for t in &group_tables {
         let name = t.req_string("name")?;
         if !group_names.insert(name.to_string()) {
             return Err(t.error("name", format!("a group named `{name}` is defined twice")));
@@ -204,6 +206,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
             index,
             &mut total,
             &mut imports,
+            &mut meshes,
         )?;
         // A glTF node's own group, named `<group>/<node>`: its name once among the groups (a
         // group of several worldline pieces names each piece so).
@@ -321,6 +324,7 @@ fn group(
     index: usize,
     total: &mut u64,
     imports: &mut gltf_object::Imports,
+    meshes: &mut super::shared_meshes::SharedMeshes,
 ) -> SceneResult<Vec<Group>> {
     let segments = worldline::read(t, "direction", super::segments::Whose::Group)?;
     let velocity = match segments {
@@ -340,17 +344,19 @@ fn group(
         );
         let kind = if o.string("type")? == Some("gltf") {
             let line = segments.is_some();
-            let placed =
+            let mut placed =
                 gltf_object::place(o, velocity, moves, line, materials, material_ids, imports)?;
             let (mat, place) = material_and_transform(o, material_ids)?;
-            if let Some(mesh) = placed.stays {
+            if let Some(mesh) = placed.stays.take() {
                 let (geo, chosen) = (&mut geometry, placed.chosen.clone());
                 add_mesh_data(o, id, mat, place, geo, total, mesh, chosen, material_ids)?;
             }
+            let geo = &mut geometry;
+            gltf_object::place_instances(o, id, mat, place, &placed, material_ids, geo, total)?;
             own_groups.push((k, placed.own, placed.chosen, mat, place));
             "gltf".to_string()
         } else {
-            add_object(o, id, material_ids, &mut geometry, total)?
+            add_object(o, id, material_ids, &mut geometry, total, meshes)?
         };
         check_object(o, &kind, &geometry, materials, (first, implicit, parts))?;
         objects.push(ObjectInfo {

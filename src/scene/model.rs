@@ -503,7 +503,23 @@ impl Scene {
             .flat_map(|s| &s.stars)
             .map(|f| f.count.saturating_mul(crate::memory::BYTES_PER_STAR))
             .sum::<u64>();
-        stars.saturating_add(
+        // Each shared mesh once, whatever number of placements it has.
+        let mut shared = std::collections::HashSet::new();
+        let meshes: u64 = self
+            .groups
+            .iter()
+            .flat_map(|g| &g.geometry.implicit)
+            .filter_map(|r| match &r.shape {
+                crate::geometry::Implicit::Instance(m) => Some(&m.mesh),
+                _ => None,
+            })
+            .filter(|m| shared.insert(std::sync::Arc::as_ptr(m)))
+            .map(|m| {
+                m.len()
+                    .saturating_mul(crate::memory::BYTES_PER_HELD_TRIANGLE)
+            })
+            .sum();
+        stars.saturating_add(meshes).saturating_add(
             self.groups
                 .iter()
                 .map(|g| {

@@ -3,6 +3,7 @@
 
 use super::procedural::{BarArray, Lattice};
 use super::reader::{SceneResult, Table};
+use super::shared_meshes::SharedMeshes;
 use super::transform::{Transform, KEYS};
 use crate::geometry::{Blocks, Implicit};
 use crate::geometry::{Geometry, Primitive};
@@ -46,6 +47,7 @@ pub(super) const OBJECT_KEYS: &[&str] = &[
     "groups",
     "time_scale",
     "camera",
+    "of",
 ];
 
 fn material_ref(
@@ -171,7 +173,7 @@ fn box_triangles(min: DVec3, max: DVec3) -> [[DVec3; 3]; 12] {
 /// The scene material of each material a mesh file names (OBJ's `usemtl`): the one
 /// `materials = { file_name = "scene_name" }` gives, else the scene's material of the same
 /// name, else the object's `material`.
-fn file_materials(
+pub(super) fn file_materials(
     t: &Table,
     in_file: &[String],
     mats: &HashMap<String, u32>,
@@ -203,8 +205,17 @@ fn file_materials(
 /// and key, and the mesh file with its own line.
 fn read_mesh_file(t: &Table) -> SceneResult<super::mesh_file::MeshData> {
     let name = t.req_string("file")?;
-    let node = t.get("file").expect("read above");
-    let path = t.path_beside(name);
+    read_mesh_at(t, "file", t.path_beside(name))
+}
+
+/// The mesh file at `path`, which `t`'s `key` names; errors name the scene's line and key, and
+/// the mesh file with its own line.
+fn read_mesh_at(
+    t: &Table,
+    key: &str,
+    path: std::path::PathBuf,
+) -> SceneResult<super::mesh_file::MeshData> {
+    let node = t.get(key).expect("read by the caller");
     if let Ok(m) = std::fs::metadata(&path) {
         let need = m
             .len()
@@ -215,16 +226,12 @@ fn read_mesh_file(t: &Table) -> SceneResult<super::mesh_file::MeshData> {
             crate::memory::human(m.len())
         );
         if let Some(why) = crate::memory::too_much(need, &what) {
-            return Err(t.error_at(node, "file", why));
+            return Err(t.error_at(node, key, why));
         }
     }
     super::mesh_file::read(&path).map_err(|e| {
         let at = e.line.map_or(String::new(), |l| format!(":{l}"));
-        t.error_at(
-            node,
-            "file",
-            format!("{}{at}: {}", path.display(), e.message),
-        )
+        t.error_at(node, key, format!("{}{at}: {}", path.display(), e.message))
     })
 }
 
@@ -234,6 +241,7 @@ pub(super) fn add_object(
     mats: &HashMap<String, u32>,
     geo: &mut Geometry,
     total: &mut u64,
+    meshes: &mut SharedMeshes,
 ) -> SceneResult<String> {
     let kind = t.req_string("type")?;
     let mat = material_ref(t, "material", mats, 0)?;
@@ -251,7 +259,27 @@ pub(super) fn add_object(
         "box" => Some(adding.add_box()?),
         "sphere" => Some(adding.add_sphere()?),
         "rod" => Some(adding.add_rod()?),
+        "mesh" if t.has("file") && meshes.is_shared(t)? => {
+            let path = t.path_beside(t.req_string("file")?);
+            adding.add_shared_mesh(mats, meshes, "file", path)?;
+            None
+        }
         "mesh" if t.has("file") => adding.add_mesh_file(mats).map(|_| None)?,
+        "instance" => {
+            if let Some(k) = ["file", "vertices", "indices"]
+                .into_iter()
+                .find(|k| t.has(k))
+            {
+                return Err(at_value(
+                    t,
+                    k,
+                    "an instance places the mesh of the object its `of` names; give the file there",
+                ));
+            }
+            let path = meshes.file_of_instance(t)?;
+            adding.add_shared_mesh(mats, meshes, "of", path)?;
+            None
+        }
         "mesh" => adding.add_inline_mesh().map(|_| None)?,
         "lattice" | "bar_array" if transform.is_some() => {
             let key = KEYS
@@ -286,7 +314,7 @@ pub(super) fn add_object(
                 n,
                 "type",
                 format!(
-                    "unknown object type `{other}` (box, sphere, rod, mesh, gltf, lattice, bar_array, wheel)"
+                    "unknown object type `{other}` (box, sphere, rod, mesh, instance, gltf, lattice, bar_array, wheel)"
                 ),
             ));
         }
@@ -589,6 +617,42 @@ pub(super) fn add_mesh_data(
 }
 
 impl Adding<'_, '_> {
+    /// A mesh file placed more than once in the scene (by `file`, or an instance's `of`, the
+    /// entry's `key`), held once: this entry one placement of it.
+    fn add_shared_mesh(
+        &mut self,
+        mats: &HashMap<String, u32>,
+        meshes: &mut SharedMeshes,
+        key: &str,
+        path: std::path::PathBuf,
+    ) -> SceneResult<()> {
+        let (t, id, mat, transform) = (self.t, self.id, self.mat, self.transform);
+        let (geo, total) = (&mut *self.geo, &mut *self.total);
+        if let Some(k) = ["vertices", "indices"].into_iter().find(|k| t.has(k)) {
+            return Err(at_value(
+                t,
+                k,
+                "a mesh is given by `file` or by `vertices` and `indices`, not both",
+            ));
+        }
+        let shared = meshes.get(path.clone(), || {
+            let mesh = read_mesh_at(t, key, path)?;
+            mesh_budget(t, total, &mesh)?;
+            Ok(mesh)
+        })?;
+        // Each placement costs a little of its own; the mesh was counted when read.
+        budget(t, "type", total, 1)?;
+        let names = shared.materials();
+        let chosen = names
+            .iter()
+            .map(|n| mats.get(n).copied().unwrap_or(mat))
+            .collect();
+        let chosen = file_materials(t, names, mats, mat, chosen)?;
+        shared
+            .place(id, mat, transform, &chosen, geo)
+            .map_err(|why| at_value(t, key, why.to_string()))
+    }
+
     /// A mesh given inline (`vertices`, `indices`), one primitive per triangle.
     fn add_inline_mesh(&mut self) -> SceneResult<()> {
         let (t, id, mat, transform) = (self.t, self.id, self.mat, self.transform);

@@ -14,6 +14,7 @@ mod fused_primary;
 mod instanced_lattice;
 mod light_buffer;
 mod many_groups;
+mod mesh_instances;
 mod progressive;
 mod screen_cull;
 mod shadow_batches;

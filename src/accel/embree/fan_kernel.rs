@@ -157,6 +157,7 @@ macro_rules! fan_packet {
                                     rh.ray.tfar[i],
                                     rh.hit.geomID[i],
                                     rh.hit.primID[i],
+                                    rh.hit.instID[0][i],
                                     ctx.exact_t(i),
                                     self.pullback,
                                 )

@@ -123,7 +123,7 @@ pub(crate) fn attach(
     first_instance: u32,
 ) -> crate::Result<BlockScene> {
     let shape = &run.shape;
-    if matches!(shape, Implicit::Mesh(_)) {
+    if matches!(shape, Implicit::Mesh(_) | Implicit::Instance(_)) {
         return Err(crate::Error::backend(
             "a mesh is a triangle geometry of its own, not instanced blocks",
         ));
@@ -168,7 +168,7 @@ pub(crate) fn attach(
             occluded: block_occluded::<Round>,
         },
         // (Refused above.)
-        Implicit::Bars(_) | Implicit::Mesh(_) => UserFunctions {
+        Implicit::Bars(_) | Implicit::Mesh(_) | Implicit::Instance(_) => UserFunctions {
             bounds: block_bounds,
             intersect: block_intersect::<Aabb>,
             occluded: block_occluded::<Aabb>,

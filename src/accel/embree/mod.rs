@@ -344,11 +344,12 @@ impl EmbreeAccel {
         t_embree: f32,
         geom: u32,
         prim: u32,
+        inst: u32,
         exact_t: f64,
         offset: f64,
     ) -> Option<Hit> {
         let k = scale(r.len);
-        let (prim, exact) = self.scene.prim(geom, prim)?;
+        let (prim, exact) = self.scene.prim(geom, prim, inst)?;
         if exact {
             return (exact_t > r.tmin && exact_t < r.tmax).then_some(Hit { t: exact_t, prim });
         }

@@ -34,8 +34,9 @@ pub(super) fn flush_denormals() {
 /// every query here gives the same value (a ray's time 0, mask all ones, flags 0, id its lane,
 /// by which the callbacks find the query's ray; a hit's instID none) are set when the packet
 /// is made, and nothing changes them but a hit's
-/// instID, which the instanced blocks' callbacks write (instanced_blocks.rs) and nothing reads:
-/// the hits' read-back goes by geomID and primID alone; each query writes the rest that Embree reads
+/// instID, which Embree and the callbacks write with every hit (the instance's geomID, or none
+/// at the top level) and the read-back reads only where there is a hit (a placement of a
+/// shared mesh, scene.rs's `MeshInstances`); each query writes the rest that Embree reads
 /// in the lanes it marks valid: a ray's origin, tnear, direction and tfar (`Lane::set`, or the
 /// fans' kernel) and a hit's geomID; in the others an empty interval (`Lane::deactivate`). The rest of a hit Embree writes where it
 /// reports one. Embree's callbacks start no query, so a packet is never in use twice on one
@@ -119,6 +120,7 @@ macro_rules! packet_fns {
                                 rh.ray.tfar[i],
                                 rh.hit.geomID[i],
                                 rh.hit.primID[i],
+                                rh.hit.instID[0][i],
                                 ctx.exact_t(i),
                                 lanes.offset[i].get(),
                             )
@@ -327,7 +329,16 @@ impl EmbreeAccel {
             return None;
         }
         let t = ctx.exact_t(0);
-        self.to_hit(r, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, t, e.offset)
+        let inst = rh.hit.instID[0];
+        self.to_hit(
+            r,
+            rh.ray.tfar,
+            rh.hit.geomID,
+            rh.hit.primID,
+            inst,
+            t,
+            e.offset,
+        )
     }
 
     pub(super) fn occluded1(&self, r: &Ray) -> bool {

@@ -282,6 +282,23 @@ impl Geometry {
         }
     }
 
+    /// Make this (instance) geometry `scene` placed by the affine map `xfm` (column-major 3x4:
+    /// three columns of the linear map, then the translation). The instance keeps its own
+    /// reference to the scene.
+    pub fn set_instance_affine(&mut self, scene: &CommittedScene, xfm: [f32; 12]) {
+        // SAFETY: a live instance geometry and a live committed scene; Embree copies the
+        // transform.
+        unsafe {
+            rtcSetGeometryInstancedScene(self.raw, scene.raw);
+            rtcSetGeometryTransform(
+                self.raw,
+                0,
+                RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR,
+                xfm.as_ptr() as *const c_void,
+            );
+        }
+    }
+
     /// A new buffer of `count` items of T (of Embree format `format`), to fill before the
     /// geometry is attached.
     pub fn new_buffer<T: Copy>(

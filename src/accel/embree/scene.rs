@@ -80,6 +80,28 @@ impl ExactRuns {
     }
 }
 
+/// The instance geometries of shared meshes' placements: geomIDs `first_id ..`, each
+/// placement's first scene primitive by geomID less `first_id`.
+#[derive(Default)]
+pub struct MeshInstances {
+    first_id: u32,
+    firsts: Vec<u32>,
+}
+
+impl MeshInstances {
+    /// The scene primitive a hit on triangle `prim` of instance `inst` names, if `inst` is
+    /// one of these (not a block's instance, nor none).
+    #[inline(always)]
+    pub fn hit(&self, inst: u32, prim: u32) -> Option<u32> {
+        let k = inst.wrapping_sub(self.first_id) as usize;
+        self.firsts.get(k).map(|first| first + prim)
+    }
+
+    fn is_empty(&self) -> bool {
+        self.firsts.is_empty()
+    }
+}
+
 /// A group's geometry as an Embree scene, and what its hits mean.
 pub struct EmbreeScene {
     /// Released before the shapes below, which it points into (fields drop in order).
@@ -93,6 +115,9 @@ pub struct EmbreeScene {
     /// Whether occlusion packets may be traced with Embree's coherent flag (not into
     /// instances: `EmbreeAccel::context`).
     pub coherent_occlusion: bool,
+    /// The placements of shared meshes (`Implicit::Instance`): Embree instances of one scene
+    /// per mesh, whose hits name the placement by instID.
+    pub mesh_instances: MeshInstances,
     /// What Embree's user geometry points into; dropped after the scene is released.
     _rounds: Option<Box<Shapes<Round>>>,
     _cuboids: Option<Box<Shapes<Aabb>>>,
@@ -184,7 +209,7 @@ impl EmbreeScene {
         let instanced: Vec<&ImplicitRun> = geo
             .implicit
             .iter()
-            .filter(|r| !matches!(r.shape, Implicit::Mesh(_)))
+            .filter(|r| !matches!(r.shape, Implicit::Mesh(_) | Implicit::Instance(_)))
             .collect();
         let mut first_instance = (maps.len() + instanced.len()) as u32;
         let mut blocks = Vec::with_capacity(instanced.len());
@@ -204,21 +229,31 @@ impl EmbreeScene {
             )?);
             first_instance += Blocks::of(run.shape.grid()).count() as u32;
         }
-        let exact_runs = ExactRuns::of(&maps);
+        // Placements of shared meshes: one Embree scene per mesh, an instance per placement,
+        // after every other geometry.
+        let mesh_instances =
+            attach_mesh_instances(&device, &mut builder, geo, center, first_instance)?;
+        let exact_runs = ExactRuns::of(&maps).filter(|_| mesh_instances.is_empty());
         Ok(EmbreeScene {
             rtc: builder.commit()?,
             maps,
             exact_runs,
             center,
-            coherent_occlusion: blocks.is_empty(),
+            coherent_occlusion: blocks.is_empty() && mesh_instances.is_empty(),
+            mesh_instances,
             _rounds: rounds,
             _cuboids: cuboids,
             _blocks: blocks,
         })
     }
 
-    /// The scene primitive an Embree hit names, and whether its t is exact already.
-    pub fn prim(&self, geom: u32, prim: u32) -> Option<(u32, bool)> {
+    /// The scene primitive an Embree hit names (on geometry `geom` of instance `inst`, none
+    /// at the top level), and whether its t is exact already.
+    #[inline(always)]
+    pub fn prim(&self, geom: u32, prim: u32, inst: u32) -> Option<(u32, bool)> {
+        if let Some(p) = self.mesh_instances.hit(inst, prim) {
+            return Some((p, false));
+        }
         let m = self.maps.get(geom as usize)?;
         Some((m.get(prim)?, m.exact))
     }
@@ -239,7 +274,54 @@ fn user_geometry<S: Shape>(device: &Arc<Device>, shapes: &Shapes<S>) -> crate::R
     Ok(g)
 }
 
-/// Attach `g`, whose primitives are the scene's `prims`, recording them by geomID.
+/// Each placement of a shared mesh in `geo` as an Embree instance, as geomIDs `first_id ..`:
+/// the mesh once, as its own scene about its own centre, and each placement's map from it to
+/// this scene's coordinates (less `center`), made in f64 and cast to f32.
+fn attach_mesh_instances(
+    device: &Arc<Device>,
+    builder: &mut SceneBuilder,
+    geo: &SceneGeometry,
+    center: DVec3,
+    first_id: u32,
+) -> crate::Result<MeshInstances> {
+    let mut scenes: std::collections::HashMap<*const IndexedMesh, (CommittedScene, DVec3)> =
+        std::collections::HashMap::new();
+    let mut out = MeshInstances {
+        first_id,
+        firsts: Vec::new(),
+    };
+    for run in &geo.implicit {
+        let Implicit::Instance(inst) = &run.shape else {
+            continue;
+        };
+        let (scene, own) = match scenes.entry(Arc::as_ptr(&inst.mesh)) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                let own = inst.mesh.bounds().centroid();
+                let own = if own.is_finite() { own } else { DVec3::ZERO };
+                let mut child = SceneBuilder::new(device)?;
+                child.attach(mesh_geometry(device, &inst.mesh, own)?)?;
+                e.insert((child.commit()?, own))
+            }
+        };
+        // x in the mesh's scene is the mesh's point x + own; placed, less `center`:
+        // A (x + own) + translate - center, with A the linear map times the scale.
+        let x = &inst.place;
+        let a = x.linear * glam::DMat3::from_diagonal(x.scale);
+        let shift = a * *own + x.translate - center;
+        let cols = a.to_cols_array();
+        let mut xfm = [0f32; 12];
+        for (slot, v) in xfm.iter_mut().zip(cols.iter().chain(&shift.to_array())) {
+            *slot = *v as f32;
+        }
+        let mut g = Geometry::new(device, RTC_GEOMETRY_TYPE_INSTANCE)?;
+        g.set_instance_affine(scene, xfm);
+        builder.attach_as(g, first_id + out.firsts.len() as u32)?;
+        out.firsts.push(run.first);
+    }
+    Ok(out)
+}
+
 /// A mesh's triangles as Embree's triangle geometry: its vertices once (less `center`, in f32)
 /// and its index buffer.
 fn mesh_geometry(
@@ -259,6 +341,7 @@ fn mesh_geometry(
     Ok(g)
 }
 
+/// Attach `g`, whose primitives are the scene's `prims`, recording them by geomID.
 fn attach(
     builder: &mut SceneBuilder,
     maps: &mut Vec<PrimMap>,

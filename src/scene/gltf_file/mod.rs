@@ -60,6 +60,9 @@ pub(crate) struct GltfData {
     pub cameras: Vec<CameraView>,
     /// What the file has that is not taken, one sentence each.
     pub warnings: Vec<String>,
+    /// The meshes several nodes place, each read once in its own coordinates, by mesh index
+    /// (the nodes' `placements` name them).
+    pub shared: std::collections::BTreeMap<usize, MeshData>,
 }
 
 /// A top-level node and everything below it.
@@ -68,6 +71,8 @@ pub(crate) struct TopNode {
     /// The subtree's triangles (none where it has no mesh); `material_of` gives the file's
     /// material by index.
     pub mesh: Option<MeshData>,
+    /// Its placements of meshes several nodes place (`GltfData::shared`).
+    pub placements: Vec<nodes::MeshPlacement>,
     /// Its keyframed translation: (file time, translation), times increasing; the node stands
     /// as at time 0 in `mesh`.
     pub keys: Option<Vec<(f64, DVec3)>>,
@@ -180,6 +185,8 @@ pub(crate) fn read(path: &Path) -> Result<GltfData, GltfError> {
         lights: Vec::new(),
         cameras: Vec::new(),
         warnings,
+        uses: mesh_uses(&scene, gltf.meshes().len()),
+        shared: Default::default(),
     };
     let mut nodes = Vec::new();
     for (top, node) in scene.nodes().enumerate() {
@@ -190,14 +197,15 @@ pub(crate) fn read(path: &Path) -> Result<GltfData, GltfError> {
             let at0 = translation_at(k, 0.0);
             local.w_axis = at0.extend(1.0);
         }
-        let mut mesh = MeshData::default();
-        reading.walk(&node, local, top, 0, &mut mesh)?;
+        let (mut mesh, mut placements) = (MeshData::default(), Vec::new());
+        reading.walk(&node, local, top, 0, &mut mesh, &mut placements)?;
         let name = node
             .name()
             .map_or_else(|| format!("node{}", node.index()), str::to_string);
         nodes.push(TopNode {
             name,
             mesh: (!mesh.triangles.is_empty()).then_some(mesh),
+            placements,
             keys,
         });
     }
@@ -216,7 +224,28 @@ pub(crate) fn read(path: &Path) -> Result<GltfData, GltfError> {
         lights: reading.lights,
         cameras: reading.cameras,
         warnings: reading.warnings,
+        shared: reading.shared,
     })
+}
+
+/// How many nodes of `scene` place each of the file's `meshes` meshes, counted to 2 (all the
+/// walk asks: one, or several). A node reached twice is counted twice here and refused by the
+/// walk; the count stops after 2^24 nodes, where a cycle would keep it going.
+fn mesh_uses(scene: &gltf::Scene, meshes: usize) -> Vec<usize> {
+    let mut uses = vec![0; meshes];
+    let mut stack: Vec<gltf::Node> = scene.nodes().collect();
+    let mut budget = 1usize << 24;
+    while let Some(n) = stack.pop() {
+        budget -= 1;
+        if budget == 0 {
+            break;
+        }
+        if let Some(u) = n.mesh().and_then(|m| uses.get_mut(m.index())) {
+            *u = (*u + 1).min(2);
+        }
+        stack.extend(n.children());
+    }
+    uses
 }
 
 /// The document and binary chunk of a `.gltf` or `.glb`, validated. The crate's validation

@@ -25,7 +25,16 @@ pub(super) struct Reading<'a> {
     pub lights: Vec<PointLight>,
     pub cameras: Vec<CameraView>,
     pub warnings: Vec<String>,
+    /// How many nodes of the scene place each mesh, by mesh index: one placed by several is
+    /// read once, in its own coordinates (`shared`), and each node's placement recorded.
+    pub uses: Vec<usize>,
+    /// The meshes placed by several nodes, read once in their own coordinates, by index.
+    pub shared: std::collections::BTreeMap<usize, MeshData>,
 }
+
+/// A node's placement of a mesh that several nodes place: the mesh's index and where the
+/// node puts it.
+pub(crate) type MeshPlacement = (usize, DMat4);
 
 impl Reading<'_> {
     pub(super) fn walk(
@@ -35,6 +44,7 @@ impl Reading<'_> {
         top: usize,
         depth: usize,
         mesh: &mut MeshData,
+        placements: &mut Vec<MeshPlacement>,
     ) -> Result<(), GltfError> {
         let i = node.index();
         if std::mem::replace(&mut self.seen[i], true) {
@@ -52,7 +62,19 @@ impl Reading<'_> {
             ));
         }
         if let Some(m) = node.mesh() {
-            self.add_mesh(&m, world, mesh)?;
+            // A mirroring placement turns the triangles' winding, which a shared mesh cannot
+            // do per placement: it is copied.
+            let mirrors = DMat3::from_mat4(world).determinant() < 0.0;
+            if self.uses[m.index()] > 1 && !mirrors {
+                if !self.shared.contains_key(&m.index()) {
+                    let mut own = MeshData::default();
+                    self.add_mesh(&m, DMat4::IDENTITY, &mut own)?;
+                    self.shared.insert(m.index(), own);
+                }
+                placements.push((m.index(), world));
+            } else {
+                self.add_mesh(&m, world, mesh)?;
+            }
         }
         let origin = world.transform_point3(DVec3::ZERO);
         if let Some(light) = node.light() {
@@ -115,7 +137,7 @@ impl Reading<'_> {
         }
         for child in node.children() {
             let m = world * node_matrix(&child)?;
-            self.walk(&child, m, top, depth + 1, mesh)?;
+            self.walk(&child, m, top, depth + 1, mesh, placements)?;
         }
         Ok(())
     }

@@ -1,0 +1,240 @@
+//! Mesh files the scene places more than once, read and held once.
+//!
+//! A first pass over the scene (`SharedMeshes::scan`) counts the entries that place each mesh
+//! file: `type = "mesh"` entries naming it by `file`, and `type = "instance"` entries naming
+//! such an object by `of`. A file placed once is read and placed as it always was (its vertices
+//! copied to their places); a file placed several times is read once, held in its own
+//! coordinates, and each entry is a placement of it (`Implicit::Instance`): a thousand
+//! placements of a mesh cost one mesh and a thousand placements, not a thousand meshes.
+
+use super::reader::{SceneResult, Table};
+use super::transform::Transform;
+use crate::geometry::{Affine, Corners, Geometry, Implicit, IndexedMesh, MeshInstance};
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// The mesh files of a scene, and those read so far that are placed more than once.
+#[derive(Default)]
+pub(super) struct SharedMeshes {
+    /// How many entries place each mesh file.
+    uses: HashMap<PathBuf, usize>,
+    /// The files of named mesh objects, by name: what an instance's `of` names.
+    named: HashMap<String, PathBuf>,
+    /// Files placed more than once, read.
+    read: HashMap<PathBuf, Arc<Shared>>,
+}
+
+/// A mesh file held once: its triangles in its own coordinates and, by runs of one of the
+/// file's materials, its corner data, each shared by every placement.
+pub(super) struct Shared {
+    mesh: Arc<IndexedMesh>,
+    /// (triangles, the file's material or `NO_MATERIAL`, corner data) of each run.
+    runs: Vec<(u64, u32, Option<Arc<Corners>>)>,
+    /// The material names the file uses.
+    materials: Vec<String>,
+}
+
+/// The key a mesh file is known by: its path made absolute where it exists, so that
+/// `rock.ply` and `./rock.ply` are one file.
+fn key(path: PathBuf) -> PathBuf {
+    std::fs::canonicalize(&path).unwrap_or(path)
+}
+
+impl SharedMeshes {
+    /// Count the entries of `groups` that place each mesh file.
+    pub fn scan(groups: &[Table]) -> SceneResult<SharedMeshes> {
+        let mut s = SharedMeshes::default();
+        let mut instances = Vec::new();
+        for g in groups {
+            for o in g.tables("object")? {
+                match o.string("type")? {
+                    Some("mesh") => {
+                        let Some(file) = o.string("file")? else {
+                            continue;
+                        };
+                        let path = key(o.path_beside(file));
+                        *s.uses.entry(path.clone()).or_default() += 1;
+                        if let Some(name) = o.string("name")? {
+                            s.named.insert(name.to_string(), path);
+                        }
+                    }
+                    Some("instance") => {
+                        if let Some(of) = o.string("of")? {
+                            instances.push(of.to_string());
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        for of in instances {
+            if let Some(path) = s.named.get(&of) {
+                *s.uses.entry(path.clone()).or_default() += 1;
+            }
+        }
+        Ok(s)
+    }
+
+    /// Whether the file `t`'s `file` names is placed more than once.
+    pub fn is_shared(&self, t: &Table) -> SceneResult<bool> {
+        let file = t.req_string("file")?;
+        Ok(self
+            .uses
+            .get(&key(t.path_beside(file)))
+            .is_some_and(|&n| n > 1))
+    }
+
+    /// The file the instance entry `t` places (its `of`: a named mesh object read from a file).
+    pub fn file_of_instance(&self, t: &Table) -> SceneResult<PathBuf> {
+        let of = t.req_string("of")?;
+        self.named.get(of).cloned().ok_or_else(|| {
+            let mut known: Vec<&str> = self.named.keys().map(String::as_str).collect();
+            known.sort_unstable();
+            let known = if known.is_empty() {
+                "the scene names none".to_string()
+            } else {
+                format!("named ones: {}", known.join(", "))
+            };
+            let n = t.get("of").expect("read above");
+            t.error_at(
+                n,
+                "of",
+                format!("no mesh object is named `{of}`: an instance places a mesh read from a file (type = \"mesh\", file = ..., name = \"{of}\"); {known}"),
+            )
+        })
+    }
+
+    /// The mesh file at `path` as held once, read on first use by `read` (which checks it
+    /// against the scene's limits); its triangles counted against the scene's once.
+    pub fn get(
+        &mut self,
+        path: PathBuf,
+        read: impl FnOnce() -> SceneResult<super::mesh_file::MeshData>,
+    ) -> SceneResult<Arc<Shared>> {
+        let path = key(path);
+        if let Some(s) = self.read.get(&path) {
+            return Ok(s.clone());
+        }
+        let shared = Arc::new(Shared::of(read()?));
+        self.read.insert(path, shared.clone());
+        Ok(shared)
+    }
+}
+
+impl Shared {
+    /// The mesh `m` (in its own coordinates) held once.
+    pub fn of(m: super::mesh_file::MeshData) -> Shared {
+        use super::mesh_file::NO_MATERIAL;
+        let n = m.triangles.len();
+        let material_of = |i: usize| m.material_of.get(i).copied().unwrap_or(NO_MATERIAL);
+        let mut runs = Vec::new();
+        let mut start = 0;
+        while start < n {
+            let k = material_of(start);
+            let end = (start + 1..n).find(|&i| material_of(i) != k).unwrap_or(n);
+            let corners = (m.normals.is_some() || m.uvs.is_some()).then(|| {
+                Arc::new(Corners {
+                    normals: m.normals.as_ref().map(|v| v[start..end].to_vec()),
+                    uvs: m.uvs.as_ref().map(|v| v[start..end].to_vec()),
+                })
+            });
+            runs.push(((end - start) as u64, k, corners));
+            start = end;
+        }
+        Shared {
+            mesh: Arc::new(IndexedMesh::new(m.positions, m.triangles)),
+            runs,
+            materials: m.materials,
+        }
+    }
+
+    /// How many triangles.
+    pub fn len(&self) -> u64 {
+        self.mesh.len()
+    }
+
+    /// The mesh as read, in its own coordinates: what a copy of it is made from.
+    pub fn data(&self) -> super::mesh_file::MeshData {
+        let corners = |take: &dyn Fn(&Corners) -> bool| {
+            self.runs
+                .iter()
+                .all(|(_, _, c)| c.as_ref().is_some_and(|c| take(c)))
+        };
+        let normals = corners(&|c| c.normals.is_some()).then(|| {
+            self.runs
+                .iter()
+                .flat_map(|(_, _, c)| {
+                    c.as_ref()
+                        .and_then(|c| c.normals.clone())
+                        .unwrap_or_default()
+                })
+                .collect()
+        });
+        let uvs = corners(&|c| c.uvs.is_some()).then(|| {
+            self.runs
+                .iter()
+                .flat_map(|(_, _, c)| c.as_ref().and_then(|c| c.uvs.clone()).unwrap_or_default())
+                .collect()
+        });
+        super::mesh_file::MeshData {
+            positions: self.mesh.positions().to_vec(),
+            triangles: self.mesh.triangles().to_vec(),
+            normals,
+            uvs,
+            materials: self.materials.clone(),
+            material_of: self
+                .runs
+                .iter()
+                .flat_map(|&(n, k, _)| std::iter::repeat_n(k, n as usize))
+                .collect(),
+        }
+    }
+
+    /// The material names the file uses.
+    pub fn materials(&self) -> &[String] {
+        &self.materials
+    }
+
+    /// Place it in `geo` as object `id` by `transform` (none: as the file has it), the file's
+    /// materials `chosen` (by index), those it names none `mat`.
+    pub fn place(
+        &self,
+        id: u32,
+        mat: u32,
+        transform: Option<Transform>,
+        chosen: &[u32],
+        geo: &mut Geometry,
+    ) -> crate::Result<()> {
+        let place = match transform {
+            Some(x) => Affine::rigid(x.scale, x.rotation, x.translate),
+            None => Affine::IDENTITY,
+        };
+        self.place_at(id, mat, place, chosen, geo)
+    }
+
+    /// Place it in `geo` as object `id` by `place`, its materials as [`place`](Self::place)
+    /// has them.
+    pub fn place_at(
+        &self,
+        id: u32,
+        mat: u32,
+        place: Affine,
+        chosen: &[u32],
+        geo: &mut Geometry,
+    ) -> crate::Result<()> {
+        let runs: Vec<_> = self
+            .runs
+            .iter()
+            .map(|(n, k, c)| {
+                (
+                    *n,
+                    chosen.get(*k as usize).copied().unwrap_or(mat),
+                    c.clone(),
+                )
+            })
+            .collect();
+        let shape = Implicit::Instance(Arc::new(MeshInstance::new(self.mesh.clone(), place)));
+        geo.push_implicit_with(id, &runs, shape)
+    }
+}
