@@ -128,6 +128,70 @@ fn mesh_file_here(triangles: usize, size: u32, backend: &str) -> String {
     line.unwrap_or_else(|e| format!("- mesh file of {triangles} triangles: not measured: {e}"))
 }
 
+/// Write a terrain of about `triangles` triangles as a PLY file and a scene that places it
+/// `placements` times (a grid of entries naming the one file, each turned its own way, so the
+/// mesh is held once), then read, build and render it at `size`² on `backend`, as a Markdown
+/// line with the time and peak memory of each step.
+fn mesh_instances_here(placements: usize, triangles: usize, size: u32, backend: &str) -> String {
+    let dir = std::env::temp_dir().join(format!(
+        "rest-embree-bench-instances-{}",
+        std::process::id()
+    ));
+    let line = (|| -> Result<String, Box<dyn std::error::Error>> {
+        std::fs::create_dir_all(&dir)?;
+        let faces = write_ply_terrain(&dir.join("terrain.ply"), triangles)?;
+        let side = (placements as f64).sqrt().ceil() as usize;
+        let reach = 1.1 * side as f64;
+        let mut text = format!(
+            "[camera]\nposition = [0, {:.3}, {:.3}]\nlook_at = [0, 0, 0]\nup = [0, 0, 1]\n\n\
+             [image]\nwidth = {size}\nheight = {size}\n\n\
+             [[light]]\nposition = [2, -2, {:.3}]\n\n\
+             [[group]]\nname = \"field\"\n",
+            -1.6 * reach - 2.0,
+            1.2 * reach + 1.0,
+            2.0 * reach + 2.0
+        );
+        for k in 0..placements {
+            let (i, j) = ((k % side) as f64, (k / side) as f64);
+            let _ = write!(
+                text,
+                "\n[[group.object]]\ntype = \"mesh\"\nfile = \"terrain.ply\"\n\
+                 translate = [{:.3}, {:.3}, 0]\nrotate = {{ axis = [0, 0, 1], degrees = {} }}\n",
+                2.2 * i - reach + 1.1,
+                2.2 * j - reach + 1.1,
+                (k * 37) % 360
+            );
+        }
+        let scene_path = dir.join("field.toml");
+        std::fs::write(&scene_path, text)?;
+        reset_peak();
+        let base = peak_mib().unwrap_or(0.0);
+        let t0 = Instant::now();
+        let scene = crate::scene::load_file(&scene_path, &[])?;
+        let read = t0.elapsed().as_secs_f64();
+        let b = crate::accel::backend_by_name(backend)?;
+        let t1 = Instant::now();
+        let world = crate::render::World::build(&scene, b.as_ref())?;
+        let build = t1.elapsed().as_secs_f64();
+        let t2 = Instant::now();
+        let (frame, _) = crate::render::render_world(&scene, &world);
+        let render = t2.elapsed().as_secs_f64();
+        let peak = peak_mib().unwrap_or(0.0) - base;
+        let hit = frame.pixels.iter().filter(|p| p.object_id > 0).count();
+        let times = match placements {
+            1 => "once".to_string(),
+            n => format!("{n} times"),
+        };
+        Ok(format!(
+            "- mesh placed {times}, a binary PLY of {faces} triangles, {backend}: \
+             read in {read:.2} s, built in {build:.2} s, rendered at {size}² in {render:.2} s \
+             ({hit} pixels see it); peak memory {peak:.0} MiB above the process's start"
+        ))
+    })();
+    let _ = std::fs::remove_dir_all(&dir);
+    line.unwrap_or_else(|e| format!("- mesh placed {placements} times: not measured: {e}"))
+}
+
 /// Markdown lines, one per kind of file. Each file is read in a process of its own (this
 /// program, run again): in a process that has freed memory before, the reading would reuse it
 /// and its peak would not show.
@@ -135,27 +199,52 @@ pub(crate) fn summary(quick: bool) -> String {
     let scale = if quick { 1 } else { 4 };
     let mut out = String::new();
     let triangles = if quick { 200_000 } else { 10_000_000 };
+    let placed = if quick { 20_000 } else { 1_000_000 };
+    let mut peaks = Vec::new();
     for (kind, size) in [
-        ("groups", 10_000 * scale),
-        ("mesh", 25_000 * scale),
-        ("mesh-file", triangles),
+        ("groups".to_string(), 10_000 * scale),
+        ("mesh".to_string(), 25_000 * scale),
+        ("mesh-file".to_string(), triangles),
+        // One placement of a mesh, then many: what the placements cost beside the mesh.
+        (format!("instances-{placed}"), 1),
+        (format!("instances-{placed}"), if quick { 50 } else { 1000 }),
     ] {
         let line = std::env::current_exe()
             .and_then(|exe| {
                 std::process::Command::new(exe)
-                    .args(["bench-scene-file", kind, &size.to_string()])
+                    .args(["bench-scene-file", &kind, &size.to_string()])
                     .output()
             })
             .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
             .unwrap_or_else(|e| format!("- scene file, {kind}: not measured: {e}"));
         let _ = writeln!(out, "{line}");
+        peaks.push(peak_of(&line));
+    }
+    // The placements' cost: the peak of many placements against one's.
+    if let [.., Some(one), Some(many)] = peaks[..] {
+        let _ = writeln!(
+            out,
+            "- so the placements cost {:.2}x one placement's peak memory",
+            many / one
+        );
     }
     out
+}
+
+/// The "peak memory N MiB" a line says.
+fn peak_of(line: &str) -> Option<f64> {
+    let after = line.rsplit("peak memory ").next()?;
+    after.split(' ').next()?.parse().ok()
 }
 
 /// Generate a file of `kind` (`groups`: that many groups of one sphere; `mesh`: that many
 /// triangles inline), read it here, and say what it cost as a Markdown line.
 pub(crate) fn scene_file_here(kind: &str, size: usize) -> String {
+    // `instances-T`: a mesh of T triangles placed `size` times.
+    if let Some(triangles) = kind.strip_prefix("instances-").and_then(|t| t.parse().ok()) {
+        let px = if triangles < 1_000_000 { 256 } else { 1024 };
+        return mesh_instances_here(size, triangles, px, crate::accel::default_backend_name());
+    }
     if kind == "mesh-file" {
         let px = if size < 1_000_000 { 256 } else { 1024 };
         return mesh_file_here(size, px, crate::accel::default_backend_name());
@@ -197,6 +286,11 @@ mod tests {
             let s = super::scene_file_here(kind, size);
             assert!(s.contains("read in") && !s.contains("not read"), "{s}");
         }
+        // A mesh placed 30 times: held once, in view.
+        let s = super::scene_file_here("instances-2000", 30);
+        assert!(s.contains("placed 30 times") && s.contains("2048 triangles"), "{s}");
+        assert_eq!(super::peak_of("a; peak memory 291 MiB above"), Some(291.0));
+        assert!(!s.contains(" 0 pixels see it"), "{s}");
         // A PLY file written, read, built and rendered: the terrain is in view.
         let s = super::scene_file_here("mesh-file", 2000);
         assert!(
