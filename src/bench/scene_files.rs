@@ -288,7 +288,10 @@ mod tests {
         }
         // A mesh placed 30 times: held once, in view.
         let s = super::scene_file_here("instances-2000", 30);
-        assert!(s.contains("placed 30 times") && s.contains("2048 triangles"), "{s}");
+        assert!(
+            s.contains("placed 30 times") && s.contains("2048 triangles"),
+            "{s}"
+        );
         assert_eq!(super::peak_of("a; peak memory 291 MiB above"), Some(291.0));
         assert!(!s.contains(" 0 pixels see it"), "{s}");
         // A PLY file written, read, built and rendered: the terrain is in view.

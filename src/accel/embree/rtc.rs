@@ -299,6 +299,34 @@ impl Geometry {
         }
     }
 
+    /// Give the geometry `items` as its buffer of `kind` (of Embree format `format`) without
+    /// copying them.
+    ///
+    /// # Safety
+    /// `items` must stay valid, unmoved and unchanged for as long as any scene this geometry
+    /// is attached to lives (the caller keeps their owner beside the scene and drops it after).
+    pub unsafe fn share_buffer<T: Copy>(
+        &mut self,
+        kind: RTCBufferType,
+        format: RTCFormat,
+        items: &[T],
+    ) -> Result<()> {
+        // SAFETY: a live geometry, slot 0; the caller vouches for the items' lifetime.
+        unsafe {
+            rtcSetSharedGeometryBuffer(
+                self.raw,
+                kind,
+                0,
+                format,
+                items.as_ptr() as *const c_void,
+                0,
+                std::mem::size_of::<T>(),
+                items.len(),
+            )
+        };
+        self.device.check("sharing a buffer")
+    }
+
     /// A new buffer of `count` items of T (of Embree format `format`), to fill before the
     /// geometry is attached.
     pub fn new_buffer<T: Copy>(
