@@ -90,8 +90,9 @@ docs: setup
 	@# The path integrator beside Mitsuba 3, where it is installed (a bench, not a test).
 	@if python3 -c 'import mitsuba, OpenEXR, numpy' 2>/dev/null; then \
 	  python3 scripts/mitsuba-compare.py --out docs/bench/mitsuba.md; \
+	  python3 scripts/mitsuba-terrain.py --out docs/bench/terrain.md; \
 	else \
-	  echo "docs: Mitsuba 3 not installed (pip install mitsuba==3.9.1 OpenEXR numpy; apt-get install libllvm19): docs/bench/mitsuba.md kept as it is"; \
+	  echo "docs: Mitsuba 3 not installed (pip install mitsuba==3.9.1 OpenEXR numpy; apt-get install libllvm19): docs/bench/mitsuba.md and terrain.md kept as they are"; \
 	fi
 	scripts/performance-doc.sh
 	scripts/accuracy-table.sh

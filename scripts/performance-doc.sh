@@ -94,5 +94,13 @@ if [ -f docs/bench/mitsuba.md ]; then
 else
   echo 'Not measured: Mitsuba 3 was not installed where `make docs` ran (`pip install mitsuba`).'
 fi
+echo
+echo '## A big mesh beside Mitsuba 3'
+echo
+if [ -f docs/bench/terrain.md ]; then
+  cat docs/bench/terrain.md
+else
+  echo 'Not measured: Mitsuba 3 was not installed where `make docs` ran (`pip install mitsuba`).'
+fi
 } > docs/performance.md
 echo "performance-doc: wrote docs/performance.md"
