@@ -654,6 +654,32 @@ fn a_mesh_several_nodes_place_is_held_once_and_renders_as_copies() {
             );
         }
     }
+    // A node that is a group of its own (`groups = "nodes"`) holds copies: its group is built
+    // alone. The same frame as the file of a mesh per node.
+    let sets = ["image.width=160", "image.height=96"];
+    let load_nodes = |file: &str| {
+        let text = with_object(&format!(
+            "type = \"gltf\"\nfile = \"{file}\"\ngroups = \"nodes\""
+        ));
+        load(&d, &format!("{file}-nodes.toml"), &text, &sets)
+    };
+    let (a, b) = (load_nodes("shared.glb"), load_nodes("copies.glb"));
+    let instances = a
+        .groups
+        .iter()
+        .flat_map(|g| &g.geometry.implicit)
+        .filter(|r| matches!(r.shape, rest_embree::geometry::Implicit::Instance(_)))
+        .count();
+    assert_eq!(instances, 0, "a node's own group holds copies");
+    for be in backends() {
+        let (x, y) = (render_with(&a, be), render_with(&b, be));
+        assert!(x.pixels.iter().filter(|p| p.alpha > 0.0).count() > 300);
+        let (all, inside) = close_but_edges(&x, &y);
+        assert_eq!(
+            inside, 0,
+            "{be}, groups = nodes: {all} differ, {inside} inside"
+        );
+    }
 }
 
 /// How many pixels of two frames differ by more than a millionth of their colour, and how many
