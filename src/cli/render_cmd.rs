@@ -320,6 +320,11 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
             stats.primary_rays as f64 / secs.max(1e-9) / 1e6
         );
     }
+    // The command ends here and its process with it: the world and the scene are left to the
+    // operating system, which takes their memory back at once, instead of being freed piece by
+    // piece (100,000 groups' trees, Embree scenes and tables took 0.09 s of a 3 s command).
+    std::mem::forget(world);
+    std::mem::forget(scene);
     Ok(())
 }
 
