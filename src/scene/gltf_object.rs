@@ -71,15 +71,6 @@ pub(super) fn place(
     let name = t.req_string("file")?;
     let node = t.get("file").expect("read above");
     let path = t.path_beside(name);
-    let data = gltf_file::read(&path)
-        .map_err(|why| t.error_at(node, "file", format!("{}: {why}", path.display())))?;
-    let transform = Transform::read(t)?;
-    let time_scale = t.f64_where(
-        "time_scale",
-        Some(1.0),
-        |v| v > 0.0 && v.is_finite(),
-        "more than 0 (scene time units per second of the file's clock)",
-    )?;
     let split_all = match t.string("groups")?.unwrap_or("one") {
         "one" => false,
         "nodes" => true,
@@ -92,6 +83,15 @@ pub(super) fn place(
             ));
         }
     };
+    let data = gltf_file::read(&path, split_all)
+        .map_err(|why| t.error_at(node, "file", format!("{}: {why}", path.display())))?;
+    let transform = Transform::read(t)?;
+    let time_scale = t.f64_where(
+        "time_scale",
+        Some(1.0),
+        |v| v > 0.0 && v.is_finite(),
+        "more than 0 (scene time units per second of the file's clock)",
+    )?;
     let GltfData {
         nodes,
         materials: file_materials,
@@ -212,18 +212,9 @@ pub(super) fn place(
     let mut stays: Option<MeshData> = None;
     let mut own = Vec::new();
     let mut instances = Vec::new();
-    for mut n in nodes {
-        let alone = split_all || n.keys.is_some();
-        if alone {
-            // A node that is a group of its own holds copies: its group is built alone.
-            for (k, world) in std::mem::take(&mut n.placements) {
-                let copy = placed_copy(&held[&k].data(), world);
-                match &mut n.mesh {
-                    None => n.mesh = Some(copy),
-                    Some(all) => append(all, copy),
-                }
-            }
-        }
+    for n in nodes {
+        // (A node that is a group of its own holds copies, made by the reader: its group is
+        // built alone.)
         instances.extend(n.placements.iter().map(|(k, w)| (held[k].clone(), *w)));
         let segments = match &n.keys {
             Some(keys) => Some(segments(keys, time_scale, transform).map_err(|why| {
@@ -304,27 +295,6 @@ pub(super) fn place_instances(
             .map_err(|why| t.error("file", why.to_string()))?;
     }
     Ok(())
-}
-
-/// A copy of mesh `m` (in its own coordinates) placed by `world`, which does not mirror it.
-fn placed_copy(m: &MeshData, world: DMat4) -> MeshData {
-    let normal_matrix = DMat3::from_mat4(world).inverse().transpose();
-    MeshData {
-        positions: m
-            .positions
-            .iter()
-            .map(|&p| world.transform_point3(p))
-            .collect(),
-        triangles: m.triangles.clone(),
-        normals: m.normals.as_ref().map(|v| {
-            v.iter()
-                .map(|c| c.map(|n| (normal_matrix * n).normalize_or_zero()))
-                .collect()
-        }),
-        uvs: m.uvs.clone(),
-        materials: m.materials.clone(),
-        material_of: m.material_of.clone(),
-    }
 }
 
 /// The camera the scene's glTF files offer: the one an entry named, else the first.

@@ -503,22 +503,46 @@ impl Scene {
             .flat_map(|s| &s.stars)
             .map(|f| f.count.saturating_mul(crate::memory::BYTES_PER_STAR))
             .sum::<u64>();
-        // Each shared mesh once, whatever number of placements it has.
-        let mut shared = std::collections::HashSet::new();
+        // A shared mesh's placements in a group: listed when all of them together are at
+        // most `INSTANCE_OVER` triangles (as the world lists them), else the mesh once for the
+        // group (each group's backend builds over it) and each placement its own.
         let meshes: u64 = self
             .groups
             .iter()
-            .flat_map(|g| &g.geometry.implicit)
-            .filter_map(|r| match &r.shape {
-                crate::geometry::Implicit::Instance(m) => Some(&m.mesh),
-                _ => None,
+            .map(|g| {
+                let mut placed: std::collections::HashMap<
+                    *const crate::geometry::IndexedMesh,
+                    u64,
+                > = Default::default();
+                for r in &g.geometry.implicit {
+                    if let crate::geometry::Implicit::Instance(m) = &r.shape {
+                        *placed.entry(std::sync::Arc::as_ptr(&m.mesh)).or_default() += m.len();
+                    }
+                }
+                g.geometry
+                    .implicit
+                    .iter()
+                    .filter_map(|r| match &r.shape {
+                        crate::geometry::Implicit::Instance(m) => Some(m),
+                        _ => None,
+                    })
+                    .map(|m| {
+                        let all = placed.insert(std::sync::Arc::as_ptr(&m.mesh), 0);
+                        match all {
+                            // Met before: counted at its first placement.
+                            None | Some(0) => 0,
+                            // The first placement met: the mesh's cost in this group.
+                            Some(n) if n <= crate::geometry::INSTANCE_OVER => {
+                                n.saturating_mul(crate::memory::BYTES_PER_PRIMITIVE)
+                            }
+                            Some(_) => m
+                                .len()
+                                .saturating_mul(crate::memory::BYTES_PER_HELD_TRIANGLE),
+                        }
+                    })
+                    .fold(0, u64::saturating_add)
             })
-            .filter(|m| shared.insert(std::sync::Arc::as_ptr(m)))
-            .map(|m| {
-                m.len()
-                    .saturating_mul(crate::memory::BYTES_PER_HELD_TRIANGLE)
-            })
-            .sum();
+            .fold(0, u64::saturating_add);
         stars.saturating_add(meshes).saturating_add(
             self.groups
                 .iter()

@@ -19,8 +19,12 @@ use std::sync::Arc;
 pub(super) struct SharedMeshes {
     /// How many entries place each mesh file.
     uses: HashMap<PathBuf, usize>,
-    /// The files of named mesh objects, by name: what an instance's `of` names.
-    named: HashMap<String, PathBuf>,
+    /// The files of named mesh objects, by name (each file once): what an instance's `of`
+    /// names. Names need not be unique across groups; an `of` naming meshes of two files is
+    /// refused.
+    named: HashMap<String, Vec<PathBuf>>,
+    /// The names of meshes given inline, which an instance cannot place.
+    inline: std::collections::HashSet<String>,
     /// Files placed more than once, read.
     read: HashMap<PathBuf, Arc<Shared>>,
 }
@@ -51,12 +55,18 @@ impl SharedMeshes {
                 match o.string("type")? {
                     Some("mesh") => {
                         let Some(file) = o.string("file")? else {
+                            if let Some(name) = o.string("name")? {
+                                s.inline.insert(name.to_string());
+                            }
                             continue;
                         };
                         let path = key(o.path_beside(file));
                         *s.uses.entry(path.clone()).or_default() += 1;
                         if let Some(name) = o.string("name")? {
-                            s.named.insert(name.to_string(), path);
+                            let files = s.named.entry(name.to_string()).or_default();
+                            if !files.contains(&path) {
+                                files.push(path);
+                            }
                         }
                     }
                     Some("instance") => {
@@ -69,7 +79,7 @@ impl SharedMeshes {
             }
         }
         for of in instances {
-            if let Some(path) = s.named.get(&of) {
+            if let Some([path]) = s.named.get(&of).map(Vec::as_slice) {
                 *s.uses.entry(path.clone()).or_default() += 1;
             }
         }
@@ -88,7 +98,27 @@ impl SharedMeshes {
     /// The file the instance entry `t` places (its `of`: a named mesh object read from a file).
     pub fn file_of_instance(&self, t: &Table) -> SceneResult<PathBuf> {
         let of = t.req_string("of")?;
-        self.named.get(of).cloned().ok_or_else(|| {
+        let at = t.get("of").expect("read above");
+        match self.named.get(of).map(Vec::as_slice) {
+            Some([path]) => return Ok(path.clone()),
+            Some(paths) => {
+                let files: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+                return Err(t.error_at(
+                    at,
+                    "of",
+                    format!("mesh objects of several files are named `{of}` ({}): give them names of their own", files.join(", ")),
+                ));
+            }
+            None if self.inline.contains(of) => {
+                return Err(t.error_at(
+                    at,
+                    "of",
+                    format!("the mesh `{of}` is given inline (vertices, indices): an instance places a mesh read from a file"),
+                ));
+            }
+            None => {}
+        }
+        Err({
             let mut known: Vec<&str> = self.named.keys().map(String::as_str).collect();
             known.sort_unstable();
             let known = if known.is_empty() {
@@ -96,9 +126,8 @@ impl SharedMeshes {
             } else {
                 format!("named ones: {}", known.join(", "))
             };
-            let n = t.get("of").expect("read above");
             t.error_at(
-                n,
+                at,
                 "of",
                 format!("no mesh object is named `{of}`: an instance places a mesh read from a file (type = \"mesh\", file = ..., name = \"{of}\"); {known}"),
             )
@@ -152,43 +181,6 @@ impl Shared {
     /// How many triangles.
     pub fn len(&self) -> u64 {
         self.mesh.len()
-    }
-
-    /// The mesh as read, in its own coordinates: what a copy of it is made from.
-    pub fn data(&self) -> super::mesh_file::MeshData {
-        let corners = |take: &dyn Fn(&Corners) -> bool| {
-            self.runs
-                .iter()
-                .all(|(_, _, c)| c.as_ref().is_some_and(|c| take(c)))
-        };
-        let normals = corners(&|c| c.normals.is_some()).then(|| {
-            self.runs
-                .iter()
-                .flat_map(|(_, _, c)| {
-                    c.as_ref()
-                        .and_then(|c| c.normals.clone())
-                        .unwrap_or_default()
-                })
-                .collect()
-        });
-        let uvs = corners(&|c| c.uvs.is_some()).then(|| {
-            self.runs
-                .iter()
-                .flat_map(|(_, _, c)| c.as_ref().and_then(|c| c.uvs.clone()).unwrap_or_default())
-                .collect()
-        });
-        super::mesh_file::MeshData {
-            positions: self.mesh.positions().to_vec(),
-            triangles: self.mesh.triangles().to_vec(),
-            normals,
-            uvs,
-            materials: self.materials.clone(),
-            material_of: self
-                .runs
-                .iter()
-                .flat_map(|&(n, k, _)| std::iter::repeat_n(k, n as usize))
-                .collect(),
-        }
     }
 
     /// The material names the file uses.

@@ -144,7 +144,10 @@ const MAPPED: [&str; 4] = [
 ];
 
 /// Read the glTF file at `path`.
-pub(crate) fn read(path: &Path) -> Result<GltfData, GltfError> {
+/// Read the glTF file at `path`. A mesh that several nodes place is held once, unless a node
+/// placing it is a group of its own (`split_all`: every top-level node; else a keyframed one),
+/// whose group is built alone: it holds a copy.
+pub(crate) fn read(path: &Path, split_all: bool) -> Result<GltfData, GltfError> {
     let bytes = read_file(path)?;
     let gltf = parse(&bytes)?;
     drop(bytes);
@@ -187,6 +190,7 @@ pub(crate) fn read(path: &Path) -> Result<GltfData, GltfError> {
         warnings,
         uses: mesh_uses(&scene, gltf.meshes().len()),
         shared: Default::default(),
+        share: true,
     };
     let mut nodes = Vec::new();
     for (top, node) in scene.nodes().enumerate() {
@@ -197,6 +201,7 @@ pub(crate) fn read(path: &Path) -> Result<GltfData, GltfError> {
             let at0 = translation_at(k, 0.0);
             local.w_axis = at0.extend(1.0);
         }
+        reading.share = !split_all && keys.is_none();
         let (mut mesh, mut placements) = (MeshData::default(), Vec::new());
         reading.walk(&node, local, top, 0, &mut mesh, &mut placements)?;
         let name = node

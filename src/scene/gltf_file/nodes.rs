@@ -30,6 +30,9 @@ pub(super) struct Reading<'a> {
     pub uses: Vec<usize>,
     /// The meshes placed by several nodes, read once in their own coordinates, by index.
     pub shared: std::collections::BTreeMap<usize, MeshData>,
+    /// Whether the top-level node being walked may hold placements of shared meshes (else it
+    /// is a group of its own, and holds copies).
+    pub share: bool,
 }
 
 /// A node's placement of a mesh that several nodes place: the mesh's index and where the
@@ -65,13 +68,24 @@ impl Reading<'_> {
             // A mirroring placement turns the triangles' winding, which a shared mesh cannot
             // do per placement: it is copied.
             let mirrors = DMat3::from_mat4(world).determinant() < 0.0;
-            if self.uses[m.index()] > 1 && !mirrors {
+            if self.share && self.uses[m.index()] > 1 && !mirrors {
                 if !self.shared.contains_key(&m.index()) {
                     let mut own = MeshData::default();
                     self.add_mesh(&m, DMat4::IDENTITY, &mut own)?;
                     self.shared.insert(m.index(), own);
                 }
-                placements.push((m.index(), world));
+                // As `add_mesh` refuses it for a copy.
+                if DMat3::from_mat4(world).determinant() == 0.0 {
+                    return Err(format!(
+                        "mesh {} is placed by a transform that flattens it",
+                        m.index()
+                    )
+                    .into());
+                }
+                // A mesh of no triangles (points, lines: warned) places nothing.
+                if !self.shared[&m.index()].triangles.is_empty() {
+                    placements.push((m.index(), world));
+                }
             } else {
                 self.add_mesh(&m, world, mesh)?;
             }

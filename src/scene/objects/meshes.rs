@@ -16,18 +16,19 @@ fn mesh_budget(
     t: &Table,
     total: &mut u64,
     mesh: &crate::scene::mesh_file::MeshData,
+    key: &str,
 ) -> SceneResult<()> {
     use crate::memory::{BYTES_PER_CORNER_NORMALS, BYTES_PER_CORNER_UVS, BYTES_PER_HELD_TRIANGLE};
     let n = mesh.triangles.len() as u64;
     let corners = u64::from(mesh.normals.is_some()) * BYTES_PER_CORNER_NORMALS
         + u64::from(mesh.uvs.is_some()) * BYTES_PER_CORNER_UVS;
     if n <= crate::geometry::INSTANCE_OVER {
-        return budget(t, "file", total, n);
+        return budget(t, key, total, n);
     }
     let need = n.saturating_mul(BYTES_PER_HELD_TRIANGLE + corners);
     let what = format!("a mesh of {n} triangles");
     if let Some(why) = crate::memory::too_much(need, &what) {
-        return Err(at_value(t, "file", why));
+        return Err(at_value(t, key, why));
     }
     Ok(())
 }
@@ -112,7 +113,7 @@ pub(in crate::scene) fn add_mesh_data(
     chosen: Vec<u32>,
     mats: &HashMap<String, u32>,
 ) -> SceneResult<()> {
-    mesh_budget(t, total, &mesh)?;
+    mesh_budget(t, total, &mesh, "file")?;
     // The corner data, moved out of the mesh as read; normals turn with the mesh and
     // take the inverse of its scale.
     let normals = match transform {
@@ -212,7 +213,7 @@ impl Adding<'_, '_> {
         }
         let shared = meshes.get(path.clone(), || {
             let mesh = read_mesh_at(t, key, path)?;
-            mesh_budget(t, total, &mesh)?;
+            mesh_budget(t, total, &mesh, "file")?;
             Ok(mesh)
         })?;
         // Each placement costs a little of its own; the mesh was counted when read.
