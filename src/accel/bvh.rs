@@ -33,7 +33,7 @@ enum Held {
 }
 
 impl Held {
-    fn build(run: &crate::geometry::ImplicitRun, trees: &mut MeshTrees) -> Held {
+    fn build(run: &crate::geometry::ImplicitRun, trees: &MeshTrees) -> Held {
         use crate::geometry::Implicit;
         match &run.shape {
             Implicit::Mesh(m) => Held::Mesh(MeshTree::build(run.first, m)),
@@ -81,26 +81,35 @@ impl NodeSet for Nodes64 {
     }
 }
 
-pub struct BvhBackend;
+/// The f64 BVH backend; it keeps the trees over shared meshes for every group it builds.
+#[derive(Default)]
+pub struct BvhBackend {
+    trees: MeshTrees,
+}
 
 impl Backend for BvhBackend {
     fn name(&self) -> &'static str {
         "bvh"
     }
     fn build(&self, geometry: Arc<Geometry>) -> crate::Result<Box<dyn Accelerator>> {
-        Ok(Box::new(Bvh::<Nodes64>::build(geometry)))
+        Ok(Box::new(Bvh::<Nodes64>::build_with(geometry, &self.trees)))
     }
 }
 
 impl<N: NodeSet> Bvh<N> {
     pub fn build(geometry: Arc<Geometry>) -> Bvh<N> {
+        Self::build_with(geometry, &MeshTrees::default())
+    }
+
+    /// The BVH over `geometry`, its shared meshes' trees taken from `trees` (built there when
+    /// new).
+    pub(super) fn build_with(geometry: Arc<Geometry>, trees: &MeshTrees) -> Bvh<N> {
         let boxes: Vec<Aabb> = geometry.prims.iter().map(|p| p.bounds()).collect();
         let BoxTree { nodes, indices } = BoxTree::build(&boxes);
-        let mut trees = MeshTrees::default();
         let instanced: Vec<Held> = geometry
             .implicit
             .iter()
-            .map(|r| Held::build(r, &mut trees))
+            .map(|r| Held::build(r, trees))
             .collect();
         let held_tree = (instanced.len() > HELD_TREE_OVER).then(|| {
             // Padded: the objects' own walks decide, the boxes only pass rays on to them.

@@ -8,19 +8,25 @@ use super::{Hit, Ray};
 use crate::geometry::{Aabb, BoxTree, IndexedMesh, MeshInstance};
 use glam::DVec3;
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
-/// The trees over shared meshes, one per mesh, by the mesh's address.
+/// The trees over shared meshes, one per mesh, by the mesh's address: kept by the backend, so
+/// that every velocity group placing a mesh walks the one tree. Each entry holds its mesh, so
+/// no other mesh can take its address while it is kept.
 #[derive(Default)]
-pub(super) struct MeshTrees(HashMap<*const IndexedMesh, Arc<BoxTree>>);
+pub(crate) struct MeshTrees(Mutex<HashMap<usize, MeshTree>>);
+
+/// A shared mesh and the tree over its triangles.
+type MeshTree = (Arc<IndexedMesh>, Arc<BoxTree>);
 
 impl MeshTrees {
     /// The tree over `mesh`'s triangles in its own coordinates, built on first use. Its boxes
     /// are padded by far more than the rounding of a ray moved into a placement's frame, so
     /// the walk there never misses a triangle the placed ray meets.
-    fn of(&mut self, mesh: &Arc<IndexedMesh>) -> Arc<BoxTree> {
-        self.0
-            .entry(Arc::as_ptr(mesh))
+    fn of(&self, mesh: &Arc<IndexedMesh>) -> Arc<BoxTree> {
+        let mut trees = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        trees
+            .entry(Arc::as_ptr(mesh) as usize)
             .or_insert_with(|| {
                 let b = mesh.bounds();
                 let pad = DVec3::splat(1e-7 * b.diagonal() + 1e-9 * b.max_abs());
@@ -30,8 +36,9 @@ impl MeshTrees {
                         Aabb::new(t.min - pad, t.max + pad)
                     })
                     .collect();
-                Arc::new(BoxTree::build(&boxes))
+                (mesh.clone(), Arc::new(BoxTree::build(&boxes)))
             })
+            .1
             .clone()
     }
 }
@@ -44,7 +51,7 @@ pub(super) struct InstanceTree {
 }
 
 impl InstanceTree {
-    pub fn build(first: u32, instance: &Arc<MeshInstance>, trees: &mut MeshTrees) -> InstanceTree {
+    pub fn build(first: u32, instance: &Arc<MeshInstance>, trees: &MeshTrees) -> InstanceTree {
         InstanceTree {
             first,
             instance: instance.clone(),

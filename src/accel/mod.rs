@@ -337,7 +337,7 @@ pub(crate) const EMBREE_WIDTHS: [&str; 4] = ["embree-16", "embree-8", "embree-4"
 /// The backend of that name, or an error that lists the choices.
 pub fn backend_by_name(name: &str) -> crate::Result<Box<dyn Backend>> {
     match name {
-        "bvh" => Ok(Box::new(BvhBackend)),
+        "bvh" => Ok(Box::new(BvhBackend::default())),
         // The f64 BVH's tree with f32 nodes, for comparisons.
         "bvh-f32" => Ok(Box::new(Bvh32Backend)),
         // The instruction set and test hook the environment asks for (`EmbreeBackend::configured_by_env`).

@@ -505,7 +505,8 @@ impl Scene {
             .sum::<u64>();
         // A shared mesh's placements in a group: listed when all of them together are at
         // most `INSTANCE_OVER` triangles (as the world lists them), else the mesh once for the
-        // group (each group's backend builds over it) and each placement its own.
+        // scene (the backend builds over it once for every group) and each placement its own.
+        let mut held = std::collections::HashSet::new();
         let meshes: u64 = self
             .groups
             .iter()
@@ -535,9 +536,10 @@ impl Scene {
                             Some(n) if n <= crate::geometry::INSTANCE_OVER => {
                                 n.saturating_mul(crate::memory::BYTES_PER_PRIMITIVE)
                             }
-                            Some(_) => m
+                            Some(_) if held.insert(std::sync::Arc::as_ptr(&m.mesh)) => m
                                 .len()
                                 .saturating_mul(crate::memory::BYTES_PER_HELD_TRIANGLE),
+                            Some(_) => 0,
                         }
                     })
                     .fold(0, u64::saturating_add)

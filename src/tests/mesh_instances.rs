@@ -272,7 +272,8 @@ fn instances_hit_as_copies_on_both_backends() {
 }
 
 /// A scene file that places one mesh file four times (three entries naming the file, one an
-/// `instance` of a named one), against the same placements from four files of the same
+/// `instance` of a named one, in a group of its own: each backend builds over the mesh once
+/// for both groups), against the same placements from four files of the same
 /// triangles (so each is read and placed as a copy): the same frame, on both backends, at
 /// rest and moving, the placements held as instances (`instance_over` 0) or listed.
 #[test]
@@ -338,6 +339,11 @@ file = "{}"
 translate = [-3.5, 2, 0.5]
 scale = 1.3
 
+# A group of its own, moving otherwise: the mesh shared across groups too.
+[[group]]
+name = "more"
+velocity = [0, 0.3, 0]
+
 [[group.object]]
 {fourth}
 material = "shiny"
@@ -353,22 +359,24 @@ rotate = {{ axis = [0, 0, 1], degrees = 90 }}
         let path = dir.join("scene.toml");
         let shared = crate::scene::load_str(path.to_str().unwrap(), &shared_text, &[]).unwrap();
         let copies = crate::scene::load_str(path.to_str().unwrap(), &copies_text, &[]).unwrap();
-        let g = &shared.groups[0].geometry;
-        let held: Vec<_> = g
-            .implicit
+        let held: Vec<_> = shared
+            .groups
             .iter()
+            .flat_map(|g| &g.geometry.implicit)
             .filter_map(|r| match &r.shape {
                 Implicit::Instance(m) => Some(Arc::as_ptr(&m.mesh)),
                 _ => None,
             })
             .collect();
-        assert_eq!(held.len(), 4, "four placements of one mesh");
+        assert_eq!(held.len(), 4, "four placements of one mesh, in two groups");
         assert!(held.iter().all(|&m| m == held[0]));
         // The same triangles, to the bit, as the copies.
-        let c = &copies.groups[0].geometry;
-        assert_eq!(g.len(), c.len());
-        for i in (0..g.len()).step_by(5) {
-            assert_eq!(g.prim(i), c.prim(i), "triangle {i}");
+        for (g, c) in shared.groups.iter().zip(&copies.groups) {
+            let (g, c) = (&g.geometry, &c.geometry);
+            assert_eq!(g.len(), c.len());
+            for i in (0..g.len()).step_by(5) {
+                assert_eq!(g.prim(i), c.prim(i), "triangle {i}");
+            }
         }
         for name in crate::accel::backend_names() {
             let backend = backend_by_name(name).unwrap();

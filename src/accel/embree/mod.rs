@@ -45,6 +45,9 @@ pub struct EmbreeBackend {
     isa: Option<Isa>,
     /// What went wrong in a callback while tracing.
     faults: Arc<Faults>,
+    /// The Embree scenes of meshes several objects place, made on this backend's device and
+    /// shared by every group's scene that instances them.
+    mesh_scenes: Arc<scene::MeshScenes>,
     /// A test hook: a user-geometry callback panics (`REST_EMBREE_FAULT=callback`), to prove
     /// that the panic is caught at the FFI boundary and the render fails with an error.
     inject_fault: Option<Option<Callback>>,
@@ -61,6 +64,7 @@ impl EmbreeBackend {
             isa: None,
             faults: Arc::default(),
             inject_fault: None,
+            mesh_scenes: Arc::default(),
         }
     }
 
@@ -81,8 +85,9 @@ impl EmbreeBackend {
     pub fn on_isa(self, isa: Isa) -> crate::Result<Self> {
         Ok(Self {
             isa: Some(isa.checked()?),
-            // A device already made runs another.
+            // A device already made runs another (and its scenes go with it).
             device: OnceLock::new(),
+            mesh_scenes: Arc::default(),
             ..self
         })
     }
@@ -98,6 +103,7 @@ impl EmbreeBackend {
         Self {
             inject_fault: Some(callback),
             device: OnceLock::new(),
+            mesh_scenes: Arc::default(),
             ..self
         }
     }
@@ -124,7 +130,7 @@ impl EmbreeBackend {
     pub fn accelerator(&self, geometry: Arc<Geometry>) -> crate::Result<EmbreeAccel> {
         let device = self.device()?;
         let width = self.packet_width.unwrap_or(device.native_width());
-        let scene = scene::EmbreeScene::build(device.clone(), &geometry)?;
+        let scene = scene::EmbreeScene::build(device.clone(), &geometry, &self.mesh_scenes)?;
         let bounds = geometry.bounds();
         let diag = bounds.diagonal();
         Ok(EmbreeAccel {

@@ -128,7 +128,11 @@ pub struct EmbreeScene {
 }
 
 impl EmbreeScene {
-    pub fn build(device: Arc<Device>, geo: &SceneGeometry) -> crate::Result<EmbreeScene> {
+    pub fn build(
+        device: Arc<Device>,
+        geo: &SceneGeometry,
+        scenes: &MeshScenes,
+    ) -> crate::Result<EmbreeScene> {
         let center = geo.bounds().centroid();
         let center = if center.is_finite() {
             center
@@ -234,7 +238,7 @@ impl EmbreeScene {
         // Placements of shared meshes: one Embree scene per mesh, an instance per placement,
         // after every other geometry.
         let mesh_instances =
-            attach_mesh_instances(&device, &mut builder, geo, center, first_instance)?;
+            attach_mesh_instances(&device, &mut builder, geo, center, first_instance, scenes)?;
         let exact_runs = ExactRuns::of(&maps).filter(|_| mesh_instances.is_empty());
         Ok(EmbreeScene {
             rtc: builder.commit()?,
@@ -285,6 +289,38 @@ fn user_geometry<S: Shape>(device: &Arc<Device>, shapes: &Shapes<S>) -> crate::R
     Ok(g)
 }
 
+/// The Embree scenes of shared meshes, one per mesh (about its own centre), by the mesh's
+/// address: kept by the backend, so that every velocity group placing a mesh instances the one
+/// scene. Each entry holds its mesh (whose index buffer the scene reads in place), so no other
+/// mesh can take its address while it is kept.
+#[derive(Default)]
+pub struct MeshScenes(std::sync::Mutex<std::collections::HashMap<usize, MeshScene>>);
+
+/// A shared mesh, its Embree scene, and the centre the scene's coordinates are taken about.
+type MeshScene = (Arc<IndexedMesh>, Arc<CommittedScene>, DVec3);
+
+impl MeshScenes {
+    /// `mesh`'s scene and the centre its coordinates are taken about, built on first use.
+    fn of(
+        &self,
+        device: &Arc<Device>,
+        mesh: &Arc<IndexedMesh>,
+    ) -> crate::Result<(Arc<CommittedScene>, DVec3)> {
+        let mut scenes = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let key = Arc::as_ptr(mesh) as usize;
+        if let Some((_, scene, own)) = scenes.get(&key) {
+            return Ok((scene.clone(), *own));
+        }
+        let own = mesh.bounds().centroid();
+        let own = if own.is_finite() { own } else { DVec3::ZERO };
+        let mut child = SceneBuilder::new(device)?;
+        child.attach(mesh_geometry(device, mesh, own)?)?;
+        let scene = Arc::new(child.commit()?);
+        scenes.insert(key, (mesh.clone(), scene.clone(), own));
+        Ok((scene, own))
+    }
+}
+
 /// Each placement of a shared mesh in `geo` as an Embree instance, as geomIDs `first_id ..`:
 /// the mesh once, as its own scene about its own centre, and each placement's map from it to
 /// this scene's coordinates (less `center`), made in f64 and cast to f32.
@@ -294,9 +330,8 @@ fn attach_mesh_instances(
     geo: &SceneGeometry,
     center: DVec3,
     first_id: u32,
+    scenes: &MeshScenes,
 ) -> crate::Result<MeshInstances> {
-    let mut scenes: std::collections::HashMap<*const IndexedMesh, (CommittedScene, DVec3)> =
-        std::collections::HashMap::new();
     let mut out = MeshInstances {
         first_id,
         firsts: Vec::new(),
@@ -305,16 +340,8 @@ fn attach_mesh_instances(
         let Implicit::Instance(inst) = &run.shape else {
             continue;
         };
-        let (scene, own) = match scenes.entry(Arc::as_ptr(&inst.mesh)) {
-            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                let own = inst.mesh.bounds().centroid();
-                let own = if own.is_finite() { own } else { DVec3::ZERO };
-                let mut child = SceneBuilder::new(device)?;
-                child.attach(mesh_geometry(device, &inst.mesh, own)?)?;
-                e.insert((child.commit()?, own))
-            }
-        };
+        let (scene, own) = scenes.of(device, &inst.mesh)?;
+        let own = &own;
         // x in the mesh's scene is the mesh's point x + own; placed, less `center`:
         // A (x + own) + translate - center, with A the linear map times the scale.
         let x = &inst.place;
@@ -326,7 +353,7 @@ fn attach_mesh_instances(
             *slot = *v as f32;
         }
         let mut g = Geometry::new(device, RTC_GEOMETRY_TYPE_INSTANCE)?;
-        g.set_instance_affine(scene, xfm);
+        g.set_instance_affine(&scene, xfm);
         builder.attach_as(g, first_id + out.firsts.len() as u32)?;
         out.firsts.push(run.first);
     }
