@@ -11,13 +11,14 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
 /// The trees over shared meshes, one per mesh, by the mesh's address: kept by the backend, so
-/// that every velocity group placing a mesh walks the one tree. Each entry holds its mesh, so
-/// no other mesh can take its address while it is kept.
+/// that every velocity group placing a mesh walks the one tree. An entry lives while its mesh
+/// does: a dead mesh's entry is dropped before any lookup, so no other mesh found at its
+/// address is taken for it.
 #[derive(Default)]
 pub(crate) struct MeshTrees(Mutex<HashMap<usize, MeshTree>>);
 
-/// A shared mesh and the tree over its triangles.
-type MeshTree = (Arc<IndexedMesh>, Arc<BoxTree>);
+/// A shared mesh (while it lives) and the tree over its triangles.
+type MeshTree = (std::sync::Weak<IndexedMesh>, Arc<BoxTree>);
 
 impl MeshTrees {
     /// The tree over `mesh`'s triangles in its own coordinates, built on first use. Its boxes
@@ -25,21 +26,33 @@ impl MeshTrees {
     /// the walk there never misses a triangle the placed ray meets.
     fn of(&self, mesh: &Arc<IndexedMesh>) -> Arc<BoxTree> {
         let mut trees = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        trees
-            .entry(Arc::as_ptr(mesh) as usize)
-            .or_insert_with(|| {
-                let b = mesh.bounds();
-                let pad = DVec3::splat(1e-7 * b.diagonal() + 1e-9 * b.max_abs());
-                let boxes: Vec<Aabb> = (0..mesh.len())
-                    .map(|i| {
-                        let t = mesh.triangle(i).bounds();
-                        Aabb::new(t.min - pad, t.max + pad)
-                    })
-                    .collect();
-                (mesh.clone(), Arc::new(BoxTree::build(&boxes)))
+        // Meshes no longer held anywhere (a scene the viewer read again, say) leave with their
+        // trees.
+        trees.retain(|_, (m, _)| m.strong_count() > 0);
+        let key = Arc::as_ptr(mesh) as usize;
+        if let Some((m, tree)) = trees.get(&key) {
+            // Alive, at this address, it is this mesh.
+            if m.upgrade().is_some_and(|m| Arc::ptr_eq(&m, mesh)) {
+                return tree.clone();
+            }
+        }
+        let b = mesh.bounds();
+        let pad = DVec3::splat(1e-7 * b.diagonal() + 1e-9 * b.max_abs());
+        let boxes: Vec<Aabb> = (0..mesh.len())
+            .map(|i| {
+                let t = mesh.triangle(i).bounds();
+                Aabb::new(t.min - pad, t.max + pad)
             })
-            .1
-            .clone()
+            .collect();
+        let tree = Arc::new(BoxTree::build(&boxes));
+        trees.insert(key, (Arc::downgrade(mesh), tree.clone()));
+        tree
+    }
+
+    /// How many meshes it keeps trees for.
+    #[cfg(test)]
+    fn len(&self) -> usize {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).len()
     }
 }
 
@@ -106,5 +119,32 @@ impl InstanceTree {
             },
         );
         best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mesh(n: usize) -> Arc<IndexedMesh> {
+        let positions = (0..n + 2)
+            .map(|i| DVec3::new(i as f64, (i % 2) as f64, 0.0))
+            .collect();
+        let triangles = (0..n as u32).map(|i| [i, i + 1, i + 2]).collect();
+        Arc::new(IndexedMesh::new(positions, triangles))
+    }
+
+    /// A tree is kept while its mesh lives, shared by every lookup of it, and dropped with it.
+    #[test]
+    fn trees_live_as_long_as_their_meshes() {
+        let trees = MeshTrees::default();
+        let a = mesh(5);
+        let t = trees.of(&a);
+        assert!(Arc::ptr_eq(&t, &trees.of(&a)));
+        assert_eq!(t.indices.len(), 5);
+        drop(a);
+        let b = mesh(7);
+        assert_eq!(trees.of(&b).indices.len(), 7);
+        assert_eq!(trees.len(), 1, "the dead mesh's tree is dropped");
     }
 }

@@ -476,3 +476,68 @@ type = "instance"
         "{e}"
     );
 }
+
+/// A backend keeps the structures it built over shared meshes for every group (and every
+/// world) it builds; a scene read again, its mesh file changed in between (as the viewer reads
+/// a scene after each edit), renders as a fresh backend renders it. (Whether the new mesh
+/// lies where the old one did is the allocator's choice; the caches take an entry only for the
+/// live mesh it was built for, `MeshTrees`' test holds them to that.)
+#[test]
+fn a_backend_reused_across_scenes_renders_each_as_a_fresh_one() {
+    use crate::render::{render_world, World, WorldOptions};
+    let dir = std::env::temp_dir().join(format!("rest-embree-reuse-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = r#"
+[camera]
+position = [0, -9, 3]
+look_at = [0, 0, 0]
+[image]
+width = 64
+height = 48
+[[light]]
+position = [5, -10, 12]
+intensity = 1
+[[group]]
+name = "a"
+[[group.object]]
+type = "mesh"
+file = "ball.obj"
+[[group]]
+name = "b"
+velocity = [0.3, 0, 0]
+[[group.object]]
+type = "mesh"
+file = "ball.obj"
+translate = [2.5, 0, 0]
+"#;
+    let options = WorldOptions {
+        instance_over: 0,
+        ..WorldOptions::default()
+    };
+    for name in crate::accel::backend_names() {
+        let kept = backend_by_name(name).unwrap();
+        for (nlat, nlon) in [(12, 20), (6, 8), (12, 20)] {
+            std::fs::write(dir.join("ball.obj"), obj(&ball(nlat, nlon))).unwrap();
+            let path = dir.join("scene.toml");
+            let scene = crate::scene::load_str(path.to_str().unwrap(), text, &[]).unwrap();
+            let fresh = backend_by_name(name).unwrap();
+            let a = render_world(
+                &scene,
+                &World::build_with(&scene, kept.as_ref(), options).unwrap(),
+            )
+            .0;
+            let b = render_world(
+                &scene,
+                &World::build_with(&scene, fresh.as_ref(), options).unwrap(),
+            )
+            .0;
+            assert!(a.pixels.iter().any(|p| p.object_id > 0));
+            let differ = super::differing_pixels(&a, &b);
+            assert_eq!(
+                differ, 0,
+                "{name}, ball {nlat}x{nlon}: {differ} pixels differ"
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

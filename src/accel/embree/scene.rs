@@ -291,13 +291,14 @@ fn user_geometry<S: Shape>(device: &Arc<Device>, shapes: &Shapes<S>) -> crate::R
 
 /// The Embree scenes of shared meshes, one per mesh (about its own centre), by the mesh's
 /// address: kept by the backend, so that every velocity group placing a mesh instances the one
-/// scene. Each entry holds its mesh (whose index buffer the scene reads in place), so no other
-/// mesh can take its address while it is kept.
+/// scene. An entry lives while its mesh does (the mesh's index buffer is the scene's, read in
+/// place; every `EmbreeScene` instancing it holds the mesh): a dead mesh's entry is dropped
+/// before any lookup, so no other mesh found at its address is taken for it.
 #[derive(Default)]
 pub struct MeshScenes(std::sync::Mutex<std::collections::HashMap<usize, MeshScene>>);
 
 /// A shared mesh, its Embree scene, and the centre the scene's coordinates are taken about.
-type MeshScene = (Arc<IndexedMesh>, Arc<CommittedScene>, DVec3);
+type MeshScene = (std::sync::Weak<IndexedMesh>, Arc<CommittedScene>, DVec3);
 
 impl MeshScenes {
     /// `mesh`'s scene and the centre its coordinates are taken about, built on first use.
@@ -307,16 +308,22 @@ impl MeshScenes {
         mesh: &Arc<IndexedMesh>,
     ) -> crate::Result<(Arc<CommittedScene>, DVec3)> {
         let mut scenes = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        // Meshes no longer held anywhere (a scene the viewer read again, say) leave with their
+        // scenes: nothing traces those any more, since every scene instancing one holds its mesh.
+        scenes.retain(|_, (m, _, _)| m.strong_count() > 0);
         let key = Arc::as_ptr(mesh) as usize;
-        if let Some((_, scene, own)) = scenes.get(&key) {
-            return Ok((scene.clone(), *own));
+        if let Some((m, scene, own)) = scenes.get(&key) {
+            // Alive, at this address, it is this mesh.
+            if m.upgrade().is_some_and(|m| Arc::ptr_eq(&m, mesh)) {
+                return Ok((scene.clone(), *own));
+            }
         }
         let own = mesh.bounds().centroid();
         let own = if own.is_finite() { own } else { DVec3::ZERO };
         let mut child = SceneBuilder::new(device)?;
         child.attach(mesh_geometry(device, mesh, own)?)?;
         let scene = Arc::new(child.commit()?);
-        scenes.insert(key, (mesh.clone(), scene.clone(), own));
+        scenes.insert(key, (Arc::downgrade(mesh), scene.clone(), own));
         Ok((scene, own))
     }
 }
