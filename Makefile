@@ -59,10 +59,16 @@ test: setup
 	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --workspace --test suite -q -- path::the_lanes_change_no_picture || exit 1; \
 	  fi; \
 	done
-	scripts/slurm-test.sh target/release/rest-embree
-	scripts/browser-test.sh target/release/rest-embree
-	scripts/python-test.sh target/release/rest-embree
-	scripts/blender-test.sh target/release/rest-embree
+	@# The SLURM cluster's test waits on its scheduler most of its time: it runs beside the
+	@# browser's, Python's and Blender's, its output shown when it ends.
+	@echo "scripts/slurm-test.sh target/release/rest-embree (beside the next three; its output follows them)"
+	@scripts/slurm-test.sh target/release/rest-embree >target/slurm-test.log 2>&1 & slurm=$$!; \
+	  scripts/browser-test.sh target/release/rest-embree && \
+	  scripts/python-test.sh target/release/rest-embree && \
+	  scripts/blender-test.sh target/release/rest-embree; rest=$$?; \
+	  wait $$slurm; cluster=$$?; cat target/slurm-test.log; \
+	  [ $$cluster -eq 0 ] || echo "make test: FAILED: scripts/slurm-test.sh (above)" >&2; \
+	  [ $$rest -eq 0 ] && [ $$cluster -eq 0 ]
 
 # The Python package (python/): `import rest_embree` in the virtual environment VENV (default
 # .venv here); see docs/python.md.
