@@ -4,6 +4,14 @@
 # table and summary as it wrote them. No figure here is typed by hand.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# A comparison with Mitsuba 3 as scripts/mitsuba-*.py wrote it, or why there is none.
+mitsuba_table() {
+  if [ -f "$1" ]; then
+    cat "$1"
+  else
+    echo 'Not measured: Mitsuba 3 was not installed where `make docs` ran (`pip install mitsuba`).'
+  fi
+}
 bench=docs/bench/bench.md
 [ -f "$bench" ] || { echo "performance-doc: $bench is missing: run rest-embree bench --out docs/bench" >&2; exit 1; }
 {
@@ -89,18 +97,10 @@ echo '(scripts/mitsuba-compare.py; `make docs` runs it where Mitsuba is installe
 echo "49): the time to Mitsuba's error at most Mitsuba's whole process, a sample at most 1.5x"
 echo "Mitsuba's warm render, the noise at equal samples within 3% of Mitsuba's."
 echo
-if [ -f docs/bench/mitsuba.md ]; then
-  cat docs/bench/mitsuba.md
-else
-  echo 'Not measured: Mitsuba 3 was not installed where `make docs` ran (`pip install mitsuba`).'
-fi
+mitsuba_table docs/bench/mitsuba.md
 echo
 echo '## A big mesh beside Mitsuba 3'
 echo
-if [ -f docs/bench/terrain.md ]; then
-  cat docs/bench/terrain.md
-else
-  echo 'Not measured: Mitsuba 3 was not installed where `make docs` ran (`pip install mitsuba`).'
-fi
+mitsuba_table docs/bench/terrain.md
 } > docs/performance.md
 echo "performance-doc: wrote docs/performance.md"

@@ -82,6 +82,42 @@ fn write_ply_terrain(path: &std::path::Path, triangles: usize) -> std::io::Resul
     Ok(faces)
 }
 
+/// What reading, building and rendering a scene file cost: its frame, the seconds of each
+/// step, and the peak memory above the process's start, after reading and at the end (MiB).
+struct Measured {
+    frame: crate::render::Frame,
+    read: f64,
+    read_peak: f64,
+    build: f64,
+    render: f64,
+    peak: f64,
+}
+
+/// Read the scene file at `path`, build its world on `backend` and render it, measuring each.
+fn measure(path: &std::path::Path, backend: &str) -> Result<Measured, Box<dyn std::error::Error>> {
+    reset_peak();
+    let base = peak_mib().unwrap_or(0.0);
+    let t0 = Instant::now();
+    let scene = crate::scene::load_file(path, &[])?;
+    let read = t0.elapsed().as_secs_f64();
+    let read_peak = peak_mib().unwrap_or(0.0) - base;
+    let b = crate::accel::backend_by_name(backend)?;
+    let t1 = Instant::now();
+    let world = crate::render::World::build(&scene, b.as_ref())?;
+    let build = t1.elapsed().as_secs_f64();
+    let t2 = Instant::now();
+    let (frame, _) = crate::render::render_world(&scene, &world);
+    let render = t2.elapsed().as_secs_f64();
+    Ok(Measured {
+        frame,
+        read,
+        read_peak,
+        build,
+        render,
+        peak: peak_mib().unwrap_or(0.0) - base,
+    })
+}
+
 /// Write a terrain of about `triangles` triangles as a PLY file, then read it through a
 /// scene, build the world and render it at `size`², as a Markdown line with the time and
 /// peak memory of each step.
@@ -101,20 +137,14 @@ fn mesh_file_here(triangles: usize, size: u32, backend: &str) -> String {
         );
         let scene_path = dir.join("terrain.toml");
         std::fs::write(&scene_path, text)?;
-        reset_peak();
-        let base = peak_mib().unwrap_or(0.0);
-        let t0 = Instant::now();
-        let scene = crate::scene::load_file(&scene_path, &[])?;
-        let read = t0.elapsed().as_secs_f64();
-        let read_peak = peak_mib().unwrap_or(0.0) - base;
-        let b = crate::accel::backend_by_name(backend)?;
-        let t1 = Instant::now();
-        let world = crate::render::World::build(&scene, b.as_ref())?;
-        let build = t1.elapsed().as_secs_f64();
-        let t2 = Instant::now();
-        let (frame, _) = crate::render::render_world(&scene, &world);
-        let render = t2.elapsed().as_secs_f64();
-        let peak = peak_mib().unwrap_or(0.0) - base;
+        let Measured {
+            frame,
+            read,
+            read_peak,
+            build,
+            render,
+            peak,
+        } = measure(&scene_path, backend)?;
         let hit = frame.pixels.iter().filter(|p| p.color != [0.0; 3]).count();
         Ok(format!(
             "- mesh file, a binary PLY of {faces} triangles ({file_mb:.0} MB), {backend}, \
@@ -164,19 +194,14 @@ fn mesh_instances_here(placements: usize, triangles: usize, size: u32, backend: 
         }
         let scene_path = dir.join("field.toml");
         std::fs::write(&scene_path, text)?;
-        reset_peak();
-        let base = peak_mib().unwrap_or(0.0);
-        let t0 = Instant::now();
-        let scene = crate::scene::load_file(&scene_path, &[])?;
-        let read = t0.elapsed().as_secs_f64();
-        let b = crate::accel::backend_by_name(backend)?;
-        let t1 = Instant::now();
-        let world = crate::render::World::build(&scene, b.as_ref())?;
-        let build = t1.elapsed().as_secs_f64();
-        let t2 = Instant::now();
-        let (frame, _) = crate::render::render_world(&scene, &world);
-        let render = t2.elapsed().as_secs_f64();
-        let peak = peak_mib().unwrap_or(0.0) - base;
+        let Measured {
+            frame,
+            read,
+            build,
+            render,
+            peak,
+            ..
+        } = measure(&scene_path, backend)?;
         let hit = frame.pixels.iter().filter(|p| p.object_id > 0).count();
         let times = match placements {
             1 => "once".to_string(),

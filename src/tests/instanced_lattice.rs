@@ -3,8 +3,8 @@
 //! and lookback time to the bit, for rays from outside and inside, in packets and alone, and
 //! the same occlusion.
 
-use crate::accel::{backend_by_name, Accelerator, Hit, Ray};
-use crate::geometry::{BarArray, Geometry, Implicit, Lattice, Primitive};
+use crate::accel::{backend_by_name, Hit, Ray};
+use crate::geometry::{Aabb, BarArray, Geometry, Implicit, Lattice, Primitive};
 use crate::rng::Rng;
 use glam::DVec3;
 use std::sync::Arc;
@@ -57,51 +57,16 @@ fn geometry() -> Geometry {
     g
 }
 
-/// Rays from around and inside the geometry, aimed into it, with directions as long as a
-/// boost makes them.
+/// Rays from around and inside the geometry, aimed into it.
 fn rays(rng: &mut Rng, n: usize) -> Vec<Ray> {
-    (0..n)
-        .map(|i| {
-            let origin = if i % 3 == 0 {
-                DVec3::new(
-                    rng.range(-4.0, 18.0),
-                    rng.range(-6.5, 6.5),
-                    rng.range(-3.0, 10.0),
-                )
-            } else {
-                rng.unit() * 40.0
-            };
-            let target = DVec3::new(
-                rng.range(-5.0, 40.0),
-                rng.range(-8.0, 8.0),
-                rng.range(-4.0, 12.0),
-            );
-            let dir = (target - origin).normalize() * rng.range(0.5, 3.0);
-            // Searched all the way, or between two points (as shadow rays are).
-            let tmax = if i % 2 == 0 {
-                f64::INFINITY
-            } else {
-                rng.range(1.0, 30.0)
-            };
-            Ray::new(origin, dir, 1e-6, tmax)
-        })
-        .collect()
-}
-
-fn hits(accel: &dyn Accelerator, rays: &[Ray], width: usize) -> Vec<Option<Hit>> {
-    let mut out = vec![None; rays.len()];
-    for (r, h) in rays.chunks(width).zip(out.chunks_mut(width)) {
-        accel.intersect(r, h);
-    }
-    out
-}
-
-fn occluded(accel: &dyn Accelerator, rays: &[Ray], width: usize) -> Vec<bool> {
-    let mut out = vec![false; rays.len()];
-    for (r, o) in rays.chunks(width).zip(out.chunks_mut(width)) {
-        accel.occluded(r, o);
-    }
-    out
+    super::rays_toward(
+        rng,
+        n,
+        Aabb::new(DVec3::new(-4.0, -6.5, -3.0), DVec3::new(18.0, 6.5, 10.0)),
+        40.0,
+        Aabb::new(DVec3::new(-5.0, -8.0, -4.0), DVec3::new(40.0, 8.0, 12.0)),
+        30.0,
+    )
 }
 
 #[test]
@@ -118,8 +83,8 @@ fn held_lattices_hit_as_listed_ones() {
         let b = backend.build(listed.clone()).unwrap();
         for width in [1, 16] {
             let (ha, hb) = (
-                hits(a.as_ref(), &rays, width),
-                hits(b.as_ref(), &rays, width),
+                super::hits(a.as_ref(), &rays, width),
+                super::hits(b.as_ref(), &rays, width),
             );
             let hit = hb.iter().filter(|h| h.is_some()).count();
             assert!(hit > rays.len() / 3, "{name}: {hit} hits of {}", rays.len());
@@ -142,8 +107,8 @@ fn held_lattices_hit_as_listed_ones() {
                 differ.first().map(|&i| hb[i]),
             );
             let (oa, ob) = (
-                occluded(a.as_ref(), &rays, width),
-                occluded(b.as_ref(), &rays, width),
+                super::occluded(a.as_ref(), &rays, width),
+                super::occluded(b.as_ref(), &rays, width),
             );
             assert_eq!(oa, ob, "{name}, {width} wide");
             for (h, o) in hb.iter().zip(&ob) {

@@ -4,7 +4,7 @@
 //! same pictures, on both backends, at rest and moving.
 
 use crate::accel::{backend_by_name, Accelerator, Hit, Ray};
-use crate::geometry::{Affine, Geometry, Implicit, IndexedMesh, MeshInstance};
+use crate::geometry::{Aabb, Affine, Geometry, Implicit, IndexedMesh, MeshInstance};
 use crate::rng::Rng;
 use glam::{DMat3, DVec3};
 use std::sync::Arc;
@@ -141,49 +141,34 @@ fn geometries() -> (Geometry, Geometry) {
     (held, copies)
 }
 
-/// Rays from around and among the placements, with directions as long as a boost makes them,
-/// searched all the way or between two points.
+/// Rays from around and among the placements.
 fn rays(n: usize) -> Vec<Ray> {
-    let mut rng = Rng(0x1257_a9ce_5eed_0003);
-    (0..n)
-        .map(|i| {
-            let origin = if i % 4 == 0 {
-                DVec3::new(
-                    rng.range(-8.0, 11.0),
-                    rng.range(-6.0, 8.0),
-                    rng.range(-2.0, 3.0),
-                )
-            } else {
-                rng.unit() * 30.0
-            };
-            let target = DVec3::new(
-                rng.range(-8.0, 11.0),
-                rng.range(-6.0, 8.0),
-                rng.range(-2.0, 2.0),
-            );
-            let dir = (target - origin).normalize() * rng.range(0.5, 3.0);
-            let tmax = if i % 2 == 0 {
-                f64::INFINITY
-            } else {
-                rng.range(1.0, 40.0)
-            };
-            Ray::new(origin, dir, 1e-6, tmax)
-        })
-        .collect()
+    super::rays_toward(
+        &mut Rng(0x1257_a9ce_5eed_0003),
+        n,
+        Aabb::new(DVec3::new(-8.0, -6.0, -2.0), DVec3::new(11.0, 8.0, 3.0)),
+        30.0,
+        Aabb::new(DVec3::new(-8.0, -6.0, -2.0), DVec3::new(11.0, 8.0, 2.0)),
+        40.0,
+    )
 }
 
+/// `scene`'s frame on `backend`, its world built with `options`.
+fn frame(
+    scene: &crate::scene::Scene,
+    backend: &dyn crate::accel::Backend,
+    options: crate::render::WorldOptions,
+) -> crate::render::Frame {
+    let world = crate::render::World::build_with(scene, backend, options).unwrap();
+    crate::render::render_world(scene, &world).0
+}
+
+/// `accel`'s hits of `rays` and whether it finds each blocked, `width` at a time.
 fn trace(accel: &dyn Accelerator, rays: &[Ray], width: usize) -> (Vec<Option<Hit>>, Vec<bool>) {
-    let mut hits = vec![None; rays.len()];
-    let mut blocked = vec![false; rays.len()];
-    for ((r, h), o) in rays
-        .chunks(width)
-        .zip(hits.chunks_mut(width))
-        .zip(blocked.chunks_mut(width))
-    {
-        accel.intersect(r, h);
-        accel.occluded(r, o);
-    }
-    (hits, blocked)
+    (
+        super::hits(accel, rays, width),
+        super::occluded(accel, rays, width),
+    )
 }
 
 #[test]
@@ -278,7 +263,7 @@ fn instances_hit_as_copies_on_both_backends() {
 /// rest and moving, the placements held as instances (`instance_over` 0) or listed.
 #[test]
 fn a_mesh_file_placed_four_times_renders_as_four_copies() {
-    use crate::render::{render_world, World, WorldOptions};
+    use crate::render::WorldOptions;
     let dir = std::env::temp_dir().join(format!("rest-embree-instances-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let text = obj(&ball(24, 40));
@@ -385,16 +370,8 @@ rotate = {{ axis = [0, 0, 1], degrees = 90 }}
                     instance_over,
                     ..WorldOptions::default()
                 };
-                let a = render_world(
-                    &shared,
-                    &World::build_with(&shared, backend.as_ref(), options).unwrap(),
-                )
-                .0;
-                let b = render_world(
-                    &copies,
-                    &World::build_with(&copies, backend.as_ref(), options).unwrap(),
-                )
-                .0;
+                let a = frame(&shared, backend.as_ref(), options);
+                let b = frame(&copies, backend.as_ref(), options);
                 let seen = a.pixels.iter().filter(|p| p.object_id > 0).count();
                 assert!(
                     seen > a.pixels.len() / 40,
@@ -484,7 +461,7 @@ type = "instance"
 /// live mesh it was built for, `MeshTrees`' test holds them to that.)
 #[test]
 fn a_backend_reused_across_scenes_renders_each_as_a_fresh_one() {
-    use crate::render::{render_world, World, WorldOptions};
+    use crate::render::WorldOptions;
     let dir = std::env::temp_dir().join(format!("rest-embree-reuse-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let text = r#"
@@ -521,16 +498,8 @@ translate = [2.5, 0, 0]
             let path = dir.join("scene.toml");
             let scene = crate::scene::load_str(path.to_str().unwrap(), text, &[]).unwrap();
             let fresh = backend_by_name(name).unwrap();
-            let a = render_world(
-                &scene,
-                &World::build_with(&scene, kept.as_ref(), options).unwrap(),
-            )
-            .0;
-            let b = render_world(
-                &scene,
-                &World::build_with(&scene, fresh.as_ref(), options).unwrap(),
-            )
-            .0;
+            let a = frame(&scene, kept.as_ref(), options);
+            let b = frame(&scene, fresh.as_ref(), options);
             assert!(a.pixels.iter().any(|p| p.object_id > 0));
             let differ = super::differing_pixels(&a, &b);
             assert_eq!(

@@ -268,18 +268,10 @@ impl Geometry {
     pub fn set_instance(&mut self, scene: &CommittedScene, translation: [f32; 3]) {
         let [x, y, z] = translation;
         // Column-major 3x4: the identity, then the translation.
-        let xfm: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, x, y, z];
-        // SAFETY: a live instance geometry and a live committed scene; Embree copies the
-        // transform.
-        unsafe {
-            rtcSetGeometryInstancedScene(self.raw, scene.raw);
-            rtcSetGeometryTransform(
-                self.raw,
-                0,
-                RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR,
-                xfm.as_ptr() as *const c_void,
-            );
-        }
+        self.set_instance_affine(
+            scene,
+            [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, x, y, z],
+        );
     }
 
     /// Make this (instance) geometry `scene` placed by the affine map `xfm` (column-major 3x4:

@@ -120,6 +120,16 @@ fn implicit_budget(t: &Table, total: &mut u64, shape: &Implicit) -> SceneResult<
     Ok(())
 }
 
+/// An error about the first transform key `t` gives (on its line): an object placed by keys
+/// of its own.
+fn at_transform(t: &Table, why: impl Into<String>) -> super::SceneError {
+    let key = KEYS
+        .into_iter()
+        .find(|k| t.has(k))
+        .expect("a transform has a key");
+    at_value(t, key, why)
+}
+
 /// An error about the value of `key` (on its line), or the table's where it has none.
 fn at_value(t: &Table, key: &str, why: impl Into<String>) -> super::SceneError {
     match t.get(key) {
@@ -202,13 +212,8 @@ pub(super) fn add_object(
         }
         "mesh" => adding.add_inline_mesh().map(|_| None)?,
         "lattice" | "bar_array" if transform.is_some() => {
-            let key = KEYS
-                .into_iter()
-                .find(|k| t.has(k))
-                .expect("a transform has a key");
-            return Err(at_value(
+            return Err(at_transform(
                 t,
-                key,
                 format!(
                     "transforms apply to boxes, spheres, rods and meshes; a {kind} is placed by its own keys (origin, center, spacing, axis)"
                 ),
@@ -216,13 +221,8 @@ pub(super) fn add_object(
         }
         "lattice" => adding.add_lattice(mats).map(|_| None)?,
         "wheel" if transform.is_some() => {
-            let key = KEYS
-                .into_iter()
-                .find(|k| t.has(k))
-                .expect("a transform has a key");
-            return Err(at_value(
+            return Err(at_transform(
                 t,
-                key,
                 "a wheel is placed by its own keys (center, axis, radius)",
             ));
         }
