@@ -20,6 +20,7 @@ mod pass_set;
 mod procedural;
 mod reader;
 mod segments;
+mod settings;
 mod shared_meshes;
 mod speed;
 mod spin_keys;
