@@ -149,20 +149,18 @@ macro_rules! fan_packet {
                         }
                         return;
                     }
+                    // Every lane's primitive fetched first, then refined (`EmbreeAccel::fetch`).
+                    let mut fetched = [None; N];
+                    for (i, f) in fetched.iter_mut().enumerate().take(n) {
+                        if rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID {
+                            let (geom, prim) = (rh.hit.geomID[i], rh.hit.primID[i]);
+                            *f = self.fetch(geom, prim, rh.hit.instID[0][i]);
+                        }
+                    }
                     for (i, ray) in rays.iter().enumerate().take(n) {
-                        let hit = (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
-                            .then(|| {
-                                self.to_hit(
-                                    ray,
-                                    rh.ray.tfar[i],
-                                    rh.hit.geomID[i],
-                                    rh.hit.primID[i],
-                                    rh.hit.instID[0][i],
-                                    ctx.exact_t(i),
-                                    self.pullback,
-                                )
-                            })
-                            .flatten();
+                        let hit = fetched[i].and_then(|f| {
+                            self.refine(ray, rh.ray.tfar[i], f, ctx.exact_t(i), self.pullback)
+                        });
                         // Written field by field: an Option copied whole went through the stack
                         // with loads that straddled its stores (a store-forwarding stall per lane).
                         out.prim[first + i] = NO_HIT;

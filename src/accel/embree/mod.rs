@@ -32,7 +32,7 @@ pub use isa::Isa;
 pub(crate) use isa::ENV as ISA_ENV;
 
 use super::{Accelerator, Backend, BoxCuller, CullerFactory, Fan, FanHits, Faults, Hit, Ray};
-use crate::geometry::{Aabb, Geometry, Real};
+use crate::geometry::{Aabb, Geometry, Primitive, Real};
 use rtc::Device;
 use std::sync::{Arc, OnceLock};
 
@@ -354,14 +354,37 @@ impl EmbreeAccel {
         exact_t: f64,
         offset: f64,
     ) -> Option<Hit> {
-        let k = scale(r.len);
+        let hit = self.fetch(geom, prim, inst)?;
+        self.refine(r, t_embree, hit, exact_t, offset)
+    }
+
+    /// What Embree's hit (geometry, primitive, instance) is among the group's primitives: its
+    /// number, and the primitive where its t is to be refined (None where the hit is exact).
+    /// Fetching it is the read-back's one trip to memory the BVH's leaf did not make (a big
+    /// mesh's indices and vertices): a packet's lanes fetch first, all of them, then refine,
+    /// so that their fetches overlap.
+    #[inline(always)]
+    fn fetch(&self, geom: u32, prim: u32, inst: u32) -> Option<(u32, Option<Primitive>)> {
         let (prim, exact) = self.scene.prim(geom, prim, inst)?;
-        if exact {
+        Some((prim, (!exact).then(|| self.geometry.prim(prim))))
+    }
+
+    /// The hit `fetch` found, in the caller's units (see `to_hit`).
+    #[inline(always)]
+    fn refine(
+        &self,
+        r: &Ray,
+        t_embree: f32,
+        (prim, p): (u32, Option<Primitive>),
+        exact_t: f64,
+        offset: f64,
+    ) -> Option<Hit> {
+        let Some(p) = p else {
             return (exact_t > r.tmin && exact_t < r.tmax).then_some(Hit { t: exact_t, prim });
-        }
+        };
+        let k = scale(r.len);
         let t = (t_embree as f64 - offset) / k;
         let slack = 1e-4 * t.abs().max(self.pullback / k) + 4.0 * self.pullback / k;
-        let p = self.geometry.prim(prim);
         let refined = p.intersect(
             r.origin,
             r.dir,
