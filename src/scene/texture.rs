@@ -72,15 +72,13 @@ impl std::fmt::Debug for ImageTexture {
     }
 }
 
-impl ImageTexture {
-    /// An image texture of `texels` for colours of `role`.
-    pub fn new(
-        path: String,
-        width: usize,
-        height: usize,
-        texels: std::sync::Arc<[[f32; 3]]>,
-        role: Role,
-    ) -> ImageTexture {
+/// The three colours a texture of `role` writes its texels on (the uplifts of pure red, green
+/// and blue) and the matrix from a texel's RGB to their weights: the same for every texture
+/// of a role, so made once (with their spectral tables) for all of them.
+fn basis_of(role: Role) -> &'static ([Colour; 3], DMat3) {
+    static BASES: [std::sync::OnceLock<([Colour; 3], DMat3)>; 2] =
+        [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
+    BASES[role as usize].get_or_init(|| {
         let basis = [DVec3::X, DVec3::Y, DVec3::Z].map(|e| Colour::rgb(e, role));
         // The basis's colours as the camera records them: an emitter's own, a reflectance's
         // under white light (each of the nine numbers a camera response, so the matrix holds
@@ -97,13 +95,27 @@ impl ImageTexture {
             }
         };
         let m = DMat3::from_cols(seen(&basis[0]), seen(&basis[1]), seen(&basis[2]));
+        (basis, m.inverse())
+    })
+}
+
+impl ImageTexture {
+    /// An image texture of `texels` for colours of `role`.
+    pub fn new(
+        path: String,
+        width: usize,
+        height: usize,
+        texels: std::sync::Arc<[[f32; 3]]>,
+        role: Role,
+    ) -> ImageTexture {
+        let (basis, to_basis) = basis_of(role).clone();
         ImageTexture {
             path,
             width,
             height,
             texels,
             basis,
-            to_basis: m.inverse(),
+            to_basis,
         }
     }
 
@@ -331,6 +343,13 @@ pub(crate) fn read_image(path: &std::path::Path) -> crate::Result<(usize, usize,
     }
 }
 
+/// `srgb_to_linear` of each 8-bit code (the same numbers, one `powf` per code instead of one
+/// per texel and channel).
+fn srgb8_to_linear() -> &'static [f32; 256] {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|b| srgb_to_linear(b as f32 / 255.0)))
+}
+
 /// sRGB's decoding to linear.
 fn srgb_to_linear(v: f32) -> f32 {
     if v <= 0.04045 {
@@ -396,12 +415,11 @@ pub(crate) fn read_png(
     let channels = frame.color_type.samples();
     let wide = frame.bit_depth == png::BitDepth::Sixteen;
     let value = |i: usize| -> f32 {
-        let v = if wide {
-            f32::from(u16::from_be_bytes([buf[2 * i], buf[2 * i + 1]])) / 65535.0
+        if wide {
+            srgb_to_linear(f32::from(u16::from_be_bytes([buf[2 * i], buf[2 * i + 1]])) / 65535.0)
         } else {
-            f32::from(buf[i]) / 255.0
-        };
-        srgb_to_linear(v)
+            srgb8_to_linear()[usize::from(buf[i])]
+        }
     };
     let texels = (0..w * h)
         .map(|p| {
@@ -418,6 +436,15 @@ pub(crate) fn read_png(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The 8-bit table holds each code's decoding, as decoded one by one.
+    #[test]
+    fn the_srgb8_table_is_the_decoding() {
+        for b in 0..=255u8 {
+            let want = srgb_to_linear(f32::from(b) / 255.0);
+            assert_eq!(srgb8_to_linear()[usize::from(b)].to_bits(), want.to_bits());
+        }
+    }
 
     #[test]
     fn checker_cells_alternate() {

@@ -19,7 +19,7 @@ mod uplift;
 pub(crate) use sampled::{Sampled, SAMPLES};
 
 use glam::DVec3;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// Planck's first radiation constant for spectral radiance, 2hc² (W·m²·sr⁻¹; CODATA 2018, exact).
 const C1L: f64 = 1.191_042_972_397_188_4e-16;
@@ -192,7 +192,7 @@ pub enum Role {
 
 /// A colour of the scene: its spectrum, and the linear sRGB it has at rest (what the RGB
 /// renderer uses, and exactly the RGB given where the colour was given as RGB).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct Colour {
     /// Linear sRGB at rest.
     pub rgb: DVec3,
@@ -201,10 +201,27 @@ pub struct Colour {
     /// Whether it was given as RGB (a scene of RGB colours only, all at rest relative to each
     /// other, needs no spectral rendering).
     pub from_rgb: bool,
-    /// The spectrum on a logarithmic grid, for the smooth kinds (see [`table`]).
-    table: Option<Arc<table::LogTable>>,
+    /// The spectrum on a logarithmic grid, for the smooth kinds (see [`table`]): made the
+    /// first time the colour is read at a frame's wavelengths (some thirteen thousand
+    /// evaluations of the spectrum), so that a scene rendered in RGB, or a colour never seen
+    /// shifted, costs none; shared by the colour's clones.
+    table: Option<Arc<OnceLock<table::LogTable>>>,
     /// Black at every wavelength (asked per hit, so kept).
     black: bool,
+}
+
+/// As derived when the table was made with the colour: its text (which the render id hashes)
+/// is the same whether or not the table has been read yet.
+impl std::fmt::Debug for Colour {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Colour")
+            .field("rgb", &self.rgb)
+            .field("spectrum", &self.spectrum)
+            .field("from_rgb", &self.from_rgb)
+            .field("table", &self.table.as_ref().map(|t| self.table_in(t)))
+            .field("black", &self.black)
+            .finish()
+    }
 }
 
 impl PartialEq for Colour {
@@ -219,7 +236,7 @@ impl Colour {
             spectrum,
             Spectrum::Sigmoid { .. } | Spectrum::Illuminant { .. } | Spectrum::Blackbody { .. }
         );
-        let table = smooth.then(|| Arc::new(table::LogTable::new(&spectrum)));
+        let table = smooth.then(|| Arc::new(OnceLock::new()));
         let black = spectrum == Spectrum::Flat(0.0) || rgb == DVec3::ZERO && from_rgb;
         Colour {
             rgb,
@@ -230,10 +247,15 @@ impl Colour {
         }
     }
 
+    /// Its table, made on first use.
+    fn table_in<'t>(&self, t: &'t OnceLock<table::LogTable>) -> &'t table::LogTable {
+        t.get_or_init(|| table::LogTable::new(&self.spectrum))
+    }
+
     /// The colour at the camera's wavelengths times `shift`.
     pub(crate) fn sampled(&self, shift: Shift) -> Sampled {
         match &self.table {
-            Some(t) => t.sample(shift, &self.spectrum),
+            Some(t) => self.table_in(t).sample(shift, &self.spectrum),
             None => Sampled::of(&self.spectrum, shift.factor),
         }
     }

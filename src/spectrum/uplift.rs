@@ -93,7 +93,32 @@ impl Model {
 
 /// Sigmoid-polynomial coefficients whose reflectance has linear sRGB `rgb` (in [0, 1]) under
 /// the white.
+/// Each fit is kept (by the colour's bits) for the process's later loads: a fit is thousands of
+/// evaluations of the model, and a scene read again (the viewer after each edit, a farm's
+/// tiles, a film's frames) has the same colours. The fit is a function of the colour alone, so
+/// a kept one is the one a new fit would give.
 fn fit(rgb: DVec3) -> [f64; 3] {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    /// Colours kept at most (then forgotten, all at once).
+    const KEPT: usize = 4096;
+    static FITS: OnceLock<Mutex<HashMap<[u64; 3], [f64; 3]>>> = OnceLock::new();
+    let fits = FITS.get_or_init(Default::default);
+    let key = rgb.to_array().map(f64::to_bits);
+    if let Some(c) = fits.lock().ok().and_then(|f| f.get(&key).copied()) {
+        return c;
+    }
+    let c = fit_anew(rgb);
+    if let Ok(mut f) = fits.lock() {
+        if f.len() >= KEPT {
+            f.clear();
+        }
+        f.insert(key, c);
+    }
+    c
+}
+
+fn fit_anew(rgb: DVec3) -> [f64; 3] {
     let model = Model::new();
     let to_xyz = XYZ_TO_SRGB.inverse();
     let grey = DVec3::splat(0.5);
@@ -184,6 +209,16 @@ mod tests {
 
     /// An RGB grey is exactly the flat spectrum of that value; an emitter grey is exactly that
     /// many times the white.
+    /// A kept fit is the fit itself, bit for bit, and a colour fitted before is found again.
+    #[test]
+    fn a_kept_fit_is_a_new_fit() {
+        for rgb in [DVec3::new(0.7, 0.2, 0.1), DVec3::new(0.05, 0.6, 0.3)] {
+            let first = fit(rgb);
+            assert_eq!(first, fit_anew(rgb));
+            assert_eq!(fit(rgb), first);
+        }
+    }
+
     #[test]
     fn greys_are_exact() {
         for v in [0.0, 0.18, 0.5, 1.0, 3.0] {
