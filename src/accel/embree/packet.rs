@@ -112,21 +112,19 @@ macro_rules! packet_fns {
                         }
                         return;
                     }
+                    // Every lane's primitive fetched, then refined (`EmbreeAccel::fetch`).
+                    let mut fetched = [None; $n];
+                    for (i, f) in fetched.iter_mut().enumerate().take(rays.len()) {
+                        if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID {
+                            let (geom, prim) = (rh.hit.geomID[i], rh.hit.primID[i]);
+                            *f = self.fetch(geom, prim, rh.hit.instID[0][i]);
+                        }
+                    }
                     for (i, r) in rays.iter().enumerate() {
-                        hits[i] = if valid.0[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID
-                        {
-                            self.to_hit(
-                                r,
-                                rh.ray.tfar[i],
-                                rh.hit.geomID[i],
-                                rh.hit.primID[i],
-                                rh.hit.instID[0][i],
-                                ctx.exact_t(i),
-                                lanes.offset[i].get(),
-                            )
-                        } else {
-                            None
-                        };
+                        let offset = lanes.offset[i].get();
+                        hits[i] = fetched[i].and_then(|f| {
+                            self.refine(r, rh.ray.tfar[i], f, ctx.exact_t(i), offset)
+                        });
                     }
                 })
             }
