@@ -78,7 +78,11 @@ impl std::fmt::Debug for ImageTexture {
 fn basis_of(role: Role) -> &'static ([Colour; 3], DMat3) {
     static BASES: [std::sync::OnceLock<([Colour; 3], DMat3)>; 2] =
         [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
-    BASES[role as usize].get_or_init(|| {
+    let slot = match role {
+        Role::Reflectance => &BASES[0],
+        Role::Emitter => &BASES[1],
+    };
+    slot.get_or_init(|| {
         let basis = [DVec3::X, DVec3::Y, DVec3::Z].map(|e| Colour::rgb(e, role));
         // The basis's colours as the camera records them: an emitter's own, a reflectance's
         // under white light (each of the nine numbers a camera response, so the matrix holds
