@@ -56,7 +56,7 @@ test: setup
 	  if REST_EMBREE_ISA=$$isa ./target/release/rest-embree backends >/dev/null 2>&1; then \
 	    echo "conformance under REST_EMBREE_ISA=$$isa"; \
 	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --workspace --test suite -q -- backend_conformance:: meshes:: gltf::a_ radar:: worldline:: shutter:: spin:: acceleration:: wigner_rotation:: turning:: || exit 1; \
-	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --workspace --test suite -q -- path::the_lanes_change_no_picture || exit 1; \
+	    REST_EMBREE_ISA=$$isa $(CARGO) test --release --workspace --test suite -q -- path::lanes::the_lanes_change_no_picture || exit 1; \
 	  fi; \
 	done
 	@# The SLURM cluster's test waits on its scheduler most of its time: it runs beside the
