@@ -1,8 +1,8 @@
-//! A 64-bit digest of a geometry's bulk data (its primitives, parts, mesh vertices and
-//! indices, corner normals and texture coordinates), taken from the numbers' bits with xxh3:
-//! what a geometry's debug text shows in place of the numbers themselves, so that the render
-//! id (`output::header::render_id`, a hash of the scene's debug text) costs a pass over the
-//! bytes, not the formatting of every vertex as decimal text.
+//! A 64-bit digest of bytes with xxh3: of the scene's serialized values (the render id,
+//! `output::header::render_id`), and of a geometry's bulk data (its primitives, parts, mesh
+//! vertices and indices, corner normals and texture coordinates), taken from the numbers' bits,
+//! which a geometry serializes as in place of the numbers themselves: the id costs a pass over
+//! the bytes, never the formatting of numbers as text.
 
 use super::{Corners, Geometry, Implicit, IndexedMesh, Primitive};
 use xxhash_rust::xxh3::Xxh3;
@@ -68,6 +68,17 @@ impl Digest {
         let mut hash = self.hash.clone();
         hash.update(&self.buf);
         hash.digest()
+    }
+}
+
+/// A writer into the digest: what a serializer (the render id's) feeds its bytes to.
+impl std::io::Write for Digest {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        self.bytes(b);
+        Ok(b.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
     }
 }
 

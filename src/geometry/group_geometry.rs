@@ -155,6 +155,19 @@ impl std::fmt::Debug for Geometry {
     }
 }
 
+/// As its counts and digest: the render id hashes these (`digest.rs`).
+impl serde::Serialize for Geometry {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        (
+            self.prims.len(),
+            self.parts.len(),
+            self.implicit.len(),
+            super::digest::geometry(self),
+        )
+            .serialize(s)
+    }
+}
+
 /// An object held as itself: its primitives are numbers `first ..` `first + shape.len()`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImplicitRun {

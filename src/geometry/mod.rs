@@ -6,7 +6,7 @@
 mod aabb;
 mod bars;
 mod box_tree;
-mod digest;
+pub(crate) mod digest;
 mod group_geometry;
 mod implicit;
 mod indexed_mesh;

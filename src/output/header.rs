@@ -164,23 +164,13 @@ pub(crate) const RENDER_ID: &str = "renderId";
 
 /// What identifies a render's settings, as hex: a hash of the whole scene as loaded (every
 /// value, the view time and the image settings but the crop included, overrides applied), the
-/// backend and the overrides as given. Two files with the same id are frames of the same render settings:
-/// `--resume` skips only a frame whose file says so. The hash is std's (SipHash with fixed
-/// keys), fed the scene's debug text as it is formatted, with no copy of it; a geometry's bulk
-/// (primitives, mesh vertices and indices, corner data) stands there as its counts and a
-/// digest of its bits (`geometry::digest`), not as text. Another build of the compiler may hash
-/// differently, which costs a frame rendered again, nothing more.
+/// backend and the overrides as given. Two files with the same id are frames of the same render
+/// settings: `--resume` skips only a frame whose file says so. The scene's values are
+/// serialized to bytes (postcard: every number its bits, every sequence its length first) into
+/// xxh3 (`geometry::digest`), never formatted as text; a geometry's bulk (primitives, mesh
+/// vertices and indices, corner data), a texture's texels and a colour's tables made from its
+/// spectrum stand there as their counts and digests.
 pub(crate) fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> String {
-    use std::fmt::Write as _;
-    use std::hash::Hasher;
-    struct Feed(std::hash::DefaultHasher);
-    impl std::fmt::Write for Feed {
-        fn write_str(&mut self, s: &str) -> std::fmt::Result {
-            self.0.write(s.as_bytes());
-            Ok(())
-        }
-    }
-    let mut feed = Feed(std::hash::DefaultHasher::new());
     // Field by field, the image without its crop: the tiles of one render share its id.
     let image = crate::scene::ImageSettings {
         crop: None,
@@ -199,15 +189,14 @@ pub(crate) fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> S
         image: _,
         warnings: _,
     } = scene;
-    let _ = write!(
-        feed,
-        "{camera:?}|{image:?}|{render:?}|{materials:?}|{lights:?}|{groups:?}|{objects:?}|{film:?}|{sky:?}|{backend}|{overrides:?}"
+    let fields = (
+        camera, &image, render, materials, lights, groups, objects, film, sky, fog, backend,
+        overrides,
     );
-    // Only where there is one, so that the ids of renders without fog stay as they were.
-    if let Some(f) = fog {
-        let _ = write!(feed, "|{f:?}");
-    }
-    format!("{:016x}", feed.0.finish())
+    let mut digest = crate::geometry::digest::Digest::new();
+    // Serializing into a digest is infallible: every value the scene holds has bytes.
+    postcard::to_io(&fields, &mut digest).expect("a scene serializes");
+    format!("{:016x}", digest.finish())
 }
 
 /// The names of the scene's objects and materials for the Cryptomatte manifests: an object's
@@ -256,5 +245,50 @@ mod tests {
         let m = world_to_ndc(&s.camera, &s.image).unwrap();
         let (x, y) = ndc(&m, DVec3::new(2.0, 12.0, 4.0));
         assert!((x - 105.0 / 200.0).abs() < 1e-12 && (y - 45.0 / 100.0).abs() < 1e-12);
+    }
+
+    fn id_of(text: &str, overrides: &[(String, String)]) -> String {
+        let scene = crate::scene::load_str("t.toml", text, overrides).unwrap();
+        render_id(&scene, "embree", &[])
+    }
+
+    const SCENE: &str = "[camera]\nposition = [0, -10, 0]\nlook_at = [0, 0, 0]\n\
+        [image]\nwidth = 8\nheight = 8\n\
+        [[material]]\nname = \"red\"\ncolor = [0.8, 0.1, 0.1]\n\
+        [[group]]\nname = \"g\"\nvelocity = [0.5, 0, 0]\n\
+        [[group.object]]\ntype = \"mesh\"\nmaterial = \"red\"\n\
+        vertices = [[0, 0, 0], [1, 0, 0], [0, 0, 1]]\nindices = [[0, 1, 2]]\n\
+        [[group.object]]\ntype = \"sphere\"\ncenter = [3, 0, 0]\nradius = 1\n";
+
+    /// The id names the settings: the same scene loaded twice, or cut into tiles, has one id;
+    /// a change of any value's last bit (a velocity, a mesh's vertex, a colour, a sphere's
+    /// radius), of the backend or of the overrides as given, another.
+    #[test]
+    fn the_render_id_follows_every_value_and_only_the_settings() {
+        let base = id_of(SCENE, &[]);
+        assert_eq!(base.len(), 16);
+        assert!(base.bytes().all(|b| b.is_ascii_hexdigit()));
+        assert_eq!(base, id_of(SCENE, &[]));
+        let cropped = SCENE.replace("height = 8\n", "height = 8\ncrop = [0, 0, 4, 4]\n");
+        assert_eq!(base, id_of(&cropped, &[]));
+        let next = |x: f64| format!("{:?}", f64::from_bits(x.to_bits() + 1));
+        let changed = [
+            SCENE.replace("velocity = [0.5,", &format!("velocity = [{},", next(0.5))),
+            SCENE.replace(
+                "[1, 0, 0], [0, 0, 1]",
+                &format!("[{}, 0, 0], [0, 0, 1]", next(1.0)),
+            ),
+            SCENE.replace("[0.8, 0.1, 0.1]", &format!("[0.8, {}, 0.1]", next(0.1))),
+            SCENE.replace("radius = 1\n", &format!("radius = {}\n", next(1.0))),
+        ];
+        let mut seen = std::collections::HashSet::from([base.clone()]);
+        for text in &changed {
+            assert_ne!(text, SCENE);
+            assert!(seen.insert(id_of(text, &[])), "{text}");
+        }
+        let scene = crate::scene::load_str("t.toml", SCENE, &[]).unwrap();
+        assert_eq!(render_id(&scene, "embree", &[]), base);
+        assert!(seen.insert(render_id(&scene, "bvh", &[])));
+        assert!(seen.insert(render_id(&scene, "embree", &["image.samples=1".into()])));
     }
 }

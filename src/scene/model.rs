@@ -5,7 +5,7 @@ use glam::DVec3;
 use std::sync::Arc;
 
 /// How camera-frame directions map to pixels.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub enum Projection {
     /// Pinhole with a vertical field of view (radians).
     Pinhole {
@@ -23,7 +23,7 @@ pub enum Projection {
 
 /// The camera: at `position` at world time `time` (the imaging event), with its axes given in its
 /// own rest frame.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Camera {
     /// Where the imaging event is (world frame).
     pub position: DVec3,
@@ -83,7 +83,7 @@ impl Camera {
 /// A film (`[film]`): frames at view times from `start` to `end` (inclusive, where the
 /// spacing lands on it), `1 / fps` or `step` apart, in world time or on the camera's clock;
 /// frame k is the camera at `start + k · spacing` on its worldline.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Film {
     /// The first frame's view time.
     pub start: f64,
@@ -96,7 +96,7 @@ pub struct Film {
 }
 
 /// The clock a film's times are read on (`[film] clock`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 pub enum Clock {
     /// World time (the default).
     #[default]
@@ -106,7 +106,7 @@ pub enum Clock {
 }
 
 /// How far apart a film's frames are in world time.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub enum FrameSpacing {
     /// Frames per unit of world time.
     Fps(f64),
@@ -141,7 +141,7 @@ impl Film {
 pub(crate) const MAX_FRAME_PIXELS: u64 = 1 << 28;
 
 /// The image: its size, samples, background and crop.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ImageSettings {
     /// Width of the full image, pixels.
     pub width: u32,
@@ -182,7 +182,7 @@ impl ImageSettings {
 }
 
 /// How light is followed: bounces, ambient light, and which relativistic effects on light apply.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct RenderSettings {
     /// Reflection/refraction bounces after the primary hit.
     pub max_depth: u32,
@@ -208,7 +208,7 @@ pub struct RenderSettings {
 }
 
 /// How light is followed from the camera (`[render] integrator`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 pub enum Integrator {
     /// Whitted: point lights, Phong, mirror and refracted rays (the default).
     #[default]
@@ -245,7 +245,7 @@ impl RenderSettings {
 }
 
 /// A rest-frame surface description: Phong plus Whitted mirror and dielectric terms.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Material {
     /// The name objects refer to it by.
     pub name: String,
@@ -280,7 +280,7 @@ pub struct Material {
 
 /// A homogeneous medium at rest in its object's frame: absorption and scattering coefficients
 /// (per unit length, spectra) and the Henyey-Greenstein asymmetry g of its scattering.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Medium {
     /// Absorption per unit length.
     pub sigma_a: Colour,
@@ -327,7 +327,7 @@ impl Material {
 
 /// An isotropic point light at rest in the frame moving at `velocity`, at `position` in that
 /// frame's coordinates (whose origin passes through the world origin at world time 0).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Light {
     /// Where it is, in its own rest frame.
     pub position: DVec3,
@@ -347,7 +347,7 @@ pub struct Light {
 }
 
 /// Objects sharing one uniform velocity; geometry in their rest frame.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize)]
 pub struct Group {
     /// The name `--set group.NAME.…` refers to it by.
     pub name: String,
@@ -382,7 +382,7 @@ impl Group {
 /// its origin starts at `start` and moves with proper acceleration `a` along `axis`; every
 /// point keeps its place relative to the origin in the frame moving with it (Born-rigid). Its
 /// geometry is its shape in that moving frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Accelerated {
     /// The origin's start event, in S' (in the group's axes).
     pub start: Event,
@@ -396,7 +396,7 @@ pub struct Accelerated {
 }
 
 /// A `[[group.object]]` of the scene, for naming what a pixel sees.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ObjectInfo {
     /// Its `name`, where it has one.
     pub name: Option<String>,
@@ -407,7 +407,7 @@ pub struct ObjectInfo {
 }
 
 /// A loaded scene (see docs/scene-format.md): what a render needs, validated.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize)]
 pub struct Scene {
     /// The camera and its imaging event.
     pub camera: Camera,
@@ -437,7 +437,7 @@ pub struct Scene {
 /// A homogeneous medium everywhere outside objects, at rest in a group's frame. Its medium is
 /// the invisible material `materials[material]` (one no object uses), so it is crossed and
 /// scattered in as a fog bank's is.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Fog {
     /// The scene group whose rest frame it is at rest in.
     pub group: usize,

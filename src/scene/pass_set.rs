@@ -81,7 +81,7 @@ pub(crate) const SHORTHANDS: [(&str, &[Pass]); 4] = [
 ];
 
 /// A set of passes; colour and alpha are always written and are not in it.
-#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
 pub struct PassSet(u16);
 
 impl PassSet {

@@ -14,7 +14,7 @@ use std::sync::Arc;
 pub(crate) const MAX_STARS: u64 = 10_000_000;
 
 /// What `[sky] stars` asks for.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct StarField {
     /// How many stars.
     pub count: u64,
@@ -32,7 +32,7 @@ pub struct StarField {
 }
 
 /// One star, in the frame where the sky is at rest.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Star {
     /// The unit direction toward it (a looking direction).
     pub dir: DVec3,

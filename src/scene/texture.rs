@@ -8,7 +8,7 @@ use glam::{DMat3, DVec3};
 use std::f64::consts::PI;
 
 /// A colour that varies over a surface.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub enum Texture {
     /// Boxes of `size` (0 along an axis: no change along it) alternating between two colours,
     /// in the group's rest frame; the box from the origin toward +x, +y, +z has the first.
@@ -53,22 +53,38 @@ pub struct ImageTexture {
     pub to_basis: DMat3,
 }
 
-/// Its path, size and a hash of its texels: the render id hashes this, not millions of floats.
+impl ImageTexture {
+    /// A digest of its texels' bits.
+    fn texel_digest(&self) -> u64 {
+        let mut d = crate::geometry::digest::Digest::new();
+        for t in self.texels.iter() {
+            for c in t {
+                d.bytes(&c.to_bits().to_le_bytes());
+            }
+        }
+        d.finish()
+    }
+}
+
+/// Its path, size and a digest of its texels: what messages show.
 impl std::fmt::Debug for ImageTexture {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        use std::hash::{Hash, Hasher};
-        let mut h = std::hash::DefaultHasher::new();
-        for t in self.texels.iter() {
-            t.map(f32::to_bits).hash(&mut h);
-        }
         write!(
             f,
             "ImageTexture({}, {}x{}, {:016x})",
             self.path,
             self.width,
             self.height,
-            h.finish()
+            self.texel_digest()
         )
+    }
+}
+
+/// As its path, size and the digest of its texels: the render id hashes these, not millions of
+/// numbers.
+impl serde::Serialize for ImageTexture {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        (&self.path, self.width, self.height, self.texel_digest()).serialize(s)
     }
 }
 
@@ -368,7 +384,7 @@ fn srgb_to_linear(v: f32) -> f32 {
 /// camera (a camera at rest with that projection looking along +x with up +z renders the map
 /// back pixel for pixel), turned by `rotation` and scaled by `intensity`, and a star field
 /// (where neither is given, the image's background).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Sky {
     /// The map, its texels radiances (emitter role).
     pub map: Option<std::sync::Arc<ImageTexture>>,

@@ -6,7 +6,7 @@ use super::doc::{Node, Val};
 use super::reader::{SceneResult, Table};
 
 /// How a light's emission varies over its proper time: a factor on its intensity.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub enum Timing {
     /// Always on (factor 1).
     Steady,

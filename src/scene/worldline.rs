@@ -26,7 +26,7 @@ pub(crate) struct Segment {
 }
 
 /// A piece of a resolved worldline.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub(super) enum Piece {
     /// Uniform motion at `velocity` through the event `at`.
     Uniform { velocity: Velocity, at: Event },
@@ -175,7 +175,7 @@ fn resolve(anchor: Event, segments: &[Segment]) -> Resolved {
 
 /// A worldline of segments through the event `anchor`: continuous, each segment's motion held
 /// through its span of world time.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Worldline {
     anchor: Event,
     pub(super) pieces: Vec<Piece>,

@@ -9,7 +9,7 @@ use glam::{DMat3, DVec3};
 /// It may carry a turn of the axes after the boost (`turned`), as the frame of a body that
 /// accelerated across its motion does (a Thomas-Wigner rotation, docs/physics.md §1.4, §12.7);
 /// its inverse turns them back before the boost back.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Boost {
     axis: DVec3,
     e_pos: f64,

@@ -2,7 +2,7 @@ use glam::DVec3;
 use std::ops::{Add, Sub};
 
 /// A spacetime event `(t, x)` in some inertial frame (c = 1).
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize)]
 pub struct Event {
     /// Time.
     pub t: f64,

@@ -9,7 +9,7 @@ use super::{Boost, Event, Velocity};
 use glam::DVec3;
 
 /// A reference point's hyperbolic motion from a start event at a start velocity.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Hyperbola {
     /// Where it starts (world frame).
     pub start: Event,

@@ -4,7 +4,7 @@ use std::fmt;
 /// A velocity relative to some frame, stored by its unit direction and rapidity φ (docs/physics.md §8):
 /// β = tanh φ, γ = cosh φ, γβ = sinh φ, e^{±φ} are all derived in f64 without cancellation, so
 /// speeds like 1 − 1e-12 keep full precision when given as rapidity or as 1 − β.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Velocity {
     dir: DVec3,
     rapidity: f64,

@@ -7,7 +7,7 @@
 use super::{Boost, Event, NullRay, Velocity};
 
 /// The events at time `time` in the frame moving at `frame` (world frame: zero velocity).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Slice {
     frame: Velocity,
     boost: Boost,
@@ -58,7 +58,7 @@ impl Slice {
 }
 
 /// The events between two slices: at or after `from`, at or before `to`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Window {
     /// The earliest events.
     pub from: Slice,

@@ -44,7 +44,7 @@ impl Shift {
 }
 
 /// A spectrum: a non-negative function of wavelength (nm), defined at every wavelength.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub enum Spectrum {
     /// The same value at every wavelength (an RGB grey reflectance, or zero).
     Flat(f64),
@@ -192,7 +192,7 @@ pub enum Role {
 
 /// A colour of the scene: its spectrum, and the linear sRGB it has at rest (what the RGB
 /// renderer uses, and exactly the RGB given where the colour was given as RGB).
-#[derive(Clone)]
+#[derive(Clone, serde::Serialize)]
 pub struct Colour {
     /// Linear sRGB at rest.
     pub rgb: DVec3,
@@ -204,7 +204,9 @@ pub struct Colour {
     /// The spectrum on a logarithmic grid, for the smooth kinds (see [`table`]): made the
     /// first time the colour is read at a frame's wavelengths (some thirteen thousand
     /// evaluations of the spectrum), so that a scene rendered in RGB, or a colour never seen
-    /// shifted, costs none; shared by the colour's clones.
+    /// shifted, costs none; shared by the colour's clones. Made from the spectrum, so the
+    /// render id, which hashes the spectrum, leaves it out.
+    #[serde(skip)]
     table: Option<Arc<OnceLock<table::LogTable>>>,
     /// Black at every wavelength (asked per hit, so kept).
     black: bool,
