@@ -10,7 +10,7 @@ use super::gltf_file::{self, CameraView, GltfData, GltfMaterial};
 use super::mesh_file::MeshData;
 use super::model::{Light, Material};
 use super::reader::{SceneResult, Table};
-use super::shared_meshes::Shared;
+use super::shared_meshes::{Shared, SharedMeshes};
 use super::transform::Transform;
 use super::worldline::{Motion, Segment};
 use crate::spacetime::Velocity;
@@ -57,16 +57,25 @@ pub(super) struct Placed {
     pub chosen: Vec<u32>,
 }
 
-/// Read the entry `t`'s file and place it: its materials appended to `materials` (and named in
-/// `ids` where the scene names none so), lights and cameras into `imports`.
+/// How the group an entry is in moves.
+pub(super) struct InGroup {
+    pub velocity: Velocity,
+    /// Whether it has a velocity or a worldline.
+    pub moves: bool,
+    /// Whether it has a worldline.
+    pub on_worldline: bool,
+}
+
+/// Read the entry `t`'s file (once, where several entries place it: `meshes`) and place it:
+/// its materials appended to `materials` (and named in `ids` where the scene names none so),
+/// lights and cameras into `imports`.
 pub(super) fn place(
     t: &Table,
-    group_velocity: Velocity,
-    group_moves: bool,
-    on_worldline: bool,
+    group: InGroup,
     materials: &mut Vec<Material>,
     ids: &HashMap<String, u32>,
     imports: &mut Imports,
+    meshes: &mut SharedMeshes,
 ) -> SceneResult<Placed> {
     let name = t.req_string("file")?;
     let node = t.get("file").expect("read above");
@@ -83,7 +92,8 @@ pub(super) fn place(
             ));
         }
     };
-    let data = gltf_file::read(&path, split_all)
+    let (data, held) = meshes
+        .gltf(&path, split_all)
         .map_err(|why| t.error_at(node, "file", format!("{}: {why}", path.display())))?;
     let transform = Transform::read(t)?;
     let time_scale = t.f64_where(
@@ -98,7 +108,7 @@ pub(super) fn place(
         lights,
         cameras,
         warnings,
-        shared,
+        shared: _,
     } = data;
     let shown = path.display().to_string();
     imports
@@ -123,7 +133,7 @@ pub(super) fn place(
     let animated: Vec<usize> = (0..nodes.len())
         .filter(|&i| nodes[i].keys.is_some())
         .collect();
-    if on_worldline && !lights.is_empty() {
+    if group.on_worldline && !lights.is_empty() {
         return Err(t.error(
             "file",
             format!("{shown} has point lights and the group a worldline: a light resting in a group whose velocity changes is not built yet (as for a [[light]] with `group`)"),
@@ -145,7 +155,7 @@ pub(super) fn place(
             velocity: if moving {
                 Velocity::ZERO
             } else {
-                group_velocity
+                group.velocity
             },
             inverse_square: true,
             timing: super::Timing::Steady,
@@ -182,7 +192,7 @@ pub(super) fn place(
         imports.chosen_camera = Some(c.clone());
     }
     imports.cameras.extend(placed_cameras);
-    if group_moves && !animated.is_empty() {
+    if group.moves && !animated.is_empty() {
         return Err(t.error(
             "file",
             format!(
@@ -201,14 +211,6 @@ pub(super) fn place(
             format!("{shown}: its scene places no triangles"),
         ));
     }
-    let names: Vec<String> = file_materials.iter().map(|m| m.name.clone()).collect();
-    let held: HashMap<usize, Arc<Shared>> = shared
-        .into_iter()
-        .map(|(k, mut m)| {
-            m.materials = names.clone();
-            (k, Arc::new(Shared::of(m)))
-        })
-        .collect();
     let mut stays: Option<MeshData> = None;
     let mut own = Vec::new();
     let mut instances = Vec::new();

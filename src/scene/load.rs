@@ -344,9 +344,13 @@ fn group(
             geometry.parts.len(),
         );
         let kind = if o.string("type")? == Some("gltf") {
-            let line = segments.is_some();
+            let group = gltf_object::InGroup {
+                velocity,
+                moves,
+                on_worldline: segments.is_some(),
+            };
             let mut placed =
-                gltf_object::place(o, velocity, moves, line, materials, material_ids, imports)?;
+                gltf_object::place(o, group, materials, material_ids, imports, meshes)?;
             let (mat, place) = material_and_transform(o, material_ids)?;
             if let Some(mesh) = placed.stays.take() {
                 let (geo, chosen) = (&mut geometry, placed.chosen.clone());

@@ -6,12 +6,18 @@
 //! copied to their places); a file placed several times is read once, held in its own
 //! coordinates, and each entry is a placement of it (`Implicit::Instance`): a thousand
 //! placements of a mesh cost one mesh and a thousand placements, not a thousand meshes.
+//!
+//! So too a glTF file that several `type = "gltf"` entries place: it is read once, every mesh
+//! in it held once (`Shared`), and each entry places those meshes where the file's nodes put
+//! them; what each entry takes for itself (its materials, lights, cameras, and the copies a
+//! node that is a group of its own holds) is cloned from the one reading.
 
+use super::gltf_file::{GltfData, GltfError};
 use super::reader::{SceneResult, Table};
 use super::transform::Transform;
 use crate::geometry::{Affine, Corners, Geometry, Implicit, IndexedMesh, MeshInstance};
 use std::collections::HashMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// The mesh files of a scene, and those read so far that are placed more than once.
@@ -27,7 +33,15 @@ pub(super) struct SharedMeshes {
     inline: std::collections::HashSet<String>,
     /// Files placed more than once, read.
     read: HashMap<PathBuf, Arc<Shared>>,
+    /// How many entries place each glTF file.
+    gltf_uses: HashMap<PathBuf, usize>,
+    /// glTF files placed more than once, read (by file, and whether each top-level node was
+    /// a group of its own): the file with its meshes held once taken out.
+    gltf_read: HashMap<(PathBuf, bool), (GltfData, Held)>,
 }
+
+/// A glTF file's meshes held once, by the file's mesh index.
+pub(super) type Held = HashMap<usize, Arc<Shared>>;
 
 /// A mesh file held once: its triangles in its own coordinates and, by runs of one of the
 /// file's materials, its corner data, each shared by every placement.
@@ -67,6 +81,11 @@ impl SharedMeshes {
                             if !files.contains(&path) {
                                 files.push(path);
                             }
+                        }
+                    }
+                    Some("gltf") => {
+                        if let Some(file) = o.string("file")? {
+                            *s.gltf_uses.entry(key(o.path_beside(file))).or_default() += 1;
                         }
                     }
                     Some("instance") => {
@@ -148,6 +167,38 @@ impl SharedMeshes {
         let shared = Arc::new(Shared::of(read()?));
         self.read.insert(path, shared.clone());
         Ok(shared)
+    }
+}
+
+impl SharedMeshes {
+    /// The glTF file at `path` as an entry takes it (`split_all`: each top-level node a group
+    /// of its own), and its meshes that are held once: read here for a file the scene places
+    /// once; for one it places several times, read on first use with every mesh held once, and
+    /// the same meshes given to every entry.
+    pub fn gltf(&mut self, path: &Path, split_all: bool) -> Result<(GltfData, Held), GltfError> {
+        let file = key(path.to_path_buf());
+        let several = self.gltf_uses.get(&file).is_some_and(|&n| n > 1);
+        let hold = |mut data: GltfData| {
+            let names: Vec<String> = data.materials.iter().map(|m| m.name.clone()).collect();
+            let held: Held = std::mem::take(&mut data.shared)
+                .into_iter()
+                .map(|(k, mut m)| {
+                    m.materials = names.clone();
+                    (k, Arc::new(Shared::of(m)))
+                })
+                .collect();
+            (data, held)
+        };
+        if !several {
+            return Ok(hold(super::gltf_file::read(path, split_all, false)?));
+        }
+        let slot = (file, split_all);
+        if let Some((data, held)) = self.gltf_read.get(&slot) {
+            return Ok((data.clone(), held.clone()));
+        }
+        let (data, held) = hold(super::gltf_file::read(path, split_all, true)?);
+        self.gltf_read.insert(slot, (data.clone(), held.clone()));
+        Ok((data, held))
     }
 }
 

@@ -49,6 +49,7 @@ impl From<&str> for GltfError {
 }
 
 /// A glTF file as the scene takes it.
+#[derive(Clone)]
 pub(crate) struct GltfData {
     /// The default scene's top-level nodes, in the file's order.
     pub nodes: Vec<TopNode>,
@@ -66,6 +67,7 @@ pub(crate) struct GltfData {
 }
 
 /// A top-level node and everything below it.
+#[derive(Clone)]
 pub(crate) struct TopNode {
     pub name: String,
     /// The subtree's triangles (none where it has no mesh); `material_of` gives the file's
@@ -80,6 +82,7 @@ pub(crate) struct TopNode {
 
 /// A metallic-roughness material (with the transmission, IOR and emissive-strength
 /// extensions), its colours linear RGB.
+#[derive(Clone)]
 pub(crate) struct GltfMaterial {
     pub name: String,
     pub base_color: DVec3,
@@ -95,6 +98,7 @@ pub(crate) struct GltfMaterial {
 
 /// An image a material uses: where it came from (for messages and the texture's name) and its
 /// linear texels.
+#[derive(Clone)]
 pub(crate) struct Image {
     pub shown: String,
     pub width: usize,
@@ -103,6 +107,7 @@ pub(crate) struct Image {
 }
 
 /// A `KHR_lights_punctual` point light.
+#[derive(Clone)]
 pub(crate) struct PointLight {
     /// The top-level node it is under.
     pub top: usize,
@@ -143,11 +148,11 @@ const MAPPED: [&str; 4] = [
     "KHR_materials_emissive_strength",
 ];
 
-/// Read the glTF file at `path`.
 /// Read the glTF file at `path`. A mesh that several nodes place is held once, unless a node
 /// placing it is a group of its own (`split_all`: every top-level node; else a keyframed one),
-/// whose group is built alone: it holds a copy.
-pub(crate) fn read(path: &Path, split_all: bool) -> Result<GltfData, GltfError> {
+/// whose group is built alone: it holds a copy. `share_every`: every mesh is held so, as for
+/// a file that several entries of the scene place.
+pub(crate) fn read(path: &Path, split_all: bool, share_every: bool) -> Result<GltfData, GltfError> {
     let bytes = read_file(path)?;
     let gltf = parse(&bytes)?;
     drop(bytes);
@@ -188,7 +193,11 @@ pub(crate) fn read(path: &Path, split_all: bool) -> Result<GltfData, GltfError> 
         lights: Vec::new(),
         cameras: Vec::new(),
         warnings,
-        uses: mesh_uses(&scene, gltf.meshes().len()),
+        uses: if share_every {
+            vec![2; gltf.meshes().len()]
+        } else {
+            mesh_uses(&scene, gltf.meshes().len())
+        },
         shared: Default::default(),
         share: true,
     };

@@ -490,6 +490,68 @@ fn a_mesh_several_nodes_place_is_held_once_and_renders_as_copies() {
     }
 }
 
+/// A glTF file that two entries place (in two groups, moving apart) is read once: each of its
+/// meshes held once and both groups' placements of it one mesh (the same `Arc`), and the
+/// frame is that of the second entry naming a copy of the file, read on its own, on both
+/// backends (every pixel but the silhouettes' within a millionth).
+#[test]
+fn a_gltf_file_two_entries_place_is_read_once_and_renders_as_two_files() {
+    let d = Dir::new("gltf-two-entries");
+    let nodes = json!([
+        {"name": "pair", "children": [1, 2]},
+        {"mesh": 0, "translation": [-0.6, 10.5, 0], "scale": [0.5, 0.5, 0.5]},
+        {"mesh": 0, "translation": [0.6, 10.5, 0.1], "rotation": [0.2, 0.0, 0.3826834, 0.9016],
+         "scale": [0.4, 0.6, 0.5]}
+    ]);
+    let glb = Doc::unit_box(nodes).glb();
+    std::fs::write(d.0.join("pair.glb"), &glb).unwrap();
+    std::fs::write(d.0.join("again.glb"), &glb).unwrap();
+    let scene = |second: &str| {
+        let text = with_object("type = \"gltf\"\nfile = \"pair.glb\"\ntranslate = [-1.2, 0, 0]");
+        format!(
+            "{text}\n[[group]]\nname = \"other\"\nvelocity = [-0.4, 0.1, 0]\n\
+             [[group.object]]\ntype = \"gltf\"\nfile = \"{second}\"\n\
+             translate = [1.2, 0.3, 0]\nscale = 0.8\n"
+        )
+    };
+    let sets = ["image.width=160", "image.height=96"];
+    let (a, b) = (
+        load(&d, "twice.toml", &scene("./pair.glb"), &sets),
+        load(&d, "apart.toml", &scene("again.glb"), &sets),
+    );
+    let meshes = |s: &rest_embree::scene::Scene| -> Vec<_> {
+        s.groups
+            .iter()
+            .flat_map(|g| &g.geometry.implicit)
+            .filter_map(|r| match &r.shape {
+                rest_embree::geometry::Implicit::Instance(i) => Some(i.mesh.clone()),
+                _ => None,
+            })
+            .collect()
+    };
+    let held = meshes(&a);
+    assert_eq!(held.len(), 4, "two placements in each group");
+    assert!(
+        held.iter().all(|m| std::sync::Arc::ptr_eq(m, &held[0])),
+        "one mesh for both entries"
+    );
+    let apart = meshes(&b);
+    assert_eq!(apart.len(), 4);
+    assert!(
+        !std::sync::Arc::ptr_eq(&apart[0], &apart[3]),
+        "two files, two meshes"
+    );
+    assert_eq!(a.groups.len(), 2);
+    for be in backends() {
+        let (x, y) = (render_with(&a, be), render_with(&b, be));
+        let seen = x.pixels.iter().filter(|p| p.alpha > 0.0).count();
+        assert!(seen > 300, "{be}: {seen} pixels see the boxes");
+        let (all, inside) = close_but_edges(&x, &y);
+        eprintln!("{be}: {all} pixels differ beyond 1e-6");
+        assert_eq!(inside, 0, "{be}: {all} differ, {inside} inside");
+    }
+}
+
 /// How many pixels of two frames differ by more than a millionth of their colour, and how many
 /// of those lie away from a silhouette (`meshes::differing`, with a tolerance for the last bits
 /// of f32 that rays rebased to a slightly other box give).
