@@ -64,7 +64,9 @@ six() {
     $r render "scenes/$scene.toml" -o "$film/$name-$k.png" --width 320 --height 180 --frames "$k" $q
     frames+=("$film/$name-$k.png")
   done
-  oiiotool "${frames[@]}" --mosaic 3x2 -o "$o/$name.png"
+  # (Without the command line in the metadata: it names a temporary folder, and the
+  # pictures must come out the same bytes each time.)
+  oiiotool --nosoftwareattrib "${frames[@]}" --mosaic 3x2 -o "$o/$name.png"
 }
 six planet_film planet-film 12 18 24 30 36 46
 six twin_film twin-film 14 22 40 56 76 96
