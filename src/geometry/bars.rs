@@ -6,7 +6,7 @@ use super::{Aabb, Primitive};
 use glam::DVec3;
 
 /// An `n × m` array of box-shaped bars, all along one axis, laid out in the perpendicular plane.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct BarArray {
     /// Bars along the two plane axes.
     pub counts: [u32; 2],

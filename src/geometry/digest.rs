@@ -54,6 +54,18 @@ impl Digest {
         self.put(&x.to_le_bytes());
     }
 
+    #[inline]
+    pub fn u64(&mut self, x: u64) {
+        self.put(&x.to_le_bytes());
+    }
+
+    /// `value`'s bytes as serialized (postcard: numbers as their bits, sequences and variants
+    /// counted first), never its text.
+    pub fn value(&mut self, value: &impl serde::Serialize) {
+        // Writing into a digest cannot fail, nor can serializing plain data.
+        postcard::to_io(value, &mut *self).expect("a value serializes");
+    }
+
     pub fn bytes(&mut self, b: &[u8]) {
         if b.len() >= BLOCK {
             self.hash.update(&self.buf);
@@ -68,6 +80,31 @@ impl Digest {
         let mut hash = self.hash.clone();
         hash.update(&self.buf);
         hash.digest()
+    }
+}
+
+/// A digest worked out once, on first use, and kept beside what it digests (a mesh's numbers,
+/// a texture's texels: data made once and not changed after): the render id of a scene whose
+/// groups place one mesh a thousand times, or of every frame of a film, reads the data once.
+/// It takes no part in comparisons, and a clone keeps it.
+#[derive(Clone, Default)]
+pub(crate) struct Memo(std::sync::OnceLock<u64>);
+
+impl Memo {
+    pub fn get_or(&self, make: impl FnOnce() -> u64) -> u64 {
+        *self.0.get_or_init(make)
+    }
+}
+
+impl PartialEq for Memo {
+    fn eq(&self, _: &Memo) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for Memo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Memo")
     }
 }
 
@@ -147,6 +184,15 @@ pub(crate) fn mesh(d: &mut Digest, m: &IndexedMesh) {
     }
 }
 
+/// A mesh's digest: its vertices and triangles (`mesh`), read once for the mesh's life.
+pub(crate) fn mesh_digest(m: &IndexedMesh) -> u64 {
+    m.digest_memo().get_or(|| {
+        let mut d = Digest::new();
+        mesh(&mut d, m);
+        d.finish()
+    })
+}
+
 /// `item`'s data into `d` the first time it is met, and after that only which one it was:
 /// an item several placements of a mesh share (one `Arc`) is read once, not a thousand times.
 fn once<T>(
@@ -170,7 +216,7 @@ fn once<T>(
 
 /// The digest of everything in `g`.
 pub(crate) fn geometry(g: &Geometry) -> u64 {
-    let (mut seen_corners, mut seen_meshes) = Default::default();
+    let mut seen_corners = Default::default();
     let mut d = Digest::new();
     d.u32(g.prims.len() as u32);
     for p in &g.prims {
@@ -183,25 +229,32 @@ pub(crate) fn geometry(g: &Geometry) -> u64 {
         if let Some(c) = &part.corners {
             once(&mut d, &mut seen_corners, c, corners);
         }
-        if let Some(x) = &part.corners_placed {
-            d.bytes(format!("{:?}", **x).as_bytes());
-        }
-        if let Some(pl) = &part.placement {
-            d.bytes(format!("{:?}", **pl).as_bytes());
-        }
-        if let Some(sp) = &part.spin {
-            d.bytes(format!("{sp:?}").as_bytes());
-        }
+        d.value(&(
+            part.corners_placed.as_deref(),
+            part.placement.as_deref(),
+            part.spin,
+        ));
     }
     for run in &g.implicit {
         d.u32(run.first);
         match &run.shape {
-            Implicit::Mesh(m) => mesh(&mut d, m),
-            Implicit::Instance(m) => {
-                once(&mut d, &mut seen_meshes, &m.mesh, mesh);
-                d.bytes(format!("{:?}", m.place).as_bytes());
+            Implicit::Lattice(l) => {
+                d.u32(0);
+                d.value(l);
             }
-            other => d.bytes(format!("{other:?}").as_bytes()),
+            Implicit::Bars(b) => {
+                d.u32(1);
+                d.value(b);
+            }
+            Implicit::Mesh(m) => {
+                d.u32(2);
+                d.u64(mesh_digest(m));
+            }
+            Implicit::Instance(m) => {
+                d.u32(3);
+                d.u64(mesh_digest(&m.mesh));
+                d.value(&m.place);
+            }
         }
     }
     d.finish()

@@ -31,7 +31,7 @@ pub struct Part {
 /// keeps its shape in the group's frame while every point of its surface moves along it;
 /// any other body (`turning`) is where its shape at time `epoch` turned by ω (t − epoch) puts
 /// it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Spin {
     /// A point of the axis.
     pub centre: DVec3,
@@ -75,7 +75,7 @@ impl Spin {
 /// An object placed by `scale`, then `rotate`, then `translate`, and the shape it was before
 /// (a box, sphere or rod; none for a mesh, whose texture coordinates are its own), so that its
 /// textures turn and move with it.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Placement {
     /// Scaled first, along the object's own axes (every factor > 0).
     pub scale: DVec3,

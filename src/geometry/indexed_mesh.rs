@@ -12,17 +12,20 @@ pub struct IndexedMesh {
     positions: Vec<DVec3>,
     triangles: Vec<[u32; 3]>,
     bounds: Aabb,
+    /// The digest of its numbers (`digest::mesh_digest`), made on first use.
+    digest: super::digest::Memo,
 }
 
 /// Its counts and a digest of its numbers, as [`Geometry`](super::Geometry)'s.
 impl std::fmt::Debug for IndexedMesh {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let mut d = super::digest::Digest::new();
-        super::digest::mesh(&mut d, self);
         f.debug_struct("IndexedMesh")
             .field("positions", &self.positions.len())
             .field("triangles", &self.triangles.len())
-            .field("digest", &format_args!("{:016x}", d.finish()))
+            .field(
+                "digest",
+                &format_args!("{:016x}", super::digest::mesh_digest(self)),
+            )
             .finish()
     }
 }
@@ -44,7 +47,13 @@ impl IndexedMesh {
             positions,
             triangles,
             bounds,
+            digest: Default::default(),
         }
+    }
+
+    /// Where its digest is kept.
+    pub(super) fn digest_memo(&self) -> &super::digest::Memo {
+        &self.digest
     }
 
     /// How many triangles.

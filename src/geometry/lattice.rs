@@ -14,7 +14,7 @@ use glam::DVec3;
 /// order of [`spheres`](Self::spheres) then [`rods`](Self::rods)): the spheres, node (i, j, k)
 /// at `i + nx (j + ny k)`; then the rods along x, along y and along z, each run numbered by
 /// the node the rod starts from within the nodes such rods start from.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Lattice {
     /// Nodes along x, y and z.
     pub counts: [u32; 3],

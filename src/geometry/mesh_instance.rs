@@ -13,7 +13,7 @@ use std::sync::Arc;
 /// Where a mesh's own coordinates go: scaled along its axes, then the linear map, then moved.
 /// From a scene file the linear map is a rotation (`scale`, `rotate`, `translate`); from a
 /// glTF node's matrix it is any invertible 3x3 map with a unit scale.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Affine {
     /// Applied first, along the object's own axes.
     pub scale: DVec3,

@@ -4,7 +4,7 @@ use glam::{DVec3, Vec3Swizzles};
 
 /// One rest-frame primitive. Boxes are axis-aligned; rods are capsules (a cylinder with round
 /// caps).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub enum Primitive {
     /// A sphere.
     Sphere {

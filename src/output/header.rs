@@ -164,12 +164,13 @@ pub(crate) const RENDER_ID: &str = "renderId";
 
 /// What identifies a render's settings, as hex: a hash of the whole scene as loaded (every
 /// value, the view time and the image settings but the crop included, overrides applied), the
-/// backend and the overrides as given. Two files with the same id are frames of the same render
-/// settings: `--resume` skips only a frame whose file says so. The scene's values are
-/// serialized to bytes (postcard: every number its bits, every sequence its length first) into
-/// xxh3 (`geometry::digest`), never formatted as text; a geometry's bulk (primitives, mesh
-/// vertices and indices, corner data), a texture's texels and a colour's tables made from its
-/// spectrum stand there as their counts and digests.
+/// backend, the overrides as given and the renderer's version. Two files with the same id are
+/// frames of the same render settings: `--resume` skips only a frame whose file says so. The
+/// scene's values are serialized to bytes (postcard: every number its bits, every sequence its
+/// length first) into xxh3 (`geometry::digest`), never formatted as text; a geometry's bulk
+/// (primitives, mesh vertices and indices, corner data) and a texture's texels stand there as
+/// their digests, each made once for the data's life, and a colour's tables, made from its
+/// spectrum, are left out.
 pub(crate) fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> String {
     // Field by field, the image without its crop: the tiles of one render share its id.
     let image = crate::scene::ImageSettings {
@@ -189,8 +190,21 @@ pub(crate) fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> S
         image: _,
         warnings: _,
     } = scene;
+    // The renderer's version too: another version may draw the same settings otherwise, and
+    // `--resume` must not keep its frames.
     let fields = (
-        camera, &image, render, materials, lights, groups, objects, film, sky, fog, backend,
+        env!("CARGO_PKG_VERSION"),
+        camera,
+        &image,
+        render,
+        materials,
+        lights,
+        groups,
+        objects,
+        film,
+        sky,
+        fog,
+        backend,
         overrides,
     );
     let mut digest = crate::geometry::digest::Digest::new();
@@ -258,7 +272,8 @@ mod tests {
         [[group]]\nname = \"g\"\nvelocity = [0.5, 0, 0]\n\
         [[group.object]]\ntype = \"mesh\"\nmaterial = \"red\"\n\
         vertices = [[0, 0, 0], [1, 0, 0], [0, 0, 1]]\nindices = [[0, 1, 2]]\n\
-        [[group.object]]\ntype = \"sphere\"\ncenter = [3, 0, 0]\nradius = 1\n";
+        [[group.object]]\ntype = \"sphere\"\ncenter = [3, 0, 0]\nradius = 1\n\
+        [[light]]\nposition = [0, -10, 5]\n";
 
     /// The id names the settings: the same scene loaded twice, or cut into tiles, has one id;
     /// a change of any value's last bit (a velocity, a mesh's vertex, a colour, a sphere's
@@ -280,12 +295,21 @@ mod tests {
             ),
             SCENE.replace("[0.8, 0.1, 0.1]", &format!("[0.8, {}, 0.1]", next(0.1))),
             SCENE.replace("radius = 1\n", &format!("radius = {}\n", next(1.0))),
+            SCENE.replace("[0, -10, 5]", &format!("[0, -10, {}]", next(5.0))),
+            format!("{SCENE}[fog]\ngroup = \"g\"\nsigma_a = 0.01\n"),
         ];
         let mut seen = std::collections::HashSet::from([base.clone()]);
         for text in &changed {
             assert_ne!(text, SCENE);
             assert!(seen.insert(id_of(text, &[])), "{text}");
         }
+        let set = |s: &str| (format!("--set {s}"), s.to_string());
+        assert!(seen.insert(id_of(SCENE, &[set("image.samples=2")])));
+        assert_eq!(
+            id_of(SCENE, &[set("image.width=8")]),
+            base,
+            "a value set as it was"
+        );
         let scene = crate::scene::load_str("t.toml", SCENE, &[]).unwrap();
         assert_eq!(render_id(&scene, "embree", &[]), base);
         assert!(seen.insert(render_id(&scene, "bvh", &[])));

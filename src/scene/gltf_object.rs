@@ -253,7 +253,8 @@ pub(super) fn place(
 /// The placements of meshes the entry `t`'s file places several times (`Placed::instances`)
 /// into `geo` as object `id`: each a placement of the mesh held once, placed by its node and
 /// then by the entry's `transform`; the file's materials `chosen`, remapped by the entry's
-/// `materials`, those it names none `mat`. Each mesh counts against the scene's limit once.
+/// `materials`, those it names none `mat`. Each mesh counts against the scene's limit once,
+/// however many entries place it (`SharedMeshes::first_count`).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn place_instances(
     t: &Table,
@@ -262,17 +263,16 @@ pub(super) fn place_instances(
     transform: Option<Transform>,
     placed: &Placed,
     ids: &HashMap<String, u32>,
-    geo: &mut crate::geometry::Geometry,
-    total: &mut u64,
+    (geo, total): (&mut crate::geometry::Geometry, &mut u64),
+    meshes: &mut SharedMeshes,
 ) -> SceneResult<()> {
     let Some((first, _)) = placed.instances.first() else {
         return Ok(());
     };
     let chosen =
         super::objects::file_materials(t, first.materials(), ids, mat, placed.chosen.clone())?;
-    let mut counted = std::collections::HashSet::new();
     for (shared, world) in &placed.instances {
-        if counted.insert(Arc::as_ptr(shared)) {
+        if meshes.first_count(shared) {
             super::objects::budget(t, "file", total, shared.len())?;
         }
         super::objects::budget(t, "file", total, 1)?;

@@ -357,7 +357,16 @@ fn group(
                 add_mesh_data(o, id, mat, place, geo, total, mesh, chosen, material_ids)?;
             }
             let geo = &mut geometry;
-            gltf_object::place_instances(o, id, mat, place, &placed, material_ids, geo, total)?;
+            gltf_object::place_instances(
+                o,
+                id,
+                mat,
+                place,
+                &placed,
+                material_ids,
+                (geo, total),
+                meshes,
+            )?;
             own_groups.push((k, placed.own, placed.chosen, mat, place));
             "gltf".to_string()
         } else {

@@ -33,11 +33,14 @@ pub(super) struct SharedMeshes {
     inline: std::collections::HashSet<String>,
     /// Files placed more than once, read.
     read: HashMap<PathBuf, Arc<Shared>>,
-    /// How many entries place each glTF file.
-    gltf_uses: HashMap<PathBuf, usize>,
-    /// glTF files placed more than once, read (by file, and whether each top-level node was
-    /// a group of its own): the file with its meshes held once taken out.
+    /// How many entries place each glTF file with each grouping (whether each top-level node
+    /// is a group of its own), and how many of them are still to be read.
+    gltf_uses: HashMap<(PathBuf, bool), (usize, usize)>,
+    /// glTF files several entries place, read and kept for the entries still to come: the file
+    /// with its meshes held once taken out.
     gltf_read: HashMap<(PathBuf, bool), (GltfData, Held)>,
+    /// The meshes held once counted against the scene's limit so far (each once).
+    counted: std::collections::HashSet<*const Shared>,
 }
 
 /// A glTF file's meshes held once, by the file's mesh index.
@@ -85,7 +88,10 @@ impl SharedMeshes {
                     }
                     Some("gltf") => {
                         if let Some(file) = o.string("file")? {
-                            *s.gltf_uses.entry(key(o.path_beside(file))).or_default() += 1;
+                            let split = o.string("groups")? == Some("nodes");
+                            let slot = (key(o.path_beside(file)), split);
+                            let uses = s.gltf_uses.entry(slot).or_default();
+                            *uses = (uses.0 + 1, uses.1 + 1);
                         }
                     }
                     Some("instance") => {
@@ -172,12 +178,19 @@ impl SharedMeshes {
 
 impl SharedMeshes {
     /// The glTF file at `path` as an entry takes it (`split_all`: each top-level node a group
-    /// of its own), and its meshes that are held once: read here for a file the scene places
-    /// once; for one it places several times, read on first use with every mesh held once, and
-    /// the same meshes given to every entry.
+    /// of its own), and its meshes that are held once: read here for a file one entry places;
+    /// for one several entries place (with the same grouping), read on first use with every
+    /// mesh held once, the same meshes given to every entry, and the reading kept until the
+    /// last of them takes it.
     pub fn gltf(&mut self, path: &Path, split_all: bool) -> Result<(GltfData, Held), GltfError> {
-        let file = key(path.to_path_buf());
-        let several = self.gltf_uses.get(&file).is_some_and(|&n| n > 1);
+        let slot = (key(path.to_path_buf()), split_all);
+        let (several, left) = match self.gltf_uses.get_mut(&slot) {
+            Some((all, left)) => {
+                *left = left.saturating_sub(1);
+                (*all > 1, *left)
+            }
+            None => (false, 0),
+        };
         let hold = |mut data: GltfData| {
             let names: Vec<String> = data.materials.iter().map(|m| m.name.clone()).collect();
             let held: Held = std::mem::take(&mut data.shared)
@@ -192,13 +205,21 @@ impl SharedMeshes {
         if !several {
             return Ok(hold(super::gltf_file::read(path, split_all, false)?));
         }
-        let slot = (file, split_all);
-        if let Some((data, held)) = self.gltf_read.get(&slot) {
-            return Ok((data.clone(), held.clone()));
+        let read = match self.gltf_read.remove(&slot) {
+            Some(read) => read,
+            None => hold(super::gltf_file::read(path, split_all, true)?),
+        };
+        if left > 0 {
+            self.gltf_read
+                .insert(slot, (read.0.clone(), read.1.clone()));
         }
-        let (data, held) = hold(super::gltf_file::read(path, split_all, true)?);
-        self.gltf_read.insert(slot, (data.clone(), held.clone()));
-        Ok((data, held))
+        Ok(read)
+    }
+
+    /// Whether the held mesh `s` is counted against the scene's limit for the first time
+    /// (it is then counted, once, however many entries and groups place it).
+    pub fn first_count(&mut self, s: &Arc<Shared>) -> bool {
+        self.counted.insert(Arc::as_ptr(s))
     }
 }
 

@@ -51,18 +51,22 @@ pub struct ImageTexture {
     pub basis: [Colour; 3],
     /// From RGB to the coefficients on `basis`.
     pub to_basis: DMat3,
+    /// The digest of `texels`, made on first use (a texture is not changed once made).
+    digest: crate::geometry::digest::Memo,
 }
 
 impl ImageTexture {
-    /// A digest of its texels' bits.
+    /// A digest of its texels' bits, read once for the texture's life.
     fn texel_digest(&self) -> u64 {
-        let mut d = crate::geometry::digest::Digest::new();
-        for t in self.texels.iter() {
-            for c in t {
-                d.bytes(&c.to_bits().to_le_bytes());
+        self.digest.get_or(|| {
+            let mut d = crate::geometry::digest::Digest::new();
+            for t in self.texels.iter() {
+                for c in t {
+                    d.bytes(&c.to_bits().to_le_bytes());
+                }
             }
-        }
-        d.finish()
+            d.finish()
+        })
     }
 }
 
@@ -136,6 +140,7 @@ impl ImageTexture {
             texels,
             basis,
             to_basis,
+            digest: Default::default(),
         }
     }
 

@@ -542,6 +542,23 @@ fn a_gltf_file_two_entries_place_is_read_once_and_renders_as_two_files() {
         "two files, two meshes"
     );
     assert_eq!(a.groups.len(), 2);
+    // A file that places its mesh once, named by two entries: the mesh held once, each
+    // entry's group placing it once.
+    let single = Doc::unit_box(json!([{"name": "one", "translation": [0, 10.5, 0]}]));
+    let mut single = single;
+    single.json["nodes"][0]["mesh"] = json!(0);
+    std::fs::write(d.0.join("single.glb"), single.glb()).unwrap();
+    let text = with_object("type = \"gltf\"\nfile = \"single.glb\"\ntranslate = [-1.2, 0, 0]");
+    let text = format!(
+        "{text}\n[[group]]\nname = \"other\"\nvelocity = [-0.4, 0.1, 0]\n\
+         [[group.object]]\ntype = \"gltf\"\nfile = \"single.glb\"\ntranslate = [1.2, 0.3, 0]\n"
+    );
+    let once = meshes(&load(&d, "single.toml", &text, &sets));
+    assert_eq!(once.len(), 2, "one placement in each group");
+    assert!(
+        std::sync::Arc::ptr_eq(&once[0], &once[1]),
+        "one mesh for both entries"
+    );
     for be in backends() {
         let (x, y) = (render_with(&a, be), render_with(&b, be));
         let seen = x.pixels.iter().filter(|p| p.alpha > 0.0).count();
