@@ -619,3 +619,47 @@ fn the_moving_bounds_test_turns_away_no_hit() {
         same_picture(&a, &b, name, 0.0, 1e-4);
     }
 }
+
+/// The trees count bodies, not groups: a body on a worldline of eight segments (eight groups
+/// of one name, each met only in its window) goes without them, and eight bodies in groups of
+/// their own take them. Both draw what the f64 BVH draws.
+#[test]
+fn the_group_trees_count_bodies_not_a_worldlines_segments() {
+    let segments = "[{until=-40, velocity=[-0.9,0,0]}, {until=-20, velocity=[-0.88,0,0]}, \
+                    {until=-10, velocity=[-0.9,0,0]}, {until=-5, velocity=[-0.88,0,0]}, \
+                    {until=-2, velocity=[-0.9,0,0]}, {until=0, velocity=[-0.88,0,0]}, \
+                    {until=1, velocity=[-0.9,0,0]}, {velocity=[-0.88,0,0]}]";
+    let head = "[camera]\nposition = [0, -30, 0]\nlook_at = [0, 0, 0]\ntime = 3\n\
+                [image]\nwidth = 64\nheight = 48\n[[light]]\nposition = [5, -30, 20]\n";
+    let body = format!(
+        "{head}[[group]]\nname = \"bar\"\nworldline = {segments}\n[[group.object]]\n\
+         type = \"box\"\nmin = [-40, -3, -3]\nmax = [-8, 3, 3]\n"
+    );
+    let mut bodies = head.to_string();
+    for i in 0..8 {
+        let x = -14.0 + 4.0 * i as f64;
+        bodies += &format!(
+            "[[group]]\nname = \"b{i}\"\nvelocity = [0, 0, 0.0{i}]\n[[group.object]]\n\
+             type = \"box\"\nmin = [{x}, -1, -1]\nmax = [{}, 1, 1]\n",
+            x + 2.0
+        );
+    }
+    for (text, trees) in [(body, false), (bodies, true)] {
+        let s = crate::scene::load_str("t.toml", &text, &[]).unwrap();
+        assert_eq!(s.groups.len(), 8);
+        let frames: Vec<Frame> = backends()
+            .into_iter()
+            .map(|name| {
+                let backend = crate::accel::backend_by_name(name).unwrap();
+                let w = World::build(&s, backend.as_ref()).unwrap();
+                assert_eq!(w.uses_group_tree(), trees, "{name}");
+                render_world(&s, &w).0
+            })
+            .collect();
+        let hit = frames[0].pixels.iter().filter(|p| p.object_id != 0).count();
+        assert!(hit > 100, "in view ({hit})");
+        for f in &frames[1..] {
+            same_picture(&frames[0], f, "embree against bvh", 0.0, 1e-4);
+        }
+    }
+}

@@ -223,8 +223,18 @@ impl World {
                 simd: options.simd,
             })
             .collect();
+        // The trees cull bodies; the segments of one body's worldline (groups of one name) lie
+        // where it goes, and a ray meets them in turn, each only in its window, which the
+        // groups' packets test before any intersection: the trees pay for many bodies, not
+        // for many segments of a few.
+        let bodies = scene
+            .groups
+            .iter()
+            .map(|g| g.name.as_str())
+            .collect::<std::collections::HashSet<_>>()
+            .len();
         let (tree, primary_tree, light_trees) =
-            if options.group_tree && groups.len() >= GROUP_TREE_MIN {
+            if options.group_tree && groups.len().min(bodies) >= GROUP_TREE_MIN {
                 let (k, a, l) = Self::group_trees(scene, &groups, backend)?;
                 (Some(k), Some(a), l)
             } else {
