@@ -39,8 +39,9 @@ pub(super) struct SharedMeshes {
     /// glTF files several entries place, read and kept for the entries still to come: the file
     /// with its meshes held once taken out.
     gltf_read: HashMap<(PathBuf, bool), (GltfData, Held)>,
-    /// The meshes held once counted against the scene's limit so far (each once).
-    counted: std::collections::HashSet<*const Shared>,
+    /// The meshes held once counted against the scene's limit so far (each once), kept alive
+    /// here so that no later mesh can take the address one of them had.
+    counted: HashMap<*const Shared, Arc<Shared>>,
 }
 
 /// A glTF file's meshes held once, by the file's mesh index.
@@ -219,7 +220,7 @@ impl SharedMeshes {
     /// Whether the held mesh `s` is counted against the scene's limit for the first time
     /// (it is then counted, once, however many entries and groups place it).
     pub fn first_count(&mut self, s: &Arc<Shared>) -> bool {
-        self.counted.insert(Arc::as_ptr(s))
+        self.counted.insert(Arc::as_ptr(s), s.clone()).is_none()
     }
 }
 
