@@ -143,7 +143,7 @@ impl Default for PassSet {
     }
 }
 
-/// As a list of names (what the render id hashes and messages show).
+/// As a list of names (what messages show).
 impl fmt::Debug for PassSet {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_list()

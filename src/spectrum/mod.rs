@@ -212,15 +212,13 @@ pub struct Colour {
     black: bool,
 }
 
-/// As derived when the table was made with the colour: its text (which the render id hashes)
-/// is the same whether or not the table has been read yet.
+/// Without its table, which is made from the spectrum (printing a colour makes none).
 impl std::fmt::Debug for Colour {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Colour")
             .field("rgb", &self.rgb)
             .field("spectrum", &self.spectrum)
             .field("from_rgb", &self.from_rgb)
-            .field("table", &self.table.as_ref().map(|t| self.table_in(t)))
             .field("black", &self.black)
             .finish()
     }

@@ -118,6 +118,7 @@ fn fit(rgb: DVec3) -> [f64; 3] {
     c
 }
 
+/// The fit itself, made anew (what `fit` keeps).
 fn fit_anew(rgb: DVec3) -> [f64; 3] {
     let model = Model::new();
     let to_xyz = XYZ_TO_SRGB.inverse();
@@ -207,8 +208,6 @@ mod tests {
         }
     }
 
-    /// An RGB grey is exactly the flat spectrum of that value; an emitter grey is exactly that
-    /// many times the white.
     /// A kept fit is the fit itself, bit for bit, and a colour fitted before is found again.
     #[test]
     fn a_kept_fit_is_a_new_fit() {
@@ -219,6 +218,8 @@ mod tests {
         }
     }
 
+    /// An RGB grey is exactly the flat spectrum of that value; an emitter grey is exactly that
+    /// many times the white.
     #[test]
     fn greys_are_exact() {
         for v in [0.0, 0.18, 0.5, 1.0, 3.0] {

@@ -223,21 +223,12 @@ impl World {
                 simd: options.simd,
             })
             .collect();
-        // The trees cull bodies; the segments of one body's worldline (groups of one name) lie
-        // where it goes, and a ray meets them in turn, each only in its window, which the
-        // groups' packets test before any intersection: the trees pay for many bodies, not
-        // for many segments of a few (measured: a lattice on 512 segments renders faster
-        // without them). Bodies: the groups seen at all times, as merged, and the worldlines.
-        let worldlines = scene
-            .groups
-            .iter()
-            .filter(|g| g.window.is_some() && !g.geometry.is_empty())
-            .map(|g| g.name.as_str())
-            .collect::<std::collections::HashSet<_>>()
-            .len();
-        let bodies = groups.iter().filter(|g| g.window.is_none()).count() + worldlines;
+        // The trees cull bodies (`RestGroups::bodies`); a body's worldline segments lie where
+        // it goes, and a ray meets them in turn, each only in its window, which the groups'
+        // packets test before any intersection: the trees pay for many bodies, not for many
+        // segments of a few (measured: a lattice on 512 segments renders faster without them).
         let (tree, primary_tree, light_trees) =
-            if options.group_tree && groups.len().min(bodies) >= GROUP_TREE_MIN {
+            if options.group_tree && groups.len().min(rest.bodies) >= GROUP_TREE_MIN {
                 let (k, a, l) = Self::group_trees(scene, &groups, backend)?;
                 (Some(k), Some(a), l)
             } else {

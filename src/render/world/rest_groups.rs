@@ -39,6 +39,9 @@ pub(super) struct RestGroup {
 pub struct RestGroups {
     pub(super) groups: Vec<RestGroup>,
     pub(super) options: WorldOptions,
+    /// How many bodies the groups are: those seen at all times (as merged) and the worldlines
+    /// (a worldline's segments are groups of one name, each seen in its window).
+    pub(super) bodies: usize,
 }
 
 impl RestGroups {
@@ -133,7 +136,19 @@ impl RestGroups {
                 direct: prims,
             });
         }
-        Ok(RestGroups { groups, options })
+        let worldlines = scene
+            .groups
+            .iter()
+            .filter(|g| g.window.is_some() && !g.geometry.is_empty())
+            .map(|g| g.name.as_str())
+            .collect::<std::collections::HashSet<_>>()
+            .len();
+        let bodies = groups.iter().filter(|g| g.window.is_none()).count() + worldlines;
+        Ok(RestGroups {
+            groups,
+            options,
+            bodies,
+        })
     }
 }
 
