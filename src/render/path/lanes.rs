@@ -15,8 +15,7 @@ use glam::DVec3;
 use multiversion::multiversion;
 use std::f64::consts::PI;
 
-/// Lanes run together: a chunk of vertices is copied into columns on the stack (where nothing
-/// else can write), run in one loop, and copied back.
+/// Lanes run together: a block of vertices, a column per input and per result.
 const WIDTH: usize = 8;
 
 /// A diffuse vertex as the lanes take it.
@@ -97,99 +96,102 @@ mod col_out {
     pub const COUNT: usize = 23;
 }
 
-/// A bounce's diffuse vertices, in and out, a row each.
+/// A block of `WIDTH` vertices' inputs, a column each (as the lanes read them).
+type InBlock = [[f64; WIDTH]; col_in::COUNT];
+/// A block of `WIDTH` vertices' results, a column each.
+type OutBlock = [[f64; WIDTH]; col_out::COUNT];
+
+/// A bounce's diffuse vertices, in and out, in blocks of `WIDTH` laid out as the lanes run
+/// them (vertex i is lane i % WIDTH of block i / WIDTH), so a run reads and writes its
+/// vector registers straight from them. The lanes past the last vertex are zeros.
 #[derive(Default)]
 pub(super) struct DiffuseLanes {
-    ins: Vec<[f64; col_in::COUNT]>,
-    outs: Vec<[f64; col_out::COUNT]>,
+    ins: Vec<InBlock>,
+    outs: Vec<OutBlock>,
+    len: usize,
 }
 
 impl DiffuseLanes {
     pub fn clear(&mut self) {
         self.ins.clear();
+        self.len = 0;
     }
 
     pub fn len(&self) -> usize {
-        self.ins.len()
+        self.len
     }
 
+    #[inline]
     pub fn push(&mut self, d: &DiffuseIn) {
         let (c, r) = d.sphere;
-        self.ins.push([
+        let j = self.len % WIDTH;
+        if j == 0 {
+            self.ins.push([[0.0; WIDTH]; col_in::COUNT]);
+        }
+        let block = self.ins.last_mut().expect("a block for the vertex");
+        let row = [
             d.nf.x, d.nf.y, d.nf.z, d.v.x, d.v.y, d.v.z, d.x.x, d.x.y, d.x.z, c.x, c.y, c.z, r,
             d.epsilon, d.u[0], d.u[1], d.p_pick, d.ue[0], d.ue[1],
-        ]);
+        ];
+        for (column, v) in block.iter_mut().zip(row) {
+            column[j] = v;
+        }
+        self.len += 1;
     }
 
     /// Vertex i's shading normal and the direction its path looked along (as pushed).
     pub fn normal_and_look(&self, i: usize) -> (DVec3, DVec3) {
         use col_in::*;
-        let r = &self.ins[i];
-        let v3 = |k: usize| DVec3::new(r[k], r[k + 1], r[k + 2]);
+        let (b, j) = (&self.ins[i / WIDTH], i % WIDTH);
+        let v3 = |k: usize| DVec3::new(b[k][j], b[k + 1][j], b[k + 2][j]);
         (v3(NF), v3(V))
     }
 
     /// Vertex i's results (after [`DiffuseLanes::run`]).
+    #[inline]
     pub fn out(&self, i: usize) -> DiffuseOut {
         use col_out::*;
-        let o = &self.outs[i];
-        let v3 = |k: usize| DVec3::new(o[k], o[k + 1], o[k + 2]);
+        let (o, j) = (&self.outs[i / WIDTH], i % WIDTH);
+        let v3 = |k: usize| DVec3::new(o[k][j], o[k + 1][j], o[k + 2][j]);
         DiffuseOut {
-            drawn: o[DRAWN] != 0.0,
-            pdf: o[PDF],
-            weight: o[WEIGHT],
+            drawn: o[DRAWN][j] != 0.0,
+            pdf: o[PDF][j],
+            weight: o[WEIGHT][j],
             wi: v3(WI),
             next: v3(NEXT),
-            coned: o[CONED] != 0.0,
-            lit: o[LIT] != 0.0,
+            coned: o[CONED][j] != 0.0,
+            lit: o[LIT][j] != 0.0,
             point: v3(POINT),
             from: v3(FROM),
             look: v3(LOOK),
-            tmax: o[TMAX],
-            cos: o[COS],
-            factor: o[FACTOR],
+            tmax: o[TMAX][j],
+            cos: o[COS][j],
+            factor: o[FACTOR][j],
         }
     }
 
     /// Run every lane (in vector registers where `simd`, else one by one).
     pub fn run(&mut self, simd: bool) {
-        self.outs.resize(self.ins.len(), [0.0; col_out::COUNT]);
+        self.outs
+            .resize(self.ins.len(), [[0.0; WIDTH]; col_out::COUNT]);
         if simd {
             run_lanes(&self.ins, &mut self.outs);
         } else {
-            for (i, o) in self.ins.iter().zip(self.outs.iter_mut()) {
-                let mut cols = [[0.0; 1]; col_in::COUNT];
-                for (c, v) in cols.iter_mut().zip(i) {
-                    c[0] = *v;
-                }
-                let mut res = [[0.0; 1]; col_out::COUNT];
-                lane(&cols, &mut res, 0);
-                for (o, c) in o.iter_mut().zip(&res) {
-                    *o = c[0];
+            for (b, (block, res)) in self.ins.iter().zip(self.outs.iter_mut()).enumerate() {
+                for j in 0..(self.len - b * WIDTH).min(WIDTH) {
+                    lane(block, res, j);
                 }
             }
         }
     }
 }
 
-/// Every lane, WIDTH at a time in a loop the compiler vectorises for the CPU it runs on.
+/// Every block's lanes, in a loop the compiler vectorises for the CPU it runs on.
 #[multiversion(targets("x86_64+avx512f+avx512dq+avx512vl", "x86_64+avx2"))]
-fn run_lanes(ins: &[[f64; col_in::COUNT]], outs: &mut [[f64; col_out::COUNT]]) {
-    for (rows, done) in ins.chunks(WIDTH).zip(outs.chunks_mut(WIDTH)) {
-        let mut cols = [[0.0; WIDTH]; col_in::COUNT];
-        for (j, row) in rows.iter().enumerate() {
-            for (c, v) in cols.iter_mut().zip(row) {
-                c[j] = *v;
-            }
-        }
-        let mut res = [[0.0; WIDTH]; col_out::COUNT];
+fn run_lanes(ins: &[InBlock], outs: &mut [OutBlock]) {
+    for (block, res) in ins.iter().zip(outs.iter_mut()) {
         for j in 0..WIDTH {
-            lane(&cols, &mut res, j);
-        }
-        for (j, row) in done.iter_mut().enumerate() {
-            for (o, c) in row.iter_mut().zip(&res) {
-                *o = c[j];
-            }
+            lane(block, res, j);
         }
     }
 }

@@ -506,19 +506,35 @@ impl World {
                     continue;
                 }
                 g.intersect_as(&batch[..n], &mut hits[..n], scattered);
+                // A group that neither accelerates nor spins: each hit is where its rest ray
+                // meets the surface (`surface_hit`, and `spun` leaves it), made here.
+                let plain = g.accelerated.is_none() && !g.spins;
                 for i in 0..n {
                     // Backends report no hit on inactive rays.
-                    if let Some(h) = hits[i] {
+                    let Some(h) = hits[i] else {
+                        continue;
+                    };
+                    let hit = if plain {
+                        let r = &batch[i];
+                        SurfaceHit {
+                            group: gi,
+                            prim: h.prim,
+                            lambda: shift[i] + h.t,
+                            point: r.origin + h.t * r.dir,
+                            dir: r.dir,
+                            s: factor[i],
+                        }
+                    } else {
                         let rr = RestRay {
                             ray: batch[i],
                             shift: shift[i],
                             s: factor[i],
                         };
-                        let hit = self.spun(self.surface_hit(gi, &rr, h));
-                        if hit.lambda < best[i] {
-                            best[i] = hit.lambda;
-                            out[i] = Some(hit);
-                        }
+                        self.spun(self.surface_hit(gi, &rr, h))
+                    };
+                    if hit.lambda < best[i] {
+                        best[i] = hit.lambda;
+                        out[i] = Some(hit);
                     }
                 }
             }
