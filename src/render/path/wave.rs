@@ -194,7 +194,9 @@ impl<'a, B: Band> PathTracer<'_, 'a, B> {
                 }
             }
         }
-        w.hits.clear();
+        // Every entry is written by the trace: the ones kept from the last bounce are not
+        // cleared first.
+        w.hits.truncate(w.rays.len());
         w.hits.resize(w.rays.len(), None);
         self.shader
             .world

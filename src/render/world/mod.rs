@@ -477,15 +477,16 @@ impl World {
         }
         // A packet's worth of rays at a time, through every group, on the stack.
         const CHUNK: usize = PACKET;
+        // Made once for every chunk: each chunk writes the lanes it reads.
+        let mut batch = [INACTIVE; CHUNK];
+        // Each lane's shift and lookback factor (valid where the lane is active); kept
+        // apart from the rays so the rays go into the batch straight from registers.
+        let mut shift = [0.0; CHUNK];
+        let mut factor = [0.0; CHUNK];
+        let mut hits: [Option<Hit>; CHUNK] = [None; CHUNK];
         for (rays, out) in rays.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
             let n = rays.len();
             let mut best = [f64::INFINITY; CHUNK];
-            let mut batch = [INACTIVE; CHUNK];
-            // Each lane's shift and lookback factor (valid where the lane is active); kept
-            // apart from the rays so the rays go into the batch straight from registers.
-            let mut shift = [0.0; CHUNK];
-            let mut factor = [0.0; CHUNK];
-            let mut hits: [Option<Hit>; CHUNK] = [None; CHUNK];
             out.iter_mut().for_each(|o| *o = None);
             for (gi, g) in self.groups.iter().enumerate() {
                 // Every ray keeps its lane, so a packet stays a square of neighbouring pixels;

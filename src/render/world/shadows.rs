@@ -26,14 +26,15 @@ impl World {
             return;
         }
         const CHUNK: usize = PACKET;
+        // Made once for every chunk: each chunk writes the lanes it reads.
+        let mut batch = [INACTIVE; CHUNK];
+        let mut hit = [false; CHUNK];
         for ((rays, tmax), out) in rays
             .chunks(CHUNK)
             .zip(tmax.chunks(CHUNK))
             .zip(out.chunks_mut(CHUNK))
         {
             let n = rays.len();
-            let mut batch = [INACTIVE; CHUNK];
-            let mut hit = [false; CHUNK];
             out.iter_mut().for_each(|o| *o = false);
             for g in &self.groups {
                 // Rays already in shadow stay out (masked) of the other groups' packets.
