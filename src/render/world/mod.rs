@@ -410,14 +410,7 @@ impl World {
                 s,
             };
         }
-        SurfaceHit {
-            group: gi,
-            prim: h.prim,
-            lambda: rr.shift + h.t,
-            point: rr.ray.origin + h.t * rr.ray.dir,
-            dir: rr.ray.dir,
-            s: rr.s,
-        }
+        hit_on(gi, &rr.ray, rr.shift, rr.s, h)
     }
 
     /// A hit on a spinning object seen in its point's own frame, which moves at the spin's
@@ -516,15 +509,7 @@ impl World {
                         continue;
                     };
                     let hit = if plain {
-                        let r = &batch[i];
-                        SurfaceHit {
-                            group: gi,
-                            prim: h.prim,
-                            lambda: shift[i] + h.t,
-                            point: r.origin + h.t * r.dir,
-                            dir: r.dir,
-                            s: factor[i],
-                        }
+                        hit_on(gi, &batch[i], shift[i], factor[i], h)
                     } else {
                         let rr = RestRay {
                             ray: batch[i],
@@ -633,5 +618,19 @@ impl World {
     #[inline(always)]
     fn may_meet(&self, g: &WorldGroup, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
         !self.clip_rays || g.moving.may_meet(ray, tmin, tmax)
+    }
+}
+
+/// Hit `h` of group `gi`'s rest ray `ray` (moved `shift` along the world ray, lookback factor
+/// `s`) as a surface hit, where the group's frame carries it no further (not accelerated).
+#[inline]
+fn hit_on(gi: usize, ray: &Ray, shift: f64, s: f64, h: Hit) -> SurfaceHit {
+    SurfaceHit {
+        group: gi,
+        prim: h.prim,
+        lambda: shift + h.t,
+        point: ray.origin + h.t * ray.dir,
+        dir: ray.dir,
+        s,
     }
 }
