@@ -219,39 +219,61 @@ pub(super) fn write_blocks(
         let header = &meta.headers[0];
         let width = header.layer_size.width();
         let (mut next, mut y0) = (0usize, 0usize);
-        let result = fill(&mut |channels, rows| {
-            let y1 = y0 + rows;
-            let mine = blocks[next..]
-                .iter()
-                .take_while(|(_, b)| b.pixel_position.y() + b.pixel_size.height() <= y1)
-                .count();
-            let chunks: Vec<_> = blocks[next..next + mine]
-                .par_iter()
-                .map(|&(index, block)| {
-                    let raw = channels.block(&header.channels, block, y0, width);
-                    compress(&meta.headers, block, raw).map(|c| (index, c))
-                })
-                .collect();
-            for chunk in chunks {
-                let (index, chunk) = chunk.map_err(cause)?;
-                writer.write_chunk(index, chunk).map_err(cause)?;
+        std::thread::scope(|scope| {
+            // A run's chunks are written, in order, by a thread of their own while the next
+            // run renders (one run waits at most); the renderer's threads never wait on the
+            // file.
+            let (tx, rx) =
+                std::sync::mpsc::sync_channel::<Vec<(usize, exr::block::chunk::Chunk)>>(1);
+            let writing = scope.spawn(move || -> exr::error::Result<()> {
+                for chunks in rx {
+                    for (index, chunk) in chunks {
+                        writer.write_chunk(index, chunk)?;
+                    }
+                }
+                Ok(())
+            });
+            let result = fill(&mut |channels, rows| {
+                let y1 = y0 + rows;
+                let mine = blocks[next..]
+                    .iter()
+                    .take_while(|(_, b)| b.pixel_position.y() + b.pixel_size.height() <= y1)
+                    .count();
+                let chunks = blocks[next..next + mine]
+                    .par_iter()
+                    .map(|&(index, block)| {
+                        let raw = channels.block(&header.channels, block, y0, width);
+                        compress(&meta.headers, block, raw).map(|c| (index, c))
+                    })
+                    .collect::<exr::error::Result<Vec<_>>>()
+                    .map_err(cause)?;
+                // A writer that stopped has its error, given below.
+                let sent = tx.send(chunks);
+                next += mine;
+                y0 = y1;
+                sent.map_err(|_| cause(std::io::Error::other("the file's writer stopped")))
+            });
+            drop(tx);
+            let wrote = writing
+                .join()
+                .unwrap_or_else(|p| std::panic::resume_unwind(p));
+            if let Err(e) = wrote {
+                failed = Some(cause(e));
+                return Err(exr::error::Error::Aborted);
             }
-            next += mine;
-            y0 = y1;
+            if let Err(e) = result {
+                failed = Some(e);
+                return Err(exr::error::Error::Aborted);
+            }
+            if next != blocks.len() {
+                failed = Some(cause(std::io::Error::other(format!(
+                    "{y0} rows of {} were written",
+                    header.layer_size.height()
+                ))));
+                return Err(exr::error::Error::Aborted);
+            }
             Ok(())
-        });
-        if let Err(e) = result {
-            failed = Some(e);
-            return Err(exr::error::Error::Aborted);
-        }
-        if next != blocks.len() {
-            failed = Some(cause(std::io::Error::other(format!(
-                "{y0} rows of {} were written",
-                header.layer_size.height()
-            ))));
-            return Err(exr::error::Error::Aborted);
-        }
-        Ok(())
+        })
     });
     if let Some(e) = failed {
         return Err(e);
