@@ -342,13 +342,15 @@ impl World {
         if let Some(t_ref) = g.time_origin() {
             return self.rest_ray_timed(g, t_ref, ray, tmin, tmax);
         }
-        // Every primary ray starts at the imaging event: its rest-frame origin is per group.
-        let origin = if ray.origin == self.event {
-            g.event_rest
+        // A group at rest in the world frame sees the ray as it is. Elsewhere, every primary
+        // ray starts at the imaging event: its rest-frame origin is per group.
+        let (origin, (dir, s)) = if g.boost.is_identity() {
+            (ray.origin.x, (ray.dir, 1.0))
+        } else if ray.origin == self.event {
+            (g.event_rest, g.boost.null_dir(ray.dir))
         } else {
-            g.boost.event(ray.origin).x
+            (g.boost.event(ray.origin).x, g.boost.null_dir(ray.dir))
         };
-        let (dir, s) = g.boost.null_dir(ray.dir);
         let shift = if self.clip_rays {
             g.bounds.clip(origin, dir.recip(), tmin, tmax)?.0
         } else {
