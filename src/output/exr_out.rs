@@ -557,4 +557,42 @@ mod tests {
             }
         }
     }
+
+    /// A file whose writes fail part way (a full device) ends the render with the device's
+    /// error, as the thread that writes the chunks met it: not a panic, and not the word of
+    /// the renderer's side that the writer stopped.
+    #[test]
+    fn a_failed_write_is_the_devices_error() {
+        let full = Path::new("/dev/full");
+        if !full.exists() {
+            return;
+        }
+        let (w, h) = (256, 256);
+        let mut rng = crate::rng::Rng(5);
+        let mut frame = Frame::new(w, h);
+        for p in frame.pixels.iter_mut() {
+            // Noise, which does not compress: every strip's chunks exceed the write buffer.
+            let r = f32::from_bits((rng.next_u64() as u32) & 0x3f7f_ffff);
+            p.color = [r, r, r];
+            p.position = [r, r, r];
+        }
+        let mut strips = 0;
+        let err = write_strips(full, (w, h), false, &ExrOptions::default(), |put| {
+            for y in (0..h).step_by(32) {
+                let strip = Frame {
+                    width: w,
+                    height: 32,
+                    pixels: frame.pixels[(y * w) as usize..((y + 32) * w) as usize].to_vec(),
+                    mattes: Vec::new(),
+                };
+                strips += 1;
+                put(&strip)?;
+            }
+            Ok(())
+        })
+        .expect_err("a full device fails the write");
+        let said = err.to_string();
+        assert!(said.contains("No space left"), "{said}");
+        assert!(strips >= 1, "{strips}");
+    }
 }
