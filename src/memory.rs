@@ -45,9 +45,9 @@ pub(crate) const BYTES_PER_PIXEL_PNG: u64 = 96;
 pub(crate) const STRIP_PIXELS: u64 = 1 << 18;
 /// Bytes per pixel of an EXR render's strip: the frame (92), its mattes (96), and the
 /// encoder's 46 channels of 4 bytes. The encoder holds no copy of the strip's channels any
-/// more, but each thread's block in flight and the two buffers it keeps for its ZIP (a block
-/// is 32 rows or fewer, a strip at least 64 rows per thread): less than that copy, so the
-/// figure stays an upper bound.
+/// more, but each thread's line, block in flight (ZIP's predicted bytes, or another
+/// compression's block) and compressed block (a block is 32 rows or fewer, a strip at least 64
+/// rows per thread): less than that copy, so the figure stays an upper bound.
 pub(crate) const BYTES_PER_PIXEL_EXR: u64 = 380;
 
 /// What a triangle of a mesh held as itself costs rendered, its corner data aside: its share of

@@ -22,6 +22,22 @@ pub(super) trait BlockSource: Sync {
         y0: usize,
         width: usize,
     ) -> UncompressedBlock;
+
+    /// The same bytes handed to `each` a line at a time, top to bottom (a source that can
+    /// make a line alone never holds the block whole).
+    fn each_line(
+        &self,
+        channels: &ChannelList,
+        block: BlockIndex,
+        y0: usize,
+        width: usize,
+        each: &mut dyn FnMut(&[u8]),
+    ) {
+        let data = self.block(channels, block, y0, width).data;
+        let lines = block.pixel_size.height().max(1);
+        data.chunks(data.len().div_ceil(lines).max(1))
+            .for_each(each);
+    }
 }
 
 /// Columns of samples, as the file orders its channels (what a tile being joined holds).
@@ -131,6 +147,58 @@ pub(super) struct Strip<'a> {
 /// Pixels whose values are made together, then stored column by column.
 const RUN: usize = 16;
 
+/// A line's columns by the kind of value each holds (which value, its first byte in the line,
+/// its sample type): the passes' and the mattes'.
+type Columns = SmallVec<[(usize, usize, SampleType); 32]>;
+
+impl Strip<'_> {
+    /// The columns of a line `n` pixels long, and the line's bytes.
+    fn columns(&self, n: usize) -> (Columns, Columns, usize) {
+        let (mut passes, mut mattes) = (Columns::new(), Columns::new());
+        let mut line_bytes = 0;
+        for &(source, t) in &self.layout.columns {
+            match source {
+                Source::Pass(i) => passes.push((i, line_bytes, t)),
+                Source::Matte(i) => mattes.push((i, line_bytes, t)),
+            }
+            line_bytes += n * t.bytes_per_sample();
+        }
+        (passes, mattes, line_bytes)
+    }
+
+    /// The bytes of the line of `n` pixels from pixel `at` of the strip, every byte of `out`
+    /// written.
+    fn line(&self, (passes, mattes): (&Columns, &Columns), at: usize, n: usize, out: &mut [u8]) {
+        // RUN pixels at a time: their values made once, then each column's RUN samples
+        // stored together (one pixel's values spread over every column).
+        let pixels = &self.frame.pixels[at..at + n];
+        let mut values = [[0.0; CHANNELS.len()]; RUN];
+        for (run, chunk) in pixels.chunks(RUN).enumerate() {
+            for (v, p) in values.iter_mut().zip(chunk) {
+                *v = p.values();
+            }
+            store_run(out, run, passes, &values[..chunk.len()]);
+        }
+        if mattes.is_empty() {
+            return;
+        }
+        // A strip without mattes leaves their channels zero.
+        let Some(pixel_mattes) = self.frame.mattes.get(at..at + n) else {
+            for &(_, column, t) in mattes {
+                out[column..column + n * t.bytes_per_sample()].fill(0);
+            }
+            return;
+        };
+        let mut values = [[0.0; MATTE_VALUES]; RUN];
+        for (run, chunk) in pixel_mattes.chunks(RUN).enumerate() {
+            for (v, m) in values.iter_mut().zip(chunk) {
+                *v = self.layout.matte_values(m);
+            }
+            store_run(out, run, mattes, &values[..chunk.len()]);
+        }
+    }
+}
+
 impl BlockSource for Strip<'_> {
     fn block(
         &self,
@@ -140,48 +208,39 @@ impl BlockSource for Strip<'_> {
         width: usize,
     ) -> UncompressedBlock {
         let lines = block.pixel_size.height();
-        let x0 = block.pixel_position.x();
-        let n = block.pixel_size.width();
-        // Each column's place in a line (its channel's samples, one after another), by the
-        // kind of value it holds.
-        let (mut passes, mut mattes) = (SmallVec::<[_; 32]>::new(), SmallVec::<[_; 32]>::new());
-        let mut line_bytes = 0;
-        for &(source, t) in &self.layout.columns {
-            match source {
-                Source::Pass(i) => passes.push((i, line_bytes, t)),
-                Source::Matte(i) => mattes.push((i, line_bytes, t)),
-            }
-            line_bytes += n * t.bytes_per_sample();
-        }
+        let (x0, n) = (block.pixel_position.x(), block.pixel_size.width());
+        let (passes, mattes, line_bytes) = self.columns(n);
         let mut data = vec![0; line_bytes * lines];
         for (line, out) in data.chunks_exact_mut(line_bytes.max(1)).enumerate() {
             let at = (block.pixel_position.y() + line - y0) * width + x0;
-            // RUN pixels at a time: their values made once, then each column's RUN samples
-            // stored together (one pixel's values spread over every column).
-            let pixels = &self.frame.pixels[at..at + n];
-            let mut values = [[0.0; CHANNELS.len()]; RUN];
-            for (run, chunk) in pixels.chunks(RUN).enumerate() {
-                for (v, p) in values.iter_mut().zip(chunk) {
-                    *v = p.values();
-                }
-                store_run(out, run, &passes, &values[..chunk.len()]);
-            }
-            // A strip without mattes leaves their channels zero.
-            let Some(pixel_mattes) = self.frame.mattes.get(at..at + n) else {
-                continue;
-            };
-            if mattes.is_empty() {
-                continue;
-            }
-            let mut values = [[0.0; MATTE_VALUES]; RUN];
-            for (run, chunk) in pixel_mattes.chunks(RUN).enumerate() {
-                for (v, m) in values.iter_mut().zip(chunk) {
-                    *v = self.layout.matte_values(m);
-                }
-                store_run(out, run, &mattes, &values[..chunk.len()]);
-            }
+            self.line((&passes, &mattes), at, n, out);
         }
         UncompressedBlock { index: block, data }
+    }
+
+    /// Each line made in a buffer the thread keeps, and handed on.
+    fn each_line(
+        &self,
+        _: &ChannelList,
+        block: BlockIndex,
+        y0: usize,
+        width: usize,
+        each: &mut dyn FnMut(&[u8]),
+    ) {
+        thread_local! {
+            static LINE: std::cell::RefCell<Vec<u8>> = Default::default();
+        }
+        let (x0, n) = (block.pixel_position.x(), block.pixel_size.width());
+        let (passes, mattes, line_bytes) = self.columns(n);
+        LINE.with_borrow_mut(|out| {
+            // Every byte is written by `line`.
+            out.resize(line_bytes, 0);
+            for line in 0..block.pixel_size.height() {
+                let at = (block.pixel_position.y() + line - y0) * width + x0;
+                self.line((&passes, &mattes), at, n, out);
+                each(out);
+            }
+        });
     }
 }
 

@@ -242,8 +242,7 @@ pub(super) fn write_blocks(
                 let chunks = blocks[next..next + mine]
                     .par_iter()
                     .map(|&(index, block)| {
-                        let raw = channels.block(&header.channels, block, y0, width);
-                        compress(&meta.headers, block, raw).map(|c| (index, c))
+                        compress(&meta.headers, block, (channels, y0, width)).map(|c| (index, c))
                     })
                     .collect::<exr::error::Result<Vec<_>>>()
                     .map_err(cause)?;
@@ -282,25 +281,32 @@ pub(super) fn write_blocks(
     sort_header_attributes(path).map_err(cause)
 }
 
-/// A block compressed into its chunk. ZIP (16 lines or 1) is done here (`zip_bytes`), the
-/// rest by the exr crate.
+/// A block, from `source` (whose first row is the image's `y0`, its lines `width` long),
+/// compressed into its chunk. ZIP (16 lines or 1) is done here, line by line as the source
+/// makes them (`zip_lines`), the rest by the exr crate.
 fn compress(
     headers: &[exr::meta::header::Header],
     block: exr::block::BlockIndex,
-    raw: exr::block::UncompressedBlock,
+    (source, y0, width): (&dyn BlockSource, usize, usize),
 ) -> exr::error::Result<exr::block::chunk::Chunk> {
     use exr::block::chunk::{Chunk, CompressedBlock, CompressedScanLineBlock};
     let header = &headers[block.layer];
     let zip = matches!(header.compression, Compression::ZIP16 | Compression::ZIP1);
     // The block's bytes are the file's (little-endian) bytes only on a little-endian machine.
     if !zip || cfg!(target_endian = "big") {
-        return raw.compress_to_chunk(headers);
+        return source
+            .block(&header.channels, block, y0, width)
+            .compress_to_chunk(headers);
     }
+    let size = header.channels.bytes_per_pixel * block.pixel_size.area();
+    let zipped = zip_lines(size, |each| {
+        source.each_line(&header.channels, block, y0, width, each)
+    });
     // A block that does not get smaller is stored as it is, as OpenEXR reads it.
-    let data = raw.data;
-    let pixels = zip_bytes(&data)
-        .filter(|z| z.len() < data.len())
-        .unwrap_or(data);
+    let pixels = match zipped.filter(|z| z.len() < size) {
+        Some(z) => z,
+        None => source.block(&header.channels, block, y0, width).data,
+    };
     Ok(Chunk {
         layer_index: block.layer,
         compressed_block: CompressedBlock::ScanLine(CompressedScanLineBlock {
@@ -321,32 +327,85 @@ const ZIP_LEVEL: i32 = 4;
 /// stored as it is).
 ///
 /// Deflated by [zlib-rs](https://crates.io/crates/zlib-rs): on this renderer's blocks it is
-/// faster than libdeflate at the same level, and its files slightly smaller. Each thread keeps
-/// its compressor and its two buffers from one block to the next (a block's fresh buffers cost
-/// their zeroing and page faults each time).
+/// faster than libdeflate at the same level, and its files slightly smaller.
+#[cfg(test)]
 pub(super) fn zip_bytes(data: &[u8]) -> Option<Vec<u8>> {
-    use zlib_rs::{Deflate, DeflateFlush, Status};
-    thread_local! {
-        static ZIP: std::cell::RefCell<(Option<Deflate>, Vec<u8>, Vec<u8>)> =
-            Default::default();
-    }
     ZIP.with_borrow_mut(|(z, t, out)| {
-        let z = z.get_or_insert_with(|| Deflate::new(ZIP_LEVEL, true, 15));
-        z.reset();
         predicted(data, t);
-        out.resize(zlib_rs::compress_bound(t.len()), 0);
-        let start = z.total_out();
-        match z.compress(t, out, DeflateFlush::Finish) {
-            Ok(Status::StreamEnd) => Some(out[..(z.total_out() - start) as usize].to_vec()),
-            _ => None,
-        }
+        deflated(z, t, out)
     })
 }
 
+thread_local! {
+    /// Each thread's compressor and its two buffers, kept from one block to the next (a
+    /// block's fresh buffers cost their zeroing and page faults each time).
+    static ZIP: std::cell::RefCell<(Option<zlib_rs::Deflate>, Vec<u8>, Vec<u8>)> =
+        Default::default();
+}
+
+/// [`zip_bytes`] of `size` bytes that `lines` hands on in runs of whole pairs of bytes (a
+/// block's lines): each run's part of the prediction made as it comes, so the block's bytes
+/// are never held whole. None where the runs are not `size` bytes of whole pairs, or deflate
+/// fails.
+pub(super) fn zip_lines(size: usize, lines: impl FnOnce(&mut dyn FnMut(&[u8]))) -> Option<Vec<u8>> {
+    ZIP.with_borrow_mut(|(z, t, out)| {
+        // Every byte is written below (or the block is not zipped).
+        t.resize(size, 0);
+        let (even, odd) = t.split_at_mut(size / 2);
+        let (mut pairs, mut before, mut first, mut whole) =
+            (0, (0, 0), None, size.is_multiple_of(2));
+        lines(&mut |run: &[u8]| {
+            let n = run.len() / 2;
+            if !whole || !run.len().is_multiple_of(2) || pairs + n > even.len() {
+                whole = false;
+                return;
+            }
+            if n > 0 {
+                first.get_or_insert((run[0], run[1]));
+            }
+            before = predicted_pairs(
+                run,
+                &mut even[pairs..pairs + n],
+                &mut odd[pairs..pairs + n],
+                before,
+            );
+            pairs += n;
+        });
+        if !whole || 2 * pairs != size {
+            return None;
+        }
+        // The stream's first byte is itself; the odd half's first follows the even half's
+        // last.
+        if let Some((e, o)) = first {
+            even[0] = e;
+            odd[0] = delta(before.0, o);
+        }
+        deflated(z, t, out)
+    })
+}
+
+/// The zlib stream of `t` at [`ZIP_LEVEL`], made with `z` in `out`.
+fn deflated(z: &mut Option<zlib_rs::Deflate>, t: &[u8], out: &mut Vec<u8>) -> Option<Vec<u8>> {
+    use zlib_rs::{Deflate, DeflateFlush, Status};
+    let z = z.get_or_insert_with(|| Deflate::new(ZIP_LEVEL, true, 15));
+    z.reset();
+    out.resize(zlib_rs::compress_bound(t.len()), 0);
+    let start = z.total_out();
+    match z.compress(t, out, DeflateFlush::Finish) {
+        Ok(Status::StreamEnd) => Some(out[..(z.total_out() - start) as usize].to_vec()),
+        _ => None,
+    }
+}
+
+/// `b − a + 128` (mod 256): the predictor's byte for `b` after `a`.
+#[inline(always)]
+fn delta(a: u8, b: u8) -> u8 {
+    b.wrapping_sub(a).wrapping_add(128)
+}
+
 /// The bytes ZIP deflates: `data`'s bytes at even offsets, then those at odd ones, each but
-/// the first replaced by its difference from the one before it plus 128 (mod 256). Made in one
-/// pass from `data` into `t`, eight pairs of bytes at a time in a u64 each way (`evens`,
-/// `byte_deltas`), the rest byte by byte.
+/// the first replaced by its difference from the one before it plus 128 (mod 256).
+#[cfg(test)]
 fn predicted(data: &[u8], t: &mut Vec<u8>) {
     let n = data.len();
     let half = n.div_ceil(2);
@@ -357,10 +416,34 @@ fn predicted(data: &[u8], t: &mut Vec<u8>) {
     };
     let (even, odd) = t.split_at_mut(half);
     let pairs = n / 2;
+    let (last_even, _) = predicted_pairs(
+        &data[..2 * pairs],
+        &mut even[..pairs],
+        &mut odd[..pairs],
+        (0, 0),
+    );
+    even[0] = first;
+    if n % 2 == 1 && n > 1 {
+        // The unpaired last byte ends the even half.
+        even[half - 1] = delta(last_even, data[n - 1]);
+    }
+    if pairs > 0 {
+        // The odd half starts after the even half's last byte.
+        odd[0] = delta(data[2 * (half - 1)], data[1]);
+    }
+}
+
+/// The predictor over whole pairs of bytes (`data`) that follow bytes whose last even and odd
+/// ones were `before`: each pair's even byte as its difference from the even byte before it
+/// (plus 128, mod 256) in `even`, its odd byte likewise in `odd`; the last pair's bytes
+/// returned. Eight pairs at a time in a u64 each way (`evens`, `byte_deltas`), the rest byte
+/// by byte.
+fn predicted_pairs(data: &[u8], even: &mut [u8], odd: &mut [u8], before: (u8, u8)) -> (u8, u8) {
+    let pairs = data.len() / 2;
     let words = pairs / 8;
     // Pairs 8k .. 8k + 8: their even and odd bytes as two words, each less the same word of
-    // the pairs before (shifted in by a byte). The first byte of each half is mended below.
-    let (mut even_before, mut odd_before) = (0u64, 0u64);
+    // the pairs before (shifted in by a byte).
+    let (mut even_before, mut odd_before) = (u64::from(before.0) << 56, u64::from(before.1) << 56);
     for (k, chunk) in data[..16 * words].chunks_exact(16).enumerate() {
         let lo = u64::from_le_bytes(chunk[..8].try_into().expect("8 bytes"));
         let hi = u64::from_le_bytes(chunk[8..].try_into().expect("8 bytes"));
@@ -372,20 +455,14 @@ fn predicted(data: &[u8], t: &mut Vec<u8>) {
         odd[8 * k..8 * k + 8].copy_from_slice(&dd.to_le_bytes());
         (even_before, odd_before) = (e, o);
     }
-    let delta = |a: u8, b: u8| b.wrapping_sub(a).wrapping_add(128);
-    for i in (8 * words).max(1)..pairs {
-        even[i] = delta(data[2 * i - 2], data[2 * i]);
-        odd[i] = delta(data[2 * i - 1], data[2 * i + 1]);
+    let mut last = ((even_before >> 56) as u8, (odd_before >> 56) as u8);
+    for i in 8 * words..pairs {
+        let (e, o) = (data[2 * i], data[2 * i + 1]);
+        even[i] = delta(last.0, e);
+        odd[i] = delta(last.1, o);
+        last = (e, o);
     }
-    even[0] = first;
-    if n % 2 == 1 && n > 1 {
-        // The unpaired last byte ends the even half.
-        even[half - 1] = delta(data[n - 3], data[n - 1]);
-    }
-    if pairs > 0 {
-        // The odd half starts after the even half's last byte.
-        odd[0] = delta(data[2 * (half - 1)], data[1]);
-    }
+    last
 }
 
 /// Bytes 0, 2, 4 and 6 of `x` (little-endian) as bytes 0 to 3.
@@ -475,6 +552,45 @@ mod tests {
     use crate::output::Compression as Packing;
 
     /// The predictor is OpenEXR's, written the plain way: split, then differences.
+    /// A block zipped a run of lines at a time is the block zipped whole, to the byte, however
+    /// it is cut (runs of one pair, empty runs, runs across the predictor's words); runs that
+    /// are not whole pairs, or not the size, are refused (the block is then stored as it is).
+    #[test]
+    fn zipped_by_lines_is_zipped_whole() {
+        let mut rng = crate::rng::Rng(5);
+        for n in [0usize, 2, 4, 16, 18, 34, 1000, 4098, 60_000] {
+            // Smooth numbers (as pixels are) and noise, half and half.
+            let data: Vec<u8> = (0..n)
+                .map(|i| match i < n / 2 {
+                    true => (i / 7) as u8,
+                    false => rng.next_u64() as u8,
+                })
+                .collect();
+            let whole = zip_bytes(&data).expect("deflated");
+            for cut in [2, 4, 14, 16, 18, 30, 1000] {
+                let runs: Vec<&[u8]> = data.chunks(cut).collect();
+                let got = zip_lines(n, |each| {
+                    each(&[]);
+                    for r in &runs {
+                        each(r);
+                    }
+                });
+                assert_eq!(got.as_ref(), Some(&whole), "{n} bytes in runs of {cut}");
+            }
+        }
+        let data = [1u8, 2, 3, 4, 5, 6];
+        assert_eq!(
+            zip_lines(6, |each| {
+                each(&data[..3]);
+                each(&data[3..]);
+            }),
+            None,
+            "a run of an odd length"
+        );
+        assert_eq!(zip_lines(8, |each| each(&data)), None, "too few bytes");
+        assert_eq!(zip_lines(4, |each| each(&data)), None, "too many bytes");
+    }
+
     #[test]
     fn predicted_is_split_then_differences() {
         let mut rng = crate::rng::Rng(3);
