@@ -79,8 +79,10 @@ pub(crate) struct Case {
     /// A scene measured beside this one (`beside`), with what it is: the same boxes in one
     /// group beside many groups, or the same scene with the Doppler and searchlight effects off.
     pub beside: Option<(String, Scene)>,
-    /// How long making the scene took (set by `run`).
+    /// How long making the scene took (set by `run`: making the case, less the scene beside).
     pub load_s: f64,
+    /// How long making the scene beside took (`beside`).
+    pub beside_load_s: f64,
 }
 
 impl Case {
@@ -94,12 +96,21 @@ impl Case {
             hi_reference: true,
             beside: None,
             load_s: 0.0,
+            beside_load_s: 0.0,
         }
     }
-    /// Measure `scene`, which is `what`, beside this case (`beside`).
-    pub fn beside(mut self, what: &str, scene: Scene) -> Case {
+    /// Measure the scene `load` makes, which is `what`, beside this case (`beside`). Its load
+    /// is timed apart: the row's load is its own scene's.
+    pub fn beside(
+        mut self,
+        what: &str,
+        load: impl FnOnce() -> Result<Scene, crate::scene::SceneError>,
+    ) -> Result<Case, crate::scene::SceneError> {
+        let t = Instant::now();
+        let scene = load()?;
+        self.beside_load_s = t.elapsed().as_secs_f64();
         self.beside = Some((what.to_string(), scene));
-        self
+        Ok(self)
     }
     pub fn with_bare(mut self) -> Case {
         self.bare = true;
@@ -517,7 +528,7 @@ pub(crate) fn run(
         progress(&lazy.name);
         let t = Instant::now();
         let mut case = lazy.build()?;
-        case.load_s = t.elapsed().as_secs_f64();
+        case.load_s = (t.elapsed().as_secs_f64() - case.beside_load_s).max(0.0);
         let case = &case;
         let mut refs: Vec<(u32, Frame)> = Vec::new();
         let hi = if case.hi_reference {
@@ -599,3 +610,35 @@ pub(crate) use plot::plot_svg;
 pub(crate) use report::{summary, table};
 pub(crate) use scene_files::{scene_file_here, summary as scene_files};
 pub(crate) use threads::summary as thread_scaling;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A row's load is its own scene's: the scene measured beside it is made, and timed, apart
+    /// (it used to count in the row's load, and so in its whole command).
+    #[test]
+    fn a_rows_load_leaves_out_the_scene_beside() {
+        let small = || {
+            let sets = ["image.width=8", "image.height=8"].map(String::from);
+            crate::scene::paper::paper("calibration_cube", &sets)
+        };
+        let pause = std::time::Duration::from_millis(400);
+        let case = Case::new("small", small().unwrap(), &["bvh"])
+            .without_hi_reference()
+            .beside("the same, slowly", || {
+                std::thread::sleep(pause);
+                small()
+            })
+            .unwrap();
+        assert!(case.beside_load_s >= pause.as_secs_f64());
+        let rows = run(&[LazyCase::ready(case)], 1, |_| {}).unwrap();
+        assert_eq!(rows.len(), 1);
+        assert!(
+            rows[0].load_s < pause.as_secs_f64() / 2.0,
+            "load {} s",
+            rows[0].load_s
+        );
+        assert!(rows[0].beside.is_some(), "the scene beside was measured");
+    }
+}

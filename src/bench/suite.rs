@@ -168,15 +168,14 @@ fn time_cases(px: u32, out: &mut Vec<LazyCase>) {
                     {until=-10, velocity=[-0.9,0,0]}, {until=-5, velocity=[-0.88,0,0]}, \
                     {until=-2, velocity=[-0.9,0,0]}, {until=0, velocity=[-0.88,0,0]}, \
                     {until=1, velocity=[-0.9,0,0]}, {velocity=[-0.88,0,0]}]";
-        Ok(Case::new(
+        Case::new(
             "lattice beta=0.9, 8 segments",
             lattice_in_segments(px, Some(line))?,
             &["embree", "bvh"],
         )
-        .beside(
-            "the lattice moving uniformly at 0.9c",
-            lattice_in_segments(px, None)?,
-        ))
+        .beside("the lattice moving uniformly at 0.9c", || {
+            lattice_in_segments(px, None)
+        })
     }));
     // Both lights as Gaussian pulses (a factor per shadow ray, and no shadow ray where it is 0).
     out.push(LazyCase::new(
@@ -184,17 +183,17 @@ fn time_cases(px: u32, out: &mut Vec<LazyCase>) {
         move || {
             let mut s = size(px);
             s.push("group.lattice.velocity=[-0.9,0,0]".into());
-            let steady = paper("lattice", &s)?;
+            let steady = s.clone();
             s.extend(sets(&[
                 "light.0.pulse={at=-8, width=6}",
                 "light.1.pulse={at=-8, width=6}",
             ]));
-            Ok(Case::new(
+            Case::new(
                 "lattice beta=0.9, pulsed lights",
                 paper("lattice", &s)?,
                 &["embree", "bvh"],
             )
-            .beside("the same lights steady", steady))
+            .beside("the same lights steady", || paper("lattice", &steady))
         },
     ));
     // A planet at rest spinning with its equator at 0.9c against the same planet still: each
@@ -206,13 +205,11 @@ fn time_cases(px: u32, out: &mut Vec<LazyCase>) {
             "camera.direction=[0,1,0]",
             "camera.time=0",
         ]));
-        let still = planet(&s)?;
+        let still = s.clone();
         s.push("group.planet.object.planet.spin={axis=[0,0,1], omega=0.6}".into());
-        Ok(
-            Case::new("planet spinning at 0.9c", planet(&s)?, &["embree", "bvh"])
-                .without_hi_reference()
-                .beside("the same planet still", still),
-        )
+        Case::new("planet spinning at 0.9c", planet(&s)?, &["embree", "bvh"])
+            .without_hi_reference()
+            .beside("the same planet still", || planet(&still))
     }));
     // The train accelerating Born-rigidly past the camera against the same train at rest:
     // every ray tries each car in closed form, in Rindler coordinates, without a tree.
@@ -227,14 +224,15 @@ fn time_cases(px: u32, out: &mut Vec<LazyCase>) {
             .map(|x| (format!("--set {x}"), x.clone()))
             .collect();
         let load = |text: &str| load_str("scenes/accelerating_train.toml", text, &sets);
-        let still = load(&TRAIN.replacen(motion, "velocity = [0, 0, 0]", 1))?;
-        Ok(Case::new(
+        Case::new(
             "train accelerating at 0.5",
             load(TRAIN)?,
             &["embree", "bvh"],
         )
         .without_hi_reference()
-        .beside("the same train at rest", still))
+        .beside("the same train at rest", || {
+            load(&TRAIN.replacen(motion, "velocity = [0, 0, 0]", 1))
+        })
     }));
     // The spoked wheel with its rim at 0.9c against the same wheel without spin: every ray
     // marched through the turning wheel, against the still one's exact tests.
@@ -248,12 +246,11 @@ fn time_cases(px: u32, out: &mut Vec<LazyCase>) {
             .map(|x| (format!("--set {x}"), x.clone()))
             .collect();
         let load = |text: &str| load_str("scenes/spoked_wheel.toml", text, &sets);
-        let still = load(&WHEEL.replacen(spin, "", 1))?;
-        Ok(
-            Case::new("wheel spinning at 0.9c", load(WHEEL)?, &["embree", "bvh"])
-                .without_hi_reference()
-                .beside("the same wheel still", still),
-        )
+        Case::new("wheel spinning at 0.9c", load(WHEEL)?, &["embree", "bvh"])
+            .without_hi_reference()
+            .beside("the same wheel still", || {
+                load(&WHEEL.replacen(spin, "", 1))
+            })
     }));
     // An open shutter: every sample from its own event, so no fans and no screen cull.
     out.push(LazyCase::new("lattice beta=0.9, shutter 0.5", move || {
@@ -262,16 +259,16 @@ fn time_cases(px: u32, out: &mut Vec<LazyCase>) {
             "group.lattice.velocity=[-0.9,0,0]",
             "image.samples=4",
         ]));
-        let instant = paper("lattice", &s)?;
+        let instant = s.clone();
         s.push("camera.shutter=0.5".into());
-        Ok(Case::new(
+        Case::new(
             "lattice beta=0.9, shutter 0.5",
             paper("lattice", &s)?,
             &["embree", "bvh"],
         )
         .without_hi_reference()
         .with_spp(&[4])
-        .beside("the same view at an instant", instant))
+        .beside("the same view at an instant", || paper("lattice", &instant))
     }));
 }
 
@@ -343,9 +340,9 @@ fn planet_cases(px: u32, out: &mut Vec<LazyCase>) {
                 s.extend(extra.map(String::from));
                 planet(&s)
             };
-            Ok(Case::new(name, with(set)?, &["embree", "bvh"])
+            Case::new(name, with(set)?, &["embree", "bvh"])
                 .without_hi_reference()
-                .beside(beside, with(beside_set)?))
+                .beside(beside, || with(beside_set))
         }));
     }
 }
@@ -357,14 +354,16 @@ fn light_cases(px: u32, out: &mut Vec<LazyCase>) {
     out.push(LazyCase::new("lattice beta=0.9, spectral", move || {
         let mut s = size(px);
         s.push("group.lattice.velocity=[-0.9,0,0]".into());
-        let rgb = paper("lattice", &s)?;
+        let rgb = s.clone();
         s.extend(sets(&["render.doppler=true", "render.searchlight=true"]));
-        Ok(Case::new(
+        Case::new(
             "lattice beta=0.9, spectral",
             paper("lattice", &s)?,
             &["embree", "bvh"],
         )
-        .beside("the same scene in RGB (both effects off)", rgb))
+        .beside("the same scene in RGB (both effects off)", || {
+            paper("lattice", &rgb)
+        })
     }));
     // What the EXR passes cost: the default EXR, an EXR of colour and alpha alone, and a PNG
     // (colour alone); without passes no ray of their own goes through each pixel's centre when
@@ -458,13 +457,13 @@ fn group_cases(quick: bool, px: u32, out: &mut Vec<LazyCase>) {
                 } else {
                     &["embree", "bvh"]
                 };
-                Ok(Case::new(
+                Case::new(
                     &format!("{g} boxes in {g} groups"),
                     many_groups(g, false, gpx)?,
                     settings,
                 )
                 .without_hi_reference()
-                .beside("the same boxes in one group", many_groups(g, true, gpx)?))
+                .beside("the same boxes in one group", || many_groups(g, true, gpx))
             },
         ));
     }
@@ -472,14 +471,11 @@ fn group_cases(quick: bool, px: u32, out: &mut Vec<LazyCase>) {
     if !quick {
         let name = "100000 boxes in 100000 groups at 1024^2";
         out.push(LazyCase::new(name, move || {
-            Ok(
-                Case::new(name, many_groups(100_000, false, 1024)?, &["embree"])
-                    .without_hi_reference()
-                    .beside(
-                        "the same boxes in one group",
-                        many_groups(100_000, true, 1024)?,
-                    ),
-            )
+            Case::new(name, many_groups(100_000, false, 1024)?, &["embree"])
+                .without_hi_reference()
+                .beside("the same boxes in one group", || {
+                    many_groups(100_000, true, 1024)
+                })
         }));
     }
     // Merging groups of one velocity: 121 bars, 121 groups.

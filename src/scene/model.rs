@@ -357,7 +357,7 @@ pub struct Group {
     pub geometry: Arc<Geometry>,
     /// For one segment of a worldline (`worldline`): the emission events at which it is
     /// seen, between two hyperplanes of simultaneity; None: all.
-    pub window: Option<crate::spacetime::Window>,
+    pub window: Option<Box<crate::spacetime::Window>>,
     /// For a segment of constant proper acceleration: how its geometry moves through the
     /// frame it starts at rest in (`velocity` is that frame's).
     pub accelerated: Option<Accelerated>,
@@ -482,7 +482,7 @@ impl Scene {
             }
         }
         for g in &mut s.groups {
-            g.window = g.window.map(|w| w.translated(shift));
+            g.window = g.window.take().map(|w| Box::new(w.translated(shift)));
             let own = g.to_rest().event(shift);
             match &mut g.accelerated {
                 // Its shape is in the frame moving with it: its start moves instead.

@@ -209,7 +209,7 @@ pub(crate) fn groups(
         .zip(&line.spans)
         .enumerate()
         .map(|(k, (piece, &(a, b)))| {
-            let window = Some(line.window(k));
+            let window = Some(Box::new(line.window(k)));
             // The piece's axes, turned by the accelerations across the motion before it.
             let r = line.turns[k];
             let turn = (r != DMat3::IDENTITY).then_some(r);

@@ -214,7 +214,7 @@ impl World {
                 epsilon: g.epsilon,
                 moving: MovingBounds::new(&g.plain_bounds, &g.velocity, event.t),
                 plain_bounds: g.plain_bounds,
-                window: g.window,
+                window: g.window.clone(),
                 spins: g.spins,
                 accelerated: g.accelerated,
                 turning: g.turning.clone(),

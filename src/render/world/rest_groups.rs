@@ -22,7 +22,7 @@ pub(super) struct RestGroup {
     pub accel: Option<Arc<dyn Accelerator>>,
     pub epsilon: f64,
     /// The emission events it is seen at (a worldline's segment).
-    pub window: Option<Window>,
+    pub window: Option<Box<Window>>,
     /// Whether anything in it spins (its hits then move into their points' frames).
     pub spins: bool,
     /// Its hyperbolic motion, for a segment of constant proper acceleration.
@@ -54,7 +54,7 @@ impl RestGroups {
         // Which scene groups share a rest frame and the times they are seen at, in file order.
         // An accelerated segment is never merged (its key holds its index).
         type Key = ([u64; 4], Option<[u64; 10]>, Option<usize>);
-        type Set = (Velocity, Option<Window>, Vec<usize>);
+        type Set = (Velocity, Option<Box<Window>>, Vec<usize>);
         let mut sets: Vec<Set> = Vec::new();
         let mut index: std::collections::HashMap<Key, usize> = std::collections::HashMap::new();
         for (i, g) in scene.groups.iter().enumerate() {
@@ -64,14 +64,14 @@ impl RestGroups {
             let v = g.velocity;
             let key = (
                 v.identity_key(),
-                g.window.map(|w| w.key()),
+                g.window.as_ref().map(|w| w.key()),
                 (g.accelerated.is_some() || g.geometry.turns() || g.turn.is_some()).then_some(i),
             );
             match index.get(&key).filter(|_| options.merge_equal_velocities) {
                 Some(&k) => sets[k].2.push(i),
                 None => {
                     index.insert(key, sets.len());
-                    sets.push((v, g.window, vec![i]));
+                    sets.push((v, g.window.clone(), vec![i]));
                 }
             }
         }

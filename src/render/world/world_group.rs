@@ -29,7 +29,7 @@ pub struct WorldGroup {
     /// The bounds as they move through the world frame: a test before the boost.
     pub(super) moving: MovingBounds,
     /// The emission events it is seen at (a worldline's segment); None: all.
-    pub window: Option<Window>,
+    pub window: Option<Box<Window>>,
     /// Whether anything in it spins.
     pub spins: bool,
     /// Its hyperbolic motion, for a segment of constant proper acceleration (its rays start
@@ -62,7 +62,7 @@ impl WorldGroup {
     /// Whether the group is seen at emission event `e` (always, but for a worldline's
     /// segment); `World::rest_ray` keeps rays to the same events.
     pub fn shows_at(&self, e: Event) -> bool {
-        self.window.is_none_or(|w| w.contains(e))
+        self.window.as_ref().is_none_or(|w| w.contains(e))
     }
 
     /// The closest hit of each ray in this group (None for inactive rays): through the
