@@ -528,7 +528,10 @@ pub(crate) fn run(
         progress(&lazy.name);
         let t = Instant::now();
         let mut case = lazy.build()?;
-        case.load_s = (t.elapsed().as_secs_f64() - case.beside_load_s).max(0.0);
+        case.load_s = t.elapsed().as_secs_f64() - case.beside_load_s;
+        // The scene beside was made within the case's making (never before: `LazyCase::ready`
+        // cases have none).
+        debug_assert!(case.load_s >= 0.0, "a scene beside made outside its case");
         let case = &case;
         let mut refs: Vec<(u32, Frame)> = Vec::new();
         let hi = if case.hi_reference {
@@ -616,28 +619,31 @@ mod tests {
     use super::*;
 
     /// A row's load is its own scene's: the scene measured beside it is made, and timed, apart
-    /// (it used to count in the row's load, and so in its whole command).
+    /// (it used to count in the row's load, and so in its whole command). Both are made slowly
+    /// here, within the case's making, as the suite's are.
     #[test]
     fn a_rows_load_leaves_out_the_scene_beside() {
+        use std::time::Duration;
         let small = || {
             let sets = ["image.width=8", "image.height=8"].map(String::from);
             crate::scene::paper::paper("calibration_cube", &sets)
         };
-        let pause = std::time::Duration::from_millis(400);
-        let case = Case::new("small", small().unwrap(), &["bvh"])
-            .without_hi_reference()
-            .beside("the same, slowly", || {
-                std::thread::sleep(pause);
-                small()
-            })
-            .unwrap();
-        assert!(case.beside_load_s >= pause.as_secs_f64());
-        let rows = run(&[LazyCase::ready(case)], 1, |_| {}).unwrap();
+        let (own, other) = (Duration::from_millis(300), Duration::from_millis(600));
+        let lazy = LazyCase::new("small", move || {
+            std::thread::sleep(own);
+            Case::new("small", small()?, &["bvh"])
+                .without_hi_reference()
+                .beside("the same, slowly", || {
+                    std::thread::sleep(other);
+                    small()
+                })
+        });
+        let rows = run(&[lazy], 1, |_| {}).unwrap();
         assert_eq!(rows.len(), 1);
+        let load = rows[0].load_s;
         assert!(
-            rows[0].load_s < pause.as_secs_f64() / 2.0,
-            "load {} s",
-            rows[0].load_s
+            load >= own.as_secs_f64() && load < other.as_secs_f64(),
+            "load {load} s"
         );
         assert!(rows[0].beside.is_some(), "the scene beside was measured");
     }

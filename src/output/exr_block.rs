@@ -24,7 +24,7 @@ pub(super) trait BlockSource: Sync {
     ) -> UncompressedBlock;
 
     /// The same bytes handed to `each` a line at a time, top to bottom (a source that can
-    /// make a line alone never holds the block whole).
+    /// make a line alone never makes the block's bytes whole).
     fn each_line(
         &self,
         channels: &ChannelList,
@@ -354,8 +354,33 @@ mod tests {
                     let want = cols.block(&list, block, 0, w).data;
                     let got = strip.block(&list, block, 0, w).data;
                     assert_eq!(got, want, "half {half}, {lines} lines, at {y}");
+                    // The same bytes a line at a time (how ZIP blocks are made).
+                    let mut joined = Vec::new();
+                    strip.each_line(&list, block, 0, w, &mut |l| {
+                        assert_eq!(l.len(), want.len() / block.pixel_size.height());
+                        joined.extend_from_slice(l)
+                    });
+                    assert_eq!(joined, want, "half {half}, {lines} lines at a time, at {y}");
                 }
             }
+            // A strip without mattes, its lines made on this thread right after those with:
+            // the line buffer's Cryptomatte columns are zero again, as a whole block's are.
+            let bare = Frame {
+                mattes: Vec::new(),
+                ..frame.clone()
+            };
+            let strip = layout.strip(&bare);
+            let block = BlockIndex {
+                layer: 0,
+                pixel_position: Vec2(0, 0),
+                pixel_size: Vec2(w, 16),
+                level: Vec2(0, 0),
+            };
+            let want = strip.block(&list, block, 0, w).data;
+            let mut joined = Vec::new();
+            strip.each_line(&list, block, 0, w, &mut |l| joined.extend_from_slice(l));
+            assert_eq!(joined, want, "half {half}, without mattes");
+            assert!(want.iter().any(|&b| b != 0) && joined.len() == want.len());
         }
         // A channel the render does not name has no layout.
         let odd = ChannelList::new(smallvec::smallvec![ChannelDescription::named(

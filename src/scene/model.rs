@@ -482,7 +482,9 @@ impl Scene {
             }
         }
         for g in &mut s.groups {
-            g.window = g.window.take().map(|w| Box::new(w.translated(shift)));
+            if let Some(w) = g.window.as_deref_mut() {
+                *w = w.translated(shift);
+            }
             let own = g.to_rest().event(shift);
             match &mut g.accelerated {
                 // Its shape is in the frame moving with it: its start moves instead.
