@@ -5,6 +5,7 @@ mod assemble;
 pub mod cryptomatte;
 mod exr_block;
 mod exr_out;
+mod exr_zip;
 pub mod file;
 mod finished;
 pub use finished::finished;
