@@ -443,6 +443,22 @@ impl BlockSource for Band {
             data: self.bytes[first * self.line_bytes..(first + n) * self.line_bytes].to_vec(),
         }
     }
+
+    /// The block's lines straight from the band, without the block's copy.
+    fn each_line(
+        &self,
+        _: &ChannelList,
+        block: BlockIndex,
+        y0: usize,
+        _: usize,
+        each: &mut dyn FnMut(&[u8]),
+    ) {
+        let first = block.pixel_position.y() - y0;
+        let n = block.pixel_size.height();
+        self.bytes[first * self.line_bytes..(first + n) * self.line_bytes]
+            .chunks(self.line_bytes.max(1))
+            .for_each(each);
+    }
 }
 
 /// What joining the tiles holds at most, an upper bound: a band of rows four times over (the

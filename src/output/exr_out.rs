@@ -303,7 +303,8 @@ fn compress(
     let zipped = zip_lines(size, |each| {
         source.each_line(&header.channels, block, y0, width, each)
     });
-    // A block that does not get smaller is stored as it is, as OpenEXR reads it.
+    // A block that does not get smaller is stored as it is, as OpenEXR reads it (its bytes
+    // made again, whole: rare, as noise is).
     let pixels = match zipped.filter(|z| z.len() < size) {
         Some(z) => z,
         None => source.block(&header.channels, block, y0, width).data,
