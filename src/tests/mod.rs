@@ -6,6 +6,7 @@
 mod common;
 
 mod allocations;
+mod at_rest;
 mod backend_names;
 mod every_isa;
 // It counts the bench's primary hits (src/bench/primary.rs).

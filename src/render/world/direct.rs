@@ -5,10 +5,13 @@
 //! ray's hit is the one the primitives tested one by one give, to the bit: the smallest t,
 //! and on a tie the primitive listed first.
 
+use super::SurfaceHit;
 use crate::accel::{Hit, Ray};
 use crate::geometry::{ball_crossings, Primitive};
+use crate::spacetime::NullRay;
 use glam::DVec3;
 use multiversion::multiversion;
+use std::sync::Arc;
 
 /// Rays tested together.
 const WIDTH: usize = 8;
@@ -66,6 +69,30 @@ impl Chunk {
         c
     }
 
+    /// World rays as the rest rays of a group at rest in the world frame, unclipped, with
+    /// the interval `span(j)` of ray j: `World::rest_ray`'s arithmetic for such a group (its
+    /// origin moved by 0 along the ray, its interval by 0), so the lanes see the same numbers.
+    fn of_world(rays: &[NullRay], span: impl Fn(usize) -> (f64, f64)) -> Chunk {
+        let mut c = Chunk {
+            o: [[0.0; WIDTH]; 3],
+            d: [[1.0; WIDTH]; 3],
+            tmin: [1.0; WIDTH],
+            best: [0.0; WIDTH],
+            prim: [u32::MAX; WIDTH],
+        };
+        for (j, r) in rays.iter().enumerate() {
+            let origin = r.origin.x + 0.0 * r.dir;
+            for k in 0..3 {
+                c.o[k][j] = origin[k];
+                c.d[k][j] = r.dir[k];
+            }
+            let (tmin, tmax) = span(j);
+            c.tmin[j] = tmin - 0.0;
+            c.best[j] = tmax - 0.0;
+        }
+        c
+    }
+
     #[inline(always)]
     fn ray(&self, j: usize) -> (DVec3, DVec3) {
         let v = |c: &[[f64; WIDTH]; 3]| DVec3::new(c[0][j], c[1][j], c[2][j]);
@@ -78,10 +105,7 @@ impl Chunk {
 pub(super) fn intersect(prims: &[Primitive], rays: &[Ray], hits: &mut [Option<Hit>], simd: bool) {
     for (rs, hs) in rays.chunks(WIDTH).zip(hits.chunks_mut(WIDTH)) {
         let mut c = Chunk::of(rs);
-        match simd {
-            true => test_lanes(prims, &mut c, false),
-            false => test_prims(prims, &mut c, false),
-        }
+        test(prims, &mut c, false, simd);
         for (j, h) in hs.iter_mut().enumerate() {
             *h = (c.prim[j] != u32::MAX).then_some(Hit {
                 t: c.best[j],
@@ -97,13 +121,86 @@ pub(super) fn occluded(prims: &[Primitive], rays: &[Ray], out: &mut [bool], simd
         let mut c = Chunk::of(rs);
         // Lanes past the rays count as met, so the chunk stops once its rays are.
         c.prim[rs.len()..].iter_mut().for_each(|p| *p = 0);
-        match simd {
-            true => test_lanes(prims, &mut c, true),
-            false => test_prims(prims, &mut c, true),
-        }
+        test(prims, &mut c, true, simd);
         for (j, o) in os.iter_mut().enumerate() {
             *o = c.prim[j] != u32::MAX;
         }
+    }
+}
+
+/// A world whose every group is small (`DirectPrims`) and at rest in the world frame, and
+/// whose rays are not clipped to the groups' bounds (`World::at_rest`). There a world ray is
+/// each group's rest ray, so a chunk of rays is made once, straight from the world rays, and
+/// tested against every group's primitives in turn, without a rest ray or a hit made per
+/// group. The hits are the ones `World::closest_hits` and `World::occluded_many` find group
+/// by group, to the bit: each group's rays end at the best hit so far, which a later group
+/// must beat (on a tie the earlier group keeps it).
+pub struct AtRest {
+    pub groups: Box<[Arc<DirectPrims>]>,
+    pub simd: bool,
+}
+
+impl AtRest {
+    /// The closest hit of each ray (lookback from `tmin` on) as the world's surface hit.
+    pub fn closest_hits(&self, rays: &[NullRay], tmin: f64, out: &mut [Option<SurfaceHit>]) {
+        for (rs, os) in rays.chunks(WIDTH).zip(out.chunks_mut(WIDTH)) {
+            let mut c = Chunk::of_world(rs, |_| (tmin, f64::INFINITY));
+            let mut met = [(0, u32::MAX); WIDTH];
+            for (gi, g) in self.groups.iter().enumerate() {
+                c.prim = [u32::MAX; WIDTH];
+                test(&g.prims, &mut c, false, self.simd);
+                for (m, &p) in met.iter_mut().zip(&c.prim) {
+                    if p != u32::MAX {
+                        *m = (gi, p);
+                    }
+                }
+            }
+            for (j, o) in os.iter_mut().enumerate() {
+                let (group, prim) = met[j];
+                // `hit_on` of the rest ray, moved by 0 and with lookback factor 1.
+                *o = (prim != u32::MAX).then(|| {
+                    let (origin, dir) = c.ray(j);
+                    let t = c.best[j];
+                    SurfaceHit {
+                        group,
+                        prim,
+                        lambda: 0.0 + t,
+                        point: origin + t * dir,
+                        dir,
+                        s: 1.0,
+                    }
+                });
+            }
+        }
+    }
+
+    /// Whether anything lies on each ray between lookback 0 and `tmax[i]`.
+    pub fn occluded(&self, rays: &[NullRay], tmax: &[f64], out: &mut [bool]) {
+        let chunks = rays.chunks(WIDTH).zip(tmax.chunks(WIDTH));
+        for ((rs, ts), os) in chunks.zip(out.chunks_mut(WIDTH)) {
+            let mut c = Chunk::of_world(rs, |j| (0.0, ts[j]));
+            // Lanes past the rays count as met, so the chunk stops once its rays are; a ray
+            // met in one group stays met through the next.
+            c.prim[rs.len()..].iter_mut().for_each(|p| *p = 0);
+            for g in self.groups.iter() {
+                test(&g.prims, &mut c, true, self.simd);
+                if c.prim.iter().all(|&p| p != u32::MAX) {
+                    break;
+                }
+            }
+            for (j, o) in os.iter_mut().enumerate() {
+                *o = c.prim[j] != u32::MAX;
+            }
+        }
+    }
+}
+
+/// `prims` against the chunk, in lanes where `simd`.
+#[inline(always)]
+fn test(prims: &[Primitive], c: &mut Chunk, any: bool, simd: bool) {
+    match simd {
+        true => test_lanes(prims, c, any),
+        false => test_prims(prims, c, any),
     }
 }
 

@@ -142,6 +142,9 @@ pub struct World {
     /// accelerator: needed to skip groups and to keep f32 coordinates small when rays come from
     /// afar; pure cost for one group seen from close by, whose rays all start near it.
     clip_rays: bool,
+    /// Where every group is small and at rest in the world frame and rays are not clipped:
+    /// rays traced against all groups at once, straight from the world rays (direct.rs).
+    at_rest: Option<direct::AtRest>,
     /// Where the backend records what went wrong while tracing, and how many faults it had
     /// when this world was made (`check`).
     faults: Option<(Arc<Faults>, u64)>,
@@ -241,6 +244,23 @@ impl World {
                 || groups.iter().any(|g| {
                     (g.event_rest - g.bounds.centroid()).length() > 4.0 * g.bounds.diagonal()
                 }));
+        let at_rest = (tree.is_none() && !clip_rays)
+            .then(|| {
+                let groups = groups.iter().map(|g| {
+                    let at_rest = g.boost.is_identity()
+                        && g.window.is_none()
+                        && g.time_origin().is_none()
+                        && g.accel.is_none()
+                        && !g.spins;
+                    g.direct.clone().filter(|_| at_rest)
+                });
+                groups.collect::<Option<Box<[_]>>>()
+            })
+            .flatten()
+            .map(|groups| direct::AtRest {
+                groups,
+                simd: options.simd,
+            });
         Ok(World {
             event,
             groups,
@@ -249,6 +269,7 @@ impl World {
             primary_tree,
             light_trees,
             clip_rays,
+            at_rest,
             faults: backend.faults().map(|f| {
                 let seen = f.count();
                 (f, seen)
@@ -320,6 +341,19 @@ impl World {
             trees: OnceLock::new(),
         };
         Ok((kinetic, primary, lights))
+    }
+
+    /// Whether rays go to every group at once, straight from the world rays (`at_rest`).
+    #[cfg(test)]
+    pub fn traces_at_rest(&self) -> bool {
+        self.at_rest.is_some()
+    }
+
+    /// The same world with its rays traced group by group (the tests compare the two).
+    #[cfg(test)]
+    pub fn group_by_group(mut self) -> World {
+        self.at_rest = None;
+        self
     }
 
     /// Whether the kinetic group tree is in use (the tests check when it is).
@@ -469,6 +503,9 @@ impl World {
                 *o = self.closest_hit(r, tmin);
             }
             return;
+        }
+        if let Some(at_rest) = &self.at_rest {
+            return at_rest.closest_hits(rays, tmin, out);
         }
         // A packet's worth of rays at a time, through every group, on the stack.
         const CHUNK: usize = PACKET;

@@ -25,6 +25,9 @@ impl World {
             }
             return;
         }
+        if let Some(at_rest) = &self.at_rest {
+            return at_rest.occluded(rays, tmax, out);
+        }
         const CHUNK: usize = PACKET;
         // Made once for every chunk: each chunk writes the lanes it reads.
         let mut batch = [INACTIVE; CHUNK];
