@@ -213,49 +213,55 @@ fn test_lanes(prims: &[Primitive], c: &mut Chunk, any: bool) {
 #[inline(always)]
 fn test_prims(prims: &[Primitive], c: &mut Chunk, any: bool) {
     for (i, p) in prims.iter().enumerate() {
-        test_all(p, i as u32, c);
-        if any && c.prim.iter().all(|&p| p != u32::MAX) {
+        if test_all(p, i as u32, c) && any {
             break;
         }
     }
 }
 
-/// Primitive `p` (number `i`) against every lane, each lane's best hit kept.
+/// Primitive `p` (number `i`) against every lane, each lane's best hit kept; whether every
+/// lane has now met something. That answer is gathered in the loop that keeps the hits, from
+/// the values it has at hand: read back from the chunk after it, lane by lane, it waited on
+/// the vector store that had just written them.
 #[inline(always)]
-fn test_all(p: &Primitive, i: u32, c: &mut Chunk) {
+fn test_all(p: &Primitive, i: u32, c: &mut Chunk) -> bool {
+    let mut all = true;
     match *p {
         Primitive::Sphere { center, radius } => {
             for j in 0..WIDTH {
                 let (o, d) = c.ray(j);
                 let t = sphere_t(center, radius, o, d, c.tmin[j], c.best[j]);
-                keep(c, j, t, i);
+                all &= keep(c, j, t, i);
             }
         }
         Primitive::Cuboid { min, max } => {
             for j in 0..WIDTH {
                 let (o, d) = c.ray(j);
                 let t = cuboid_t(min, max, o, d, c.tmin[j], c.best[j]);
-                keep(c, j, t, i);
+                all &= keep(c, j, t, i);
             }
         }
         // Rods and triangles, one ray at a time (their tests branch).
         _ => {
             for j in 0..WIDTH {
                 let (o, d) = c.ray(j);
-                if let Some(t) = p.intersect(o, d, c.tmin[j], c.best[j]) {
-                    keep(c, j, t, i);
-                }
+                let t = p.intersect(o, d, c.tmin[j], c.best[j]);
+                all &= keep(c, j, t.unwrap_or(f64::NAN), i);
             }
         }
     }
+    all
 }
 
-/// Lane j's best hit becomes t (of primitive i) where t is a hit (not NaN).
+/// Lane j's best hit becomes t (of primitive i) where t is a hit (not NaN); whether the lane
+/// has met something.
 #[inline(always)]
-fn keep(c: &mut Chunk, j: usize, t: f64, i: u32) {
+fn keep(c: &mut Chunk, j: usize, t: f64, i: u32) -> bool {
     let hit = !t.is_nan();
+    let prim = if hit { i } else { c.prim[j] };
     c.best[j] = if hit { t } else { c.best[j] };
-    c.prim[j] = if hit { i } else { c.prim[j] };
+    c.prim[j] = prim;
+    prim != u32::MAX
 }
 
 /// `Primitive::intersect` of a sphere, without branches: the first crossing in (tmin, tmax),
