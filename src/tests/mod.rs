@@ -22,6 +22,7 @@ mod shadow_batches;
 mod slow_light;
 mod strips;
 mod toml_tree;
+mod visiting_order;
 
 /// How many pixels of two frames of one size differ, in any pass.
 fn differing_pixels(a: &crate::render::Frame, b: &crate::render::Frame) -> usize {

@@ -145,6 +145,11 @@ pub struct World {
     /// Where every group is small and at rest in the world frame and rays are not clipped:
     /// rays traced against all groups at once, straight from the world rays (direct.rs).
     at_rest: Option<direct::AtRest>,
+    /// Whether closest hits visit the groups last to first: where a worldline's segments are
+    /// groups, listed earliest first, a ray meets the latest segment's window first (the
+    /// smallest lookbacks), and once it has a hit there, the earlier segments' windows lie
+    /// beyond it and are passed over before any boost.
+    latest_first: bool,
     /// Where the backend records what went wrong while tracing, and how many faults it had
     /// when this world was made (`check`).
     faults: Option<(Arc<Faults>, u64)>,
@@ -261,7 +266,9 @@ impl World {
                 groups,
                 simd: options.simd,
             });
+        let latest_first = groups.iter().any(|g| g.window.is_some());
         Ok(World {
+            latest_first,
             event,
             groups,
             options,
@@ -347,6 +354,19 @@ impl World {
     #[cfg(test)]
     pub fn traces_at_rest(&self) -> bool {
         self.at_rest.is_some()
+    }
+
+    /// The same world with its groups visited first to last (the tests compare the orders).
+    #[cfg(test)]
+    pub fn first_to_last(mut self) -> World {
+        self.latest_first = false;
+        self
+    }
+
+    /// Whether closest hits visit the groups last to first.
+    #[cfg(test)]
+    pub fn visits_latest_first(&self) -> bool {
+        self.latest_first
     }
 
     /// The same world with its rays traced group by group (the tests compare the two).
@@ -520,7 +540,8 @@ impl World {
             let n = rays.len();
             let mut best = [f64::INFINITY; CHUNK];
             out.iter_mut().for_each(|o| *o = None);
-            for (gi, g) in self.groups.iter().enumerate() {
+            for gi in self.visiting_order() {
+                let g = &self.groups[gi];
                 // Every ray keeps its lane, so a packet stays a square of neighbouring pixels;
                 // a ray that misses the group's bounds is masked (inactive), not removed.
                 let mut any = false;
@@ -640,12 +661,20 @@ impl World {
                 .traverse(ray, tmin, f64::INFINITY, |g, tmax| visit(g as usize, tmax)),
             _ => {
                 let mut tmax = f64::INFINITY;
-                for gi in 0..self.groups.len() {
+                for gi in self.visiting_order() {
                     tmax = visit(gi, tmax);
                 }
             }
         }
         best
+    }
+
+    /// The order in which closest hits visit the groups without a tree (`latest_first`). On a
+    /// tie of lookbacks between two groups the one visited first keeps the hit.
+    fn visiting_order(&self) -> impl Iterator<Item = usize> {
+        let n = self.groups.len();
+        let later = self.latest_first;
+        (0..n).map(move |k| if later { n - 1 - k } else { k })
     }
 
     /// Whether the ray may meet group g's bounds in lookback (tmin, tmax), by where they move
