@@ -267,6 +267,10 @@ impl World {
                 simd: options.simd,
             });
         let latest_first = groups.iter().any(|g| g.window.is_some());
+        debug_assert!(
+            !(latest_first && at_rest.is_some()),
+            "AtRest visits first to last"
+        );
         Ok(World {
             latest_first,
             event,
@@ -670,7 +674,9 @@ impl World {
     }
 
     /// The order in which closest hits visit the groups without a tree (`latest_first`). On a
-    /// tie of lookbacks between two groups the one visited first keeps the hit.
+    /// tie of lookbacks between two groups, to rounding, the one visited first keeps the hit
+    /// (a later one must come out closer in its own frame and then in lookback). `AtRest`
+    /// visits its groups first to last: a world with windows is never wholly at rest.
     fn visiting_order(&self) -> impl Iterator<Item = usize> {
         let n = self.groups.len();
         let later = self.latest_first;
