@@ -2,6 +2,7 @@
 //! and renders with and without it, or with equal velocities merged or not, are identical.
 
 use super::common::*;
+use super::EIGHT_SEGMENTS;
 use crate::geometry::Aabb;
 use crate::render::{render_world, Frame, GroupTree, SlicedGroupTree, World, WorldOptions};
 use crate::spacetime::{Boost, Event, NullRay, Velocity};
@@ -625,10 +626,7 @@ fn the_moving_bounds_test_turns_away_no_hit() {
 /// their own take them. Both draw what the f64 BVH draws.
 #[test]
 fn the_group_trees_count_bodies_not_a_worldlines_segments() {
-    let segments = "[{until=-40, velocity=[-0.9,0,0]}, {until=-20, velocity=[-0.88,0,0]}, \
-                    {until=-10, velocity=[-0.9,0,0]}, {until=-5, velocity=[-0.88,0,0]}, \
-                    {until=-2, velocity=[-0.9,0,0]}, {until=0, velocity=[-0.88,0,0]}, \
-                    {until=1, velocity=[-0.9,0,0]}, {velocity=[-0.88,0,0]}]";
+    let segments = EIGHT_SEGMENTS;
     let head = "[camera]\nposition = [0, -30, 0]\nlook_at = [0, 0, 0]\ntime = 3\n\
                 [image]\nwidth = 64\nheight = 48\n[[light]]\nposition = [5, -30, 20]\n";
     let body = format!(

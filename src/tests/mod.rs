@@ -24,6 +24,14 @@ mod strips;
 mod toml_tree;
 mod visiting_order;
 
+/// A worldline of eight segments alternating between 0.9c and 0.88c along −x, their ends
+/// spread over the emission times a view from t = 3 sees (the bench's "8 segments").
+const EIGHT_SEGMENTS: &str =
+    "[{until=-40, velocity=[-0.9,0,0]}, {until=-20, velocity=[-0.88,0,0]}, \
+    {until=-10, velocity=[-0.9,0,0]}, {until=-5, velocity=[-0.88,0,0]}, \
+    {until=-2, velocity=[-0.9,0,0]}, {until=0, velocity=[-0.88,0,0]}, \
+    {until=1, velocity=[-0.9,0,0]}, {velocity=[-0.88,0,0]}]";
+
 /// How many pixels of two frames of one size differ, in any pass.
 fn differing_pixels(a: &crate::render::Frame, b: &crate::render::Frame) -> usize {
     a.pixels

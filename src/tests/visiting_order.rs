@@ -3,6 +3,7 @@
 //! closest whichever group is asked first.
 
 use super::common::*;
+use super::EIGHT_SEGMENTS;
 use crate::render::World;
 use crate::spacetime::{Event, NullRay};
 use glam::DVec3;
@@ -11,13 +12,9 @@ use glam::DVec3;
 /// closer by, whose rays meet the later segments.
 #[test]
 fn segments_visited_latest_first_meet_what_first_to_last_meets() {
-    let line = "[{until=-40, velocity=[-0.9,0,0]}, {until=-20, velocity=[-0.88,0,0]}, \
-                {until=-10, velocity=[-0.9,0,0]}, {until=-5, velocity=[-0.88,0,0]}, \
-                {until=-2, velocity=[-0.9,0,0]}, {until=0, velocity=[-0.88,0,0]}, \
-                {until=1, velocity=[-0.9,0,0]}, {velocity=[-0.88,0,0]}]";
     let text = format!(
         "[camera]\nposition = [0, -30, 0]\nlook_at = [0, 0, 0]\ntime = 3\n\
-         [image]\nwidth = 8\nheight = 8\n[[group]]\nname = \"lattice\"\nworldline = {line}\n\
+         [image]\nwidth = 8\nheight = 8\n[[group]]\nname = \"lattice\"\nworldline = {EIGHT_SEGMENTS}\n\
          [[group.object]]\ntype = \"lattice\"\norigin = [-6, -6, -6]\nspacing = 2.0\n\
          counts = [7, 7, 7]\nrod_radius = 0.1\nsphere_radius = 0.3\n"
     );

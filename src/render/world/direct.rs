@@ -49,15 +49,20 @@ struct Chunk {
 }
 
 impl Chunk {
-    fn of(rays: &[Ray]) -> Chunk {
-        let mut c = Chunk {
+    /// Lanes without rays: each with an empty interval, and no hit.
+    fn empty() -> Chunk {
+        Chunk {
             o: [[0.0; WIDTH]; 3],
             d: [[1.0; WIDTH]; 3],
-            // Lanes past the rays, and inactive rays, have an empty interval.
             tmin: [1.0; WIDTH],
             best: [0.0; WIDTH],
             prim: [u32::MAX; WIDTH],
-        };
+        }
+    }
+
+    /// Lanes past the rays, and inactive rays, keep an empty interval.
+    fn of(rays: &[Ray]) -> Chunk {
+        let mut c = Chunk::empty();
         for (j, r) in rays.iter().enumerate() {
             for k in 0..3 {
                 c.o[k][j] = r.origin[k];
@@ -73,13 +78,7 @@ impl Chunk {
     /// the interval `span(j)` of ray j: `World::rest_ray`'s arithmetic for such a group (its
     /// origin moved by 0 along the ray, its interval by 0), so the lanes see the same numbers.
     fn of_world(rays: &[NullRay], span: impl Fn(usize) -> (f64, f64)) -> Chunk {
-        let mut c = Chunk {
-            o: [[0.0; WIDTH]; 3],
-            d: [[1.0; WIDTH]; 3],
-            tmin: [1.0; WIDTH],
-            best: [0.0; WIDTH],
-            prim: [u32::MAX; WIDTH],
-        };
+        let mut c = Chunk::empty();
         for (j, r) in rays.iter().enumerate() {
             let origin = r.origin.x + 0.0 * r.dir;
             for k in 0..3 {
