@@ -18,7 +18,7 @@ if [ -z "$chromium" ]; then
         exit 0
     fi
     echo "browser-test: installing chromium" >&2
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium >/dev/null
+    DEBIAN_FRONTEND=noninteractive apt-get -o DPkg::Lock::Timeout=600 install -y -q chromium >/dev/null
     chromium=$(command -v chromium)
 fi
 cache=${REST_EMBREE_CACHE:-$HOME/.cache/rest-embree}

@@ -16,7 +16,7 @@ if [ "$(id -u)" != 0 ]; then
 fi
 if ! command -v slurmctld >/dev/null || ! command -v munged >/dev/null; then
     echo "slurm-test: installing slurm-wlm and munge" >&2
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -q slurm-wlm munge >/dev/null
+    DEBIAN_FRONTEND=noninteractive apt-get -o DPkg::Lock::Timeout=600 install -y -q slurm-wlm munge >/dev/null
 fi
 
 work=$(mktemp -d /tmp/rest-embree-slurm.XXXXXX)
