@@ -80,6 +80,26 @@ impl Window {
         self.from.time_of(e) >= self.from.time && self.to.time_of(e) <= self.to.time
     }
 
+    /// Its two times, where both its slices are of world time (then a ray's crossings are
+    /// `origin.t − time`, with no boost).
+    pub fn world_times(&self) -> Option<(f64, f64)> {
+        (self.from.boost.is_identity() && self.to.boost.is_identity())
+            .then_some((self.from.time, self.to.time))
+    }
+
+    /// [`Window::lookbacks`] of a window of world times `(from, to)` (`world_times`): the
+    /// same numbers, without the slices' boosts.
+    #[inline(always)]
+    pub fn lookbacks_in_world_times(
+        (from, to): (f64, f64),
+        ray: &NullRay,
+        tmin: f64,
+        tmax: f64,
+    ) -> Option<(f64, f64)> {
+        let (lo, hi) = (tmin.max(ray.origin.t - to), tmax.min(ray.origin.t - from));
+        (lo < hi).then_some((lo, hi))
+    }
+
     /// The lookbacks (lo, hi) between which `ray`'s events lie in it, within (tmin, tmax);
     /// None where none do.
     pub fn lookbacks(&self, ray: &NullRay, tmin: f64, tmax: f64) -> Option<(f64, f64)> {
@@ -116,6 +136,51 @@ impl Window {
 mod tests {
     use super::*;
     use glam::DVec3;
+
+    /// A window of world times gives the same lookbacks without its boosts, to the bit; one
+    /// with an end in a moving frame has no world times.
+    #[test]
+    fn world_times_give_the_same_lookbacks() {
+        let mut rng = crate::rng::Rng(0x71fe);
+        let v = Velocity::from_beta_vec(DVec3::new(0.6, 0.3, 0.0)).unwrap();
+        assert_eq!(
+            Window {
+                from: Slice::world(-4.0),
+                to: Slice::of(v, 2.5),
+            }
+            .world_times(),
+            None
+        );
+        for (from, to) in [
+            (-40.0, -20.0),
+            (f64::NEG_INFINITY, -40.0),
+            (1.0, f64::INFINITY),
+        ] {
+            let w = Window::world(from, to);
+            let times = w.world_times().expect("world times");
+            for _ in 0..2000 {
+                let ray = NullRay::new(
+                    Event::new(
+                        rng.range(-50.0, 50.0),
+                        DVec3::new(rng.range(-9.0, 9.0), 0.0, 1.0),
+                    ),
+                    rng.unit(),
+                );
+                let tmin = rng.range(0.0, 5.0);
+                let tmax = if rng.f() < 0.5 {
+                    f64::INFINITY
+                } else {
+                    rng.range(5.0, 90.0)
+                };
+                let fast = Window::lookbacks_in_world_times(times, &ray, tmin, tmax);
+                let slow = w.lookbacks(&ray, tmin, tmax);
+                assert_eq!(
+                    fast.map(|(a, b)| (a.to_bits(), b.to_bits())),
+                    slow.map(|(a, b)| (a.to_bits(), b.to_bits()))
+                );
+            }
+        }
+    }
 
     /// A ray's lookbacks in a window are where its events lie in it, in any frame.
     #[test]

@@ -3,6 +3,7 @@
 //! with many, and straight through every group at once where the world is wholly at rest
 //! (`direct::AtRest`).
 
+use super::moving_bounds::RaySpan;
 use super::{hit_on, ApparentTree, RestRay, SurfaceHit, World, INACTIVE};
 use crate::accel::{Hit, Ray};
 use crate::geometry::PACKET;
@@ -56,17 +57,46 @@ impl World {
         let mut shift = [0.0; CHUNK];
         let mut factor = [0.0; CHUNK];
         let mut hits: [Option<Hit>; CHUNK] = [None; CHUNK];
+        // Each lane's lookbacks in the group's window, where it has any.
+        let mut within: [Option<(f64, f64)>; CHUNK] = [None; CHUNK];
         for (rays, out) in rays.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
             let n = rays.len();
             let mut best = [f64::INFINITY; CHUNK];
             out.iter_mut().for_each(|o| *o = None);
+            // What the chunk's rays span, for the groups' test in the world frame.
+            let span = self.clip_rays.then(|| RaySpan::of(rays));
             for gi in self.visiting_order() {
                 let g = &self.groups[gi];
+                // The lookbacks each ray may still meet the group at, and their hull.
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                for (i, r) in rays.iter().enumerate() {
+                    within[i] = Self::in_window(g, r, tmin, best[i]);
+                    // Plain comparisons: `in_window` gives no NaN.
+                    if let Some((a, b)) = within[i] {
+                        if a < lo {
+                            lo = a;
+                        }
+                        if b > hi {
+                            hi = b;
+                        }
+                    }
+                }
+                if lo > hi {
+                    continue;
+                }
+                // A chunk that cannot meet where the group moves skips its boosts (a
+                // worldline's segments: most chunks meet few of their windows there).
+                if let Some(span) = &span {
+                    if g.time_origin().is_none() && !g.moving.may_meet_any(span, lo, hi) {
+                        continue;
+                    }
+                }
                 // Every ray keeps its lane, so a packet stays a square of neighbouring pixels;
                 // a ray that misses the group's bounds is masked (inactive), not removed.
                 let mut any = false;
                 for (i, r) in rays.iter().enumerate() {
-                    match self.rest_ray(g, r, tmin, best[i]) {
+                    let rest = within[i].and_then(|(a, b)| self.rest_ray_within(g, r, a, b));
+                    match rest {
                         Some(rr) => {
                             batch[i] = rr.ray;
                             shift[i] = rr.shift;

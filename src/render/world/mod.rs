@@ -38,7 +38,7 @@ mod world_group;
 use crate::accel::{Backend, Faults, Hit, Ray};
 use crate::geometry::Aabb;
 use crate::scene::Scene;
-use crate::spacetime::{NullRay, Velocity};
+use crate::spacetime::{NullRay, Velocity, Window};
 use glam::DVec3;
 use moving_bounds::MovingBounds;
 pub use primary_hits::PrimaryHits;
@@ -224,6 +224,7 @@ impl World {
                 moving: MovingBounds::new(&g.plain_bounds, &g.velocity, event.t),
                 plain_bounds: g.plain_bounds,
                 window: g.window.clone(),
+                world_window: g.window.as_ref().and_then(|w| w.world_times()),
                 spins: g.spins,
                 accelerated: g.accelerated,
                 turning: g.turning.clone(),
@@ -394,10 +395,30 @@ impl World {
     /// (docs/physics.md §12.4).
     #[inline(always)]
     fn rest_ray(&self, g: &WorldGroup, ray: &NullRay, tmin: f64, tmax: f64) -> Option<RestRay> {
-        let (tmin, tmax) = match &g.window {
-            None => (tmin, tmax),
-            Some(w) => w.lookbacks(ray, tmin, tmax)?,
-        };
+        let (tmin, tmax) = Self::in_window(g, ray, tmin, tmax)?;
+        self.rest_ray_within(g, ray, tmin, tmax)
+    }
+
+    /// The lookbacks in (tmin, tmax) at which the ray's events lie in group g's window (all of
+    /// them for a group without one); None where none do.
+    #[inline(always)]
+    fn in_window(g: &WorldGroup, ray: &NullRay, tmin: f64, tmax: f64) -> Option<(f64, f64)> {
+        match (g.world_window, &g.window) {
+            (Some(times), _) => Window::lookbacks_in_world_times(times, ray, tmin, tmax),
+            (None, None) => Some((tmin, tmax)),
+            (None, Some(w)) => w.lookbacks(ray, tmin, tmax),
+        }
+    }
+
+    /// [`World::rest_ray`] of lookbacks already kept to the group's window (`in_window`).
+    #[inline(always)]
+    fn rest_ray_within(
+        &self,
+        g: &WorldGroup,
+        ray: &NullRay,
+        tmin: f64,
+        tmax: f64,
+    ) -> Option<RestRay> {
         if let Some(t_ref) = g.time_origin() {
             return self.rest_ray_timed(g, t_ref, ray, tmin, tmax);
         }
@@ -499,8 +520,9 @@ impl World {
     /// in the world frame: before the boost `rest_ray` makes, for the groups the trees hand a
     /// ray one by one, most of which it misses (moving_bounds.rs). Part of the bounds cull
     /// (`clip_rays`). The packets of scenes with fewer groups than `GROUP_TREE_MIN`
-    /// (`closest_hits`, `occluded_many`) go without it: each group's bounds clip their rays
-    /// there (`rest_ray`).
+    /// (`closest_hits`, `occluded_many`) go without it ray by ray: each group's bounds clip
+    /// their rays there (`rest_ray`), after, for closest hits, one test of the whole chunk
+    /// (`MovingBounds::may_meet_any`).
     #[inline(always)]
     fn may_meet(&self, g: &WorldGroup, ray: &NullRay, tmin: f64, tmax: f64) -> bool {
         !self.clip_rays || g.moving.may_meet(ray, tmin, tmax)

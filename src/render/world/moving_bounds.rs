@@ -9,6 +9,10 @@
 //! within `at_ref + v (t − t_ref)` (`world_box`). The ray is at x = o + λ d at time t_o − λ, so
 //! it meets that moving box at lookback λ where o − v (t_o − t_ref) + λ (d + v) lies in
 //! `at_ref`: a slab test on a static box, with no boost.
+//!
+//! The same test widened over a chunk of rays (`may_meet_any`, by interval arithmetic over
+//! their origins, directions and lookbacks) lets a packet that passes beside a group, or
+//! beside where a worldline's segment is during its window, skip the group's boosts at once.
 
 use super::group_tree::world_box;
 use crate::geometry::Aabb;
@@ -66,6 +70,77 @@ impl MovingBounds {
             tmax + SLACK * (1.0 + tmax.abs()),
         );
         b.clip(o, (ray.dir + v).recip(), lo, hi).is_some()
+    }
+}
+
+/// What a chunk of rays spans: per axis the least and greatest origin and direction, and the
+/// least and greatest origin time (`MovingBounds::may_meet_any`).
+#[derive(Clone, Copy, Debug)]
+pub struct RaySpan {
+    x: Aabb,
+    d: Aabb,
+    t: (f64, f64),
+}
+
+impl RaySpan {
+    /// The span of `rays` (at least one).
+    pub fn of(rays: &[NullRay]) -> RaySpan {
+        let (mut x, mut d) = (Aabb::EMPTY, Aabb::EMPTY);
+        let mut t = (f64::INFINITY, f64::NEG_INFINITY);
+        for r in rays {
+            x.grow(r.origin.x);
+            d.grow(r.dir);
+            t = (t.0.min(r.origin.t), t.1.max(r.origin.t));
+        }
+        RaySpan { x, d, t }
+    }
+}
+
+/// λ w for a lookback λ in [0, ∞] and a component w of d + v: 0 where w is (for every λ).
+#[inline]
+fn reach(lambda: f64, w: f64) -> f64 {
+    if w == 0.0 {
+        0.0
+    } else {
+        lambda * w
+    }
+}
+
+impl MovingBounds {
+    /// Whether any ray of `span` may meet the bounds at a lookback in [lo, hi] (0 ≤ lo ≤ hi,
+    /// hi perhaps ∞): false only where none can. The set `may_meet` tests ray by ray,
+    /// o − v (t_o − t_ref) + λ (d + v), widened to a box by interval arithmetic over the
+    /// span's origins, times and directions and the lookbacks: one test for a chunk of rays
+    /// (a packet of primary rays shares its origin, and its directions lie close), which a
+    /// chunk that misses the group's moving bounds takes instead of a boost per ray.
+    pub fn may_meet_any(&self, span: &RaySpan, lo: f64, hi: f64) -> bool {
+        let Some(v) = self.v else {
+            return true;
+        };
+        let (ta, tb) = (span.t.0 - self.t_ref, span.t.1 - self.t_ref);
+        for k in 0..3 {
+            let vk = v[k];
+            let (va, vb) = (vk * ta, vk * tb);
+            // The origins as seen against the box at t_ref: x − v (t − t_ref).
+            let p = span.x.min[k] - va.max(vb);
+            let q = span.x.max[k] - va.min(vb);
+            let (a, b) = (span.d.min[k] + vk, span.d.max[k] + vk);
+            let ends = [reach(lo, a), reach(lo, b), reach(hi, a), reach(hi, b)];
+            let near = ends.iter().fold(f64::INFINITY, |m, &e| m.min(e));
+            let far = ends.iter().fold(f64::NEG_INFINITY, |m, &e| m.max(e));
+            let (low, high) = (p + near, q + far);
+            // Rounding of every term above, far below the slack (an infinite end rejects
+            // nothing on its side; a NaN fails both comparisons).
+            let size = [p, q, near, far, low, high]
+                .iter()
+                .filter(|e| e.is_finite())
+                .fold(0.0f64, |m, e| m.max(e.abs()));
+            let pad = SLACK * (1.0 + self.scale + size);
+            if high < self.at_ref.min[k] - pad || low > self.at_ref.max[k] + pad {
+                return false;
+            }
+        }
+        true
     }
 }
 
@@ -157,6 +232,106 @@ mod tests {
         assert!(
             rejected > 4 * missed,
             "the test should reject most misses: {rejected} rejected, {missed} kept"
+        );
+    }
+
+    /// A chunk's test never turns away a chunk with a ray that meets the bounds in the
+    /// lookbacks given, and turns away most chunks that miss: chunks of eight rays from one
+    /// event (a packet of primary rays, directions within a small cone) or from events
+    /// scattered about one, at speeds up to 1 − 1e-5, with finite and unbounded lookbacks.
+    #[test]
+    fn a_chunk_is_kept_if_any_ray_meets_the_bounds() {
+        let mut rng = Rng(0x0dd_c0ffee);
+        let (mut met, mut rejected, mut missed) = (0, 0, 0);
+        for case in 0..20_000 {
+            let c = DVec3::new(
+                rng.range(-40.0, 40.0),
+                rng.range(-40.0, 40.0),
+                rng.range(-40.0, 40.0),
+            );
+            let h = DVec3::new(
+                rng.range(0.1, 4.0),
+                rng.range(0.1, 4.0),
+                rng.range(0.1, 4.0),
+            );
+            let rest = Aabb::new(c - h, c + h);
+            let v = match case % 3 {
+                0 => Velocity::from_beta(rng.unit(), rng.range(0.0, 0.9)),
+                1 => Velocity::from_beta(rng.unit(), rng.range(0.9, 0.999)),
+                _ => Velocity::from_one_minus_beta(rng.unit(), 10f64.powf(-rng.range(3.0, 5.0))),
+            }
+            .expect("below c");
+            let t_ref = 30.0;
+            let bounds = MovingBounds::new(&rest, &v, t_ref);
+            let centre = Event::new(
+                t_ref - rng.range(0.0, 30.0),
+                DVec3::new(
+                    rng.range(-80.0, 80.0),
+                    rng.range(-80.0, 80.0),
+                    rng.range(-80.0, 80.0),
+                ),
+            );
+            // The first ray toward a corner of the bounds or a point of an edge, as seen from
+            // the event (it may meet them there alone), or anywhere; the others about it.
+            let aim = if case % 2 == 0 {
+                let mut p = DVec3::new(
+                    rng.range(-1.0, 1.0),
+                    rng.range(-1.0, 1.0),
+                    rng.range(-1.0, 1.0),
+                );
+                let free = (rng.f() * 3.0) as usize % 3;
+                for k in 0..3 {
+                    if case % 4 == 0 || k != free {
+                        p[k] = p[k].signum();
+                    }
+                }
+                let rest_event = Boost::to_rest(&v).event(centre).x;
+                let rest_dir = (c + h * p - rest_event).normalize();
+                Boost::to_rest(&v).inverse().view_dir(rest_dir).0
+            } else {
+                rng.unit()
+            };
+            let spread = [0.003, 0.03, 0.3][case % 3];
+            let scattered = case % 8 >= 5;
+            let rays: Vec<NullRay> = (0..8)
+                .map(|j| {
+                    if j == 0 {
+                        return NullRay::new(centre, aim);
+                    }
+                    let origin = if scattered {
+                        Event::new(centre.t - rng.range(0.0, 2.0), centre.x + 2.0 * rng.unit())
+                    } else {
+                        centre
+                    };
+                    NullRay::new(origin, (aim + spread * rng.unit()).normalize())
+                })
+                .collect();
+            let (lo, hi) = match case % 5 {
+                0 => (0.0, f64::INFINITY),
+                1 => (rng.range(0.0, 40.0), f64::INFINITY),
+                _ => {
+                    let a = rng.range(0.0, 150.0);
+                    (a, a + rng.range(0.5, 60.0))
+                }
+            };
+            let meets = rays
+                .iter()
+                .any(|r| meets_in_rest_frame(&rest, &v, r, lo, hi));
+            let kept = bounds.may_meet_any(&RaySpan::of(&rays), lo, hi);
+            assert!(
+                kept || !meets,
+                "case {case}: a chunk with a ray that meets the bounds was turned away"
+            );
+            match (meets, kept) {
+                (true, _) => met += 1,
+                (false, false) => rejected += 1,
+                (false, true) => missed += 1,
+            }
+        }
+        assert!(met > 2_000, "too few chunks met the bounds: {met}");
+        assert!(
+            rejected > 2 * missed,
+            "the test should turn away most chunks that miss: {rejected} turned away, {missed} kept"
         );
     }
 

@@ -30,6 +30,9 @@ pub struct WorldGroup {
     pub(super) moving: MovingBounds,
     /// The emission events it is seen at (a worldline's segment); None: all.
     pub window: Option<Box<Window>>,
+    /// The window's two world times where both its ends are of world time (between uniform
+    /// segments), for lookbacks without a boost (`World::in_window`).
+    pub(super) world_window: Option<(f64, f64)>,
     /// Whether anything in it spins.
     pub spins: bool,
     /// Its hyperbolic motion, for a segment of constant proper acceleration (its rays start
