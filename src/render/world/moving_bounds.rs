@@ -117,26 +117,30 @@ impl MovingBounds {
         let Some(v) = self.v else {
             return true;
         };
+        // λ ≥ 0 below (lookbacks); anything else is kept.
+        if lo.is_nan() || lo < 0.0 {
+            return true;
+        }
         let (ta, tb) = (span.t.0 - self.t_ref, span.t.1 - self.t_ref);
         for k in 0..3 {
             let vk = v[k];
             let (va, vb) = (vk * ta, vk * tb);
+            let (vmin, vmax) = if va < vb { (va, vb) } else { (vb, va) };
             // The origins as seen against the box at t_ref: x − v (t − t_ref).
-            let p = span.x.min[k] - va.max(vb);
-            let q = span.x.max[k] - va.min(vb);
+            let (xmin, xmax) = (span.x.min[k], span.x.max[k]);
+            let (p, q) = (xmin - vmax, xmax - vmin);
+            // λ w over λ in [lo, hi] and w in [a, b] (λ ≥ 0): least at lo a where a ≥ 0, else
+            // at hi a; greatest at hi b where b ≥ 0, else at lo b. Finite, or ∞ away from
+            // the box on that side only.
             let (a, b) = (span.d.min[k] + vk, span.d.max[k] + vk);
-            let ends = [reach(lo, a), reach(lo, b), reach(hi, a), reach(hi, b)];
-            let near = ends.iter().fold(f64::INFINITY, |m, &e| m.min(e));
-            let far = ends.iter().fold(f64::NEG_INFINITY, |m, &e| m.max(e));
-            let (low, high) = (p + near, q + far);
-            // Rounding of every term above, far below the slack (an infinite end rejects
-            // nothing on its side; a NaN fails both comparisons).
-            let size = [p, q, near, far, low, high]
-                .iter()
-                .filter(|e| e.is_finite())
-                .fold(0.0f64, |m, e| m.max(e.abs()));
-            let pad = SLACK * (1.0 + self.scale + size);
-            if high < self.at_ref.min[k] - pad || low > self.at_ref.max[k] + pad {
+            let near = if a >= 0.0 { reach(lo, a) } else { reach(hi, a) };
+            let far = if b >= 0.0 { reach(hi, b) } else { reach(lo, b) };
+            // The rounding of every term, far below the slack. Where the positions' end
+            // toward the box is infinite, so is its pad, and that test turns nothing away.
+            let common = 1.0 + self.scale + vmin.abs().max(vmax.abs());
+            let below = q + far < self.at_ref.min[k] - SLACK * (common + xmax.abs() + far.abs());
+            let above = p + near > self.at_ref.max[k] + SLACK * (common + xmin.abs() + near.abs());
+            if below || above {
                 return false;
             }
         }
@@ -306,9 +310,19 @@ mod tests {
                     NullRay::new(origin, (aim + spread * rng.unit()).normalize())
                 })
                 .collect();
-            let (lo, hi) = match case % 5 {
-                0 => (0.0, f64::INFINITY),
-                1 => (rng.range(0.0, 40.0), f64::INFINITY),
+            // Where the first ray crosses the bounds, in lookback.
+            let crossing = {
+                let boost = Boost::to_rest(&v);
+                let (d, _) = boost.null_dir(rays[0].dir);
+                rest.clip(boost.event(rays[0].origin).x, d.recip(), 0.0, f64::INFINITY)
+            };
+            let (lo, hi) = match (case % 5, crossing) {
+                (0, _) => (0.0, f64::INFINITY),
+                (1, _) => (rng.range(0.0, 40.0), f64::INFINITY),
+                // Lookbacks that end just after the first ray enters the bounds, or begin just
+                // before it leaves them: it meets them in a sliver at one end.
+                (2, Some((t0, _))) => (0.0, t0 + 1e-6 * (1.0 + t0)),
+                (3, Some((_, t1))) => ((t1 - 1e-6 * (1.0 + t1)).max(0.0), f64::INFINITY),
                 _ => {
                     let a = rng.range(0.0, 150.0);
                     (a, a + rng.range(0.5, 60.0))
