@@ -30,6 +30,17 @@ import tomllib
 
 import numpy as np
 
+
+def cpu_model():
+    """The CPU's model as Linux names it: the figures are this machine's."""
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                return " ".join(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    return "an unnamed CPU"
+
 # The project's root (given to the copy of this file the Mitsuba process imports).
 ROOT = os.environ.get("REST_EMBREE_ROOT") or os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BIN = os.path.join(ROOT, "target", "release", "rest-embree")
@@ -183,7 +194,7 @@ def main():
     lines = [
         f"Measured with `python3 scripts/mitsuba-compare.py{' --quick' if QUICK else ''}` "
         f"(scenes/room.toml at {size}x{size}, Mitsuba {__import__('mitsuba').__version__} llvm_ad_rgb `path`, "
-        f"{os.cpu_count()} cores, one run):",
+        f"{os.cpu_count()} cores of {cpu_model()}, one run):",
         "",
         f"- Agreement with Mitsuba's {ref_spp}-spp picture: mean {overall:+.4f}; 8x8 blocks "
         f"median {np.median(blocks):.4f}, 95th percentile {np.percentile(blocks, 95):.4f}.",

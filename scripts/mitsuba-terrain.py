@@ -29,6 +29,17 @@ import time
 
 import numpy as np
 
+
+def cpu_model():
+    """The CPU's model as Linux names it: the figures are this machine's."""
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                return " ".join(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    return "an unnamed CPU"
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BIN = os.path.join(ROOT, "target", "release", "rest-embree")
 OUT = sys.argv[sys.argv.index("--out") + 1] if "--out" in sys.argv else os.path.join(ROOT, "docs", "bench", "terrain.md")
@@ -154,8 +165,8 @@ def main():
     met = lambda ok: "**met**" if ok else "**not met**"
     lines = [
         f"The bench's terrain, a binary PLY of {faces:,} triangles, rendered at {SIZE}² with 1 sample",
-        f"per pixel and one point light, at rest, on {nproc} cores, each renderer in a process of its",
-        "own (scripts/mitsuba-terrain.py). Mitsuba's render of llvm_ad_rgb includes its kernel's",
+        f"per pixel and one point light, at rest, on {nproc} cores of {cpu_model()}, each renderer in",
+        "a process of its own (scripts/mitsuba-terrain.py). Mitsuba's render of llvm_ad_rgb includes its kernel's",
         "compilation, as a first render does; its load includes its import. rest-embree's render",
         "includes writing its EXR (its strips are compressed and written as they are rendered):",
         "with every pass, as by default, and with colour and alpha alone (`--passes none`), the",

@@ -153,9 +153,10 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         rayon::current_num_threads()
     ));
     let md = format!(
-        "Measured with `rest-embree bench{}` on {} threads.{embree}\n\n{table}\n{summary}",
+        "Measured with `rest-embree bench{}` on {} threads{}.{embree}\n\n{table}\n{summary}",
         if args.quick { " --quick" } else { "" },
-        rayon::current_num_threads()
+        rayon::current_num_threads(),
+        cpu_model().map_or(String::new(), |m| format!(" of {m}"))
     );
     let write = |name: &str, text: &str| {
         std::fs::write(args.out.join(name), text).map_err(|e| Error::flag(&out_flag, e))
@@ -168,6 +169,15 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// The CPU's model as Linux names it (`/proc/cpuinfo`), where it does: the figures are this
+/// machine's, and its instruction sets decide several of them.
+fn cpu_model() -> Option<String> {
+    let info = std::fs::read_to_string("/proc/cpuinfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("model name"))?;
+    let name = line.split_once(':')?.1.trim();
+    (!name.is_empty()).then(|| name.split_whitespace().collect::<Vec<_>>().join(" "))
 }
 
 #[cfg(test)]
