@@ -32,14 +32,15 @@ import numpy as np
 
 
 def cpu_model():
-    """The CPU's model as Linux names it: the figures are this machine's."""
+    """' of <the CPU's model>' as Linux names it, or nothing: the figures are this machine's."""
     try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                return " ".join(line.split(":", 1)[1].split())
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return " of " + " ".join(line.split(":", 1)[1].split())
     except OSError:
         pass
-    return "an unnamed CPU"
+    return ""
 
 # The project's root (given to the copy of this file the Mitsuba process imports).
 ROOT = os.environ.get("REST_EMBREE_ROOT") or os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -194,7 +195,7 @@ def main():
     lines = [
         f"Measured with `python3 scripts/mitsuba-compare.py{' --quick' if QUICK else ''}` "
         f"(scenes/room.toml at {size}x{size}, Mitsuba {__import__('mitsuba').__version__} llvm_ad_rgb `path`, "
-        f"{os.cpu_count()} cores of {cpu_model()}, one run):",
+        f"{os.cpu_count()} cores{cpu_model()}, one run):",
         "",
         f"- Agreement with Mitsuba's {ref_spp}-spp picture: mean {overall:+.4f}; 8x8 blocks "
         f"median {np.median(blocks):.4f}, 95th percentile {np.percentile(blocks, 95):.4f}.",

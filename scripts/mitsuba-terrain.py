@@ -31,14 +31,15 @@ import numpy as np
 
 
 def cpu_model():
-    """The CPU's model as Linux names it: the figures are this machine's."""
+    """' of <the CPU's model>' as Linux names it, or nothing: the figures are this machine's."""
     try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                return " ".join(line.split(":", 1)[1].split())
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return " of " + " ".join(line.split(":", 1)[1].split())
     except OSError:
         pass
-    return "an unnamed CPU"
+    return ""
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BIN = os.path.join(ROOT, "target", "release", "rest-embree")
@@ -165,7 +166,7 @@ def main():
     met = lambda ok: "**met**" if ok else "**not met**"
     lines = [
         f"The bench's terrain, a binary PLY of {faces:,} triangles, rendered at {SIZE}² with 1 sample",
-        f"per pixel and one point light, at rest, on {nproc} cores of {cpu_model()}, each renderer in",
+        f"per pixel and one point light, at rest, on {nproc} cores{cpu_model()}, each renderer in",
         "a process of its own (scripts/mitsuba-terrain.py). Mitsuba's render of llvm_ad_rgb includes its kernel's",
         "compilation, as a first render does; its load includes its import. rest-embree's render",
         "includes writing its EXR (its strips are compressed and written as they are rendered):",

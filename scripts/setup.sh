@@ -16,7 +16,13 @@ if [ ${#missing[@]} -gt 0 ]; then
     exit 1
   fi
   echo "setup: installing ${missing[*]}"
-  "${sudo[@]}" apt-get -o DPkg::Lock::Timeout=600 update -qq
+  # The lock timeout covers dpkg's locks, not the package lists' that update takes: another
+  # apt-get updating at the same moment is waited out by trying again.
+  for try in 1 2 3 4 5 6; do
+    "${sudo[@]}" apt-get -o DPkg::Lock::Timeout=600 update -qq && break
+    [ "$try" -lt 6 ] || exit 1
+    sleep 10
+  done
   DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get -o DPkg::Lock::Timeout=600 install -y -qq "${missing[@]}" >/dev/null
 fi
 

@@ -3,8 +3,8 @@ same pixels in every pass, errors carry the same messages, renders stop on Ctrl-
 stays flat over many renders, and the notebook runs top to bottom."""
 
 import os
-import signal
 import re as regex
+import signal
 import subprocess
 import sys
 import threading
@@ -158,15 +158,15 @@ def test_ctrl_c_stops_a_render():
     # Started as a background job (`make test &`), the interpreter inherits SIGINT ignored,
     # and then interrupt_main does nothing: Python's own handler is put back for the test.
     old_handler = signal.signal(signal.SIGINT, signal.default_int_handler)
+    timer = threading.Timer(0.3, _thread.interrupt_main)
     try:
-        timer = threading.Timer(0.3, _thread.interrupt_main)
         start = time.monotonic()
         timer.start()
         with pytest.raises(KeyboardInterrupt):
             re.render(scene, width=2048, height=2048, samples=16)
         took = time.monotonic() - start
-        timer.cancel()
     finally:
+        timer.cancel()
         signal.signal(signal.SIGINT, old_handler)
     assert took < 10, f"stopped after {took:.1f} s"
     # And the next render runs.
