@@ -519,8 +519,9 @@ impl World {
     /// Whether the ray may meet group g's bounds in lookback (tmin, tmax), by where they move
     /// in the world frame: before the boost `rest_ray` makes, for the groups the trees hand a
     /// ray one by one, most of which it misses (moving_bounds.rs). Part of the bounds cull
-    /// (`clip_rays`). The packets of scenes with fewer groups than `GROUP_TREE_MIN`
-    /// (`closest_hits`, `occluded_many`) go without it ray by ray: each group's bounds clip
+    /// (`clip_rays`). The packets of worlds without the group trees (fewer than
+    /// `GROUP_TREE_MIN` groups or bodies, or the trees switched off; `closest_hits`,
+    /// `occluded_many`) go without it ray by ray: each group's bounds clip
     /// their rays there (`rest_ray`), after, for closest hits, one test of the whole chunk
     /// (`MovingBounds::may_meet_any`).
     #[inline(always)]
