@@ -31,17 +31,6 @@ import tomllib
 import numpy as np
 
 
-def cpu_model():
-    """' of <the CPU's model>' as Linux names it, or nothing: the figures are this machine's."""
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return " of " + " ".join(line.split(":", 1)[1].split())
-    except OSError:
-        pass
-    return ""
-
 # The project's root (given to the copy of this file the Mitsuba process imports).
 ROOT = os.environ.get("REST_EMBREE_ROOT") or os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BIN = os.path.join(ROOT, "target", "release", "rest-embree")
@@ -164,6 +153,9 @@ def lum(img):
 
 
 def main():
+    # Here, not at the top: the Mitsuba process imports a copy of this file from elsewhere.
+    from machine import cpu_model  # scripts/machine.py
+
     size = 128 if QUICK else 192
     ref_spp = 512 if QUICK else 2048
     counts = (4, 16, 64) if QUICK else (4, 16, 64, 256)

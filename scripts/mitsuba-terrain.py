@@ -29,17 +29,8 @@ import time
 
 import numpy as np
 
+from machine import cpu_model  # scripts/machine.py
 
-def cpu_model():
-    """' of <the CPU's model>' as Linux names it, or nothing: the figures are this machine's."""
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return " of " + " ".join(line.split(":", 1)[1].split())
-    except OSError:
-        pass
-    return ""
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BIN = os.path.join(ROOT, "target", "release", "rest-embree")

@@ -85,9 +85,10 @@ impl World {
                     continue;
                 }
                 // A chunk that cannot meet where the group moves skips its boosts (a
-                // worldline's segments: most chunks meet few of their windows there).
+                // worldline's segments: most chunks meet few of their windows there). The
+                // bounds move as the ray-by-ray test (`may_meet`) has them for every group.
                 if let Some(span) = &span {
-                    if g.time_origin().is_none() && !g.moving.may_meet_any(span, lo, hi) {
+                    if !g.moving.may_meet_any(span, lo, hi) {
                         continue;
                     }
                 }
