@@ -17,6 +17,11 @@ use glam::DVec3;
 
 /// Grid cells per box listed on a face, about: finer cells list each box in more of them.
 const CELLS_PER_BOX: f64 = 0.5;
+/// The cells a face's median rectangle spans along each side, at most: where the boxes' shadows
+/// overlap many deep (many groups swept over a slice of time), finer cells than this list each
+/// box in ever more of them, and a ray still meets the same boxes, as many as overlap in its
+/// direction. The entries then cost more to make than the rays save, and the memory.
+const CELLS_ACROSS: f64 = 2.0;
 /// The most cells along a face's side.
 const MAX_RES: usize = 1024;
 /// Rectangles grow by this much (in face coordinates) for rounding in the projections.
@@ -135,6 +140,15 @@ fn footprints(b: &Aabb, o: DVec3) -> [Option<[f64; 4]>; 6] {
     out
 }
 
+/// The median of `x` (the upper one of an even count), which it reorders; 0 for none.
+fn median(x: &mut [f64]) -> f64 {
+    if x.is_empty() {
+        return 0.0;
+    }
+    let mid = x.len() / 2;
+    *x.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
 /// The distance from `o` to the box (0 inside).
 fn distance(b: &Aabb, o: DVec3) -> f64 {
     (b.min - o).max(o - b.max).max(DVec3::ZERO).length()
@@ -173,9 +187,10 @@ impl LightBuffer {
                 }
             }
         }
-        // Each face's span of rectangles and how many it has.
+        // Each face's span of rectangles, how many it has, and their widths along u and v.
         let mut spans = [[f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY]; 6];
         let mut counts = [0usize; 6];
+        let mut widths: [(Vec<f64>, Vec<f64>); 6] = Default::default();
         for &(_, f, r) in &rects {
             let span = &mut spans[f as usize];
             *span = [
@@ -185,10 +200,14 @@ impl LightBuffer {
                 span[3].max(r[3]),
             ];
             counts[f as usize] += 1;
+            widths[f as usize].0.push(r[2] - r[0]);
+            widths[f as usize].1.push(r[3] - r[1]);
         }
         // Each face's grid over the rectangles on it.
         let mut first = 0;
-        for ((face, span), count) in lb.faces.iter_mut().zip(spans).zip(counts) {
+        for (((face, span), count), (wu, wv)) in
+            lb.faces.iter_mut().zip(spans).zip(counts).zip(&mut widths)
+        {
             if count == 0 {
                 *face = Face {
                     lo: [0.0; 2],
@@ -199,7 +218,16 @@ impl LightBuffer {
                 first += 1;
                 continue;
             }
-            let res = ((count as f64 * CELLS_PER_BOX).sqrt().ceil() as usize).clamp(1, MAX_RES);
+            let by_count = (count as f64 * CELLS_PER_BOX).sqrt().ceil();
+            // The median rectangle's share of the span along u and along v: cells of about
+            // 1 / CELLS_ACROSS of it (their geometric mean; none where rectangles are points).
+            let share = median(wu) / (span[2] - span[0]) * median(wv) / (span[3] - span[1]);
+            let by_size = CELLS_ACROSS / share.sqrt();
+            let res = match by_size.is_finite() && by_size > 0.0 {
+                true => by_count.min(by_size.ceil()),
+                false => by_count,
+            };
+            let res = (res as usize).clamp(1, MAX_RES);
             let inv_w = |lo: f64, hi: f64| {
                 let w = (hi - lo) / res as f64;
                 if w > 0.0 {
@@ -258,6 +286,12 @@ impl LightBuffer {
     #[cfg(test)]
     pub fn len(&self) -> usize {
         self.boxes.len()
+    }
+
+    /// How many entries its cells list, in all.
+    #[cfg(test)]
+    pub fn entries(&self) -> usize {
+        self.entries.len()
     }
 
     /// Whether it holds no box.

@@ -37,22 +37,54 @@ fn direction(r: &mut Rng) -> DVec3 {
     }
 }
 
+/// Many large boxes in a cone before the light, their shadows dozens deep (as many groups'
+/// boxes swept over a slice of time are): the grid's cells follow the rectangles' size.
+fn deep_boxes(r: &mut Rng, o: DVec3) -> Vec<Aabb> {
+    (0..3000)
+        .map(|_| {
+            let c = o + (DVec3::Y + 0.4 * r.unit()).normalize() * r.range(10.0, 30.0);
+            let h = DVec3::new(r.range(1.0, 4.0), r.range(0.5, 2.0), r.range(1.0, 3.0));
+            Aabb::new(c - h, c + h)
+        })
+        .collect()
+}
+
 #[test]
 fn light_buffer_offers_every_box_a_ray_meets_once_nearest_first() {
     let mut r = Rng(77);
     let o = DVec3::new(3.0, -20.0, 7.0);
     let boxes = boxes(&mut r, o);
+    offers_every_met_box(&mut r, o, &boxes, 20_000);
+}
+
+/// Where the boxes' shadows lie dozens deep, cells finer than the boxes' rectangles would list
+/// each box in ever more of them for no fewer boxes per ray: the grid stops at about two cells
+/// across the median rectangle, and still offers every box a ray meets.
+#[test]
+fn light_buffer_cells_follow_deep_shadows() {
+    let mut r = Rng(79);
+    let o = DVec3::new(-2.0, 5.0, 1.0);
+    let boxes = deep_boxes(&mut r, o);
     let lb = LightBuffer::build(o, &boxes);
+    let per_box = lb.entries() as f64 / boxes.len() as f64;
+    assert!(per_box < 16.0, "each box listed in {per_box} cells");
+    offers_every_met_box(&mut r, o, &boxes, 4000);
+}
+
+/// Rays from the light at `o` (and, every tenth, from elsewhere) through `boxes`' buffer: each
+/// box a ray meets in its interval is offered once, nearest first, and no other.
+fn offers_every_met_box(r: &mut Rng, o: DVec3, boxes: &[Aabb], rays: usize) {
+    let lb = LightBuffer::build(o, boxes);
     assert_eq!(lb.len(), boxes.len());
     let mut met = 0;
-    for k in 0..20_000 {
+    for k in 0..rays {
         // Rays from the light, and (every tenth) from elsewhere.
         let from = if k % 10 == 0 {
             o + r.unit() * r.range(0.0, 30.0)
         } else {
             o
         };
-        let d = direction(&mut r) * r.range(0.2, 3.0);
+        let d = direction(r) * r.range(0.2, 3.0);
         let tmin = if k % 3 == 0 { r.range(0.0, 10.0) } else { 0.0 };
         let mut tmax = [if k % 7 == 0 {
             f64::INFINITY
@@ -90,7 +122,7 @@ fn light_buffer_offers_every_box_a_ray_meets_once_nearest_first() {
         }
         met += want.len();
     }
-    assert!(met > 20_000, "enough meetings checked ({met})");
+    assert!(met > rays, "enough meetings checked ({met})");
 }
 
 #[test]
