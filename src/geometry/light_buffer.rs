@@ -17,10 +17,12 @@ use glam::DVec3;
 
 /// Grid cells per box listed on a face, about: finer cells list each box in more of them.
 const CELLS_PER_BOX: f64 = 0.5;
-/// The cells a face's median rectangle spans along each side, at most: where the boxes' shadows
-/// overlap many deep (many groups swept over a slice of time), finer cells than this list each
-/// box in ever more of them, and a ray still meets the same boxes, as many as overlap in its
-/// direction. The entries then cost more to make than the rays save, and the memory.
+/// The cells a face's typical rectangle spans along a side, at most (the geometric mean of its
+/// median width along u and along v, so about CELLS_ACROSS² cells in area): where the boxes'
+/// shadows overlap many deep (many groups swept over a slice of time), finer cells list each
+/// box in ever more of them while a ray meets as many boxes as before, those overlapping in its
+/// direction; the entries then cost more time and memory to make than the rays save. Where
+/// most of a face's rectangles are large, the small ones on it get these coarser cells too.
 const CELLS_ACROSS: f64 = 2.0;
 /// The most cells along a face's side.
 const MAX_RES: usize = 1024;
@@ -219,8 +221,8 @@ impl LightBuffer {
                 continue;
             }
             let by_count = (count as f64 * CELLS_PER_BOX).sqrt().ceil();
-            // The median rectangle's share of the span along u and along v: cells of about
-            // 1 / CELLS_ACROSS of it (their geometric mean; none where rectangles are points).
+            // The median widths' shares of the span along u and along v: cells of about
+            // 1 / CELLS_ACROSS of their geometric mean (none where the span is empty).
             let share = median(wu) / (span[2] - span[0]) * median(wv) / (span[3] - span[1]);
             let by_size = CELLS_ACROSS / share.sqrt();
             let res = match by_size.is_finite() && by_size > 0.0 {

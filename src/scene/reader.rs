@@ -270,9 +270,10 @@ impl<'a> Table<'a> {
         self.vec3_of(n, key).map(Some)
     }
 
-    /// `numbers_of(n, key, Some(3))` as a vector, without a list made for each (a scene of
-    /// 100,000 boxes reads 300,000 of them).
-    fn vec3_of(&self, n: &Node, key: &str) -> SceneResult<DVec3> {
+    /// `numbers_of(n, key, Some(3))` as a vector, with the same errors, without a list made
+    /// for each (an inline mesh reads one per vertex; 100,000 moving boxes, a velocity, min and
+    /// max each).
+    pub(crate) fn vec3_of(&self, n: &Node, key: &str) -> SceneResult<DVec3> {
         match &n.val {
             Val::Array(items) if items.len() == 3 => Ok(DVec3::new(
                 self.num(&items[0], key)?,
@@ -491,7 +492,8 @@ mod tests {
     use crate::scene::load_str;
 
     /// Three numbers are read without a list made for them: each element is still checked in
-    /// order, at its own line, and a length other than three is still said as such.
+    /// order and named at its own line, and a length other than three, or a value that is no
+    /// list, is still said as such.
     #[test]
     fn three_numbers_keep_their_errors() {
         let scene = |velocity: &str, color: &str| {
@@ -546,5 +548,14 @@ mod tests {
                 "{velocity} {color}: {e}"
             );
         }
+        // An element's error names its own line (the velocity opens on line 9, "a" is on
+        // 11), and a value that is no list says so.
+        let e = scene("[\n0.1,\n\"a\",\n0]", "[1, 1, 1]").unwrap_err();
+        assert!(e.starts_with("t.toml:11:") && e.contains(v), "{e}");
+        let e = scene("0.1", "[1, 1, 1]").unwrap_err();
+        assert!(
+            e.contains("expected an array of 3 numbers, found a number"),
+            "{e}"
+        );
     }
 }

@@ -178,10 +178,7 @@ fn checker(c: &Table) -> SceneResult<(Arc<Texture>, Arc<Texture>)> {
         None => return Err(c.error("size", "missing: the checker's square size (a number, or [sx, sy, sz] with 0 for no change along an axis)")),
         Some(n) => {
             let s = match n.val {
-                super::doc::Val::Array(_) => {
-                    let v = c.numbers_of(n, "size", Some(3))?;
-                    DVec3::new(v[0], v[1], v[2])
-                }
+                super::doc::Val::Array(_) => c.vec3_of(n, "size")?,
                 _ => DVec3::splat(c.f64_or("size", 1.0)?),
             };
             if s.cmplt(DVec3::ZERO).any() || s == DVec3::ZERO {

@@ -27,8 +27,7 @@ impl Transform {
             None => DVec3::ONE,
             Some(n) => {
                 let s = if let super::doc::Val::Array(_) = n.val {
-                    let v = t.numbers_of(n, "scale", Some(3))?;
-                    DVec3::new(v[0], v[1], v[2])
+                    t.vec3_of(n, "scale")?
                 } else {
                     DVec3::splat(t.f64_or("scale", 1.0)?)
                 };

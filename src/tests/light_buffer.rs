@@ -54,7 +54,8 @@ fn light_buffer_offers_every_box_a_ray_meets_once_nearest_first() {
     let mut r = Rng(77);
     let o = DVec3::new(3.0, -20.0, 7.0);
     let boxes = boxes(&mut r, o);
-    offers_every_met_box(&mut r, o, &boxes, 20_000);
+    let lb = LightBuffer::build(o, &boxes);
+    offers_every_met_box(&mut r, o, &lb, &boxes, 20_000);
 }
 
 /// Where the boxes' shadows lie dozens deep, cells finer than the boxes' rectangles would list
@@ -68,13 +69,12 @@ fn light_buffer_cells_follow_deep_shadows() {
     let lb = LightBuffer::build(o, &boxes);
     let per_box = lb.entries() as f64 / boxes.len() as f64;
     assert!(per_box < 16.0, "each box listed in {per_box} cells");
-    offers_every_met_box(&mut r, o, &boxes, 4000);
+    offers_every_met_box(&mut r, o, &lb, &boxes, 4000);
 }
 
-/// Rays from the light at `o` (and, every tenth, from elsewhere) through `boxes`' buffer: each
-/// box a ray meets in its interval is offered once, nearest first, and no other.
-fn offers_every_met_box(r: &mut Rng, o: DVec3, boxes: &[Aabb], rays: usize) {
-    let lb = LightBuffer::build(o, boxes);
+/// Rays from the light at `o` (and, every tenth, from elsewhere) through `lb`, the buffer of
+/// `boxes`: each box a ray meets in its interval is offered once, nearest first, and no other.
+fn offers_every_met_box(r: &mut Rng, o: DVec3, lb: &LightBuffer, boxes: &[Aabb], rays: usize) {
     assert_eq!(lb.len(), boxes.len());
     let mut met = 0;
     for k in 0..rays {

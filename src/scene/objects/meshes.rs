@@ -239,10 +239,7 @@ impl Adding<'_, '_> {
         let verts = match &vn.val {
             crate::scene::doc::Val::Array(items) => items
                 .iter()
-                .map(|e| {
-                    t.numbers_of(e, "vertices", Some(3))
-                        .map(|v| DVec3::new(v[0], v[1], v[2]))
-                })
+                .map(|e| t.vec3_of(e, "vertices"))
                 .collect::<SceneResult<Vec<_>>>()?,
             _ => return Err(t.error_at(vn, "vertices", "expected an array of [x, y, z]")),
         };
