@@ -189,9 +189,8 @@ impl LightBuffer {
                 }
             }
         }
-        // Each face's span of rectangles, how many it has, and their widths along u and v.
+        // Each face's span of rectangles and their widths along u and v (as many as it has).
         let mut spans = [[f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY]; 6];
-        let mut counts = [0usize; 6];
         let mut widths: [(Vec<f64>, Vec<f64>); 6] = Default::default();
         for &(_, f, r) in &rects {
             let span = &mut spans[f as usize];
@@ -201,15 +200,13 @@ impl LightBuffer {
                 span[2].max(r[2]),
                 span[3].max(r[3]),
             ];
-            counts[f as usize] += 1;
             widths[f as usize].0.push(r[2] - r[0]);
             widths[f as usize].1.push(r[3] - r[1]);
         }
         // Each face's grid over the rectangles on it.
         let mut first = 0;
-        for (((face, span), count), (wu, wv)) in
-            lb.faces.iter_mut().zip(spans).zip(counts).zip(&mut widths)
-        {
+        for ((face, span), (wu, wv)) in lb.faces.iter_mut().zip(spans).zip(&mut widths) {
+            let count = wu.len();
             if count == 0 {
                 *face = Face {
                     lo: [0.0; 2],

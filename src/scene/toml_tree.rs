@@ -633,10 +633,10 @@ impl EventReceiver for Builder<'_, '_> {
     fn scalar(&mut self, span: Span, kind: Option<Encoding>, error: &mut dyn ErrorSink) {
         let text = &self.source.input()[span.start()..span.end()];
         let raw = toml_parser::Raw::new_unchecked(text, kind, span);
-        let mut decoded = std::mem::take(&mut self.decoded);
+        let decoded = &mut self.decoded;
         decoded.clear();
-        let val = match raw.decode_scalar(&mut decoded, error) {
-            ScalarKind::String => Val::Str(std::mem::take(&mut decoded)),
+        let val = match raw.decode_scalar(decoded, error) {
+            ScalarKind::String => Val::Str(std::mem::take(decoded)),
             ScalarKind::Boolean(b) => Val::Bool(b),
             ScalarKind::DateTime => {
                 if decoded.parse::<toml_datetime::Datetime>().is_err() {
@@ -653,7 +653,7 @@ impl EventReceiver for Builder<'_, '_> {
                     Val::Float(0.0)
                 }
             },
-            ScalarKind::Integer(radix) => match i64::from_str_radix(&decoded, radix.value()) {
+            ScalarKind::Integer(radix) => match i64::from_str_radix(decoded, radix.value()) {
                 Ok(i) => Val::Int(i),
                 Err(_) => {
                     error.report_error(err(
@@ -664,7 +664,6 @@ impl EventReceiver for Builder<'_, '_> {
                 }
             },
         };
-        self.decoded = decoded;
         let node = Node {
             val,
             origin: self.place.at(span.start()),
