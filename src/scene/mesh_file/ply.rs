@@ -113,23 +113,32 @@ impl ply_rs_bw::ply::PropertyAccess for PlySkip {
     }
 }
 
-/// A PLY file's vertices: positions, and normals and texture coordinates where every vertex
-/// has them.
-type VertexData = (Vec<DVec3>, Option<Vec<DVec3>>, Option<Vec<[f64; 2]>>);
+/// A PLY file's vertices as they are read: positions, and normals and texture coordinates
+/// for as long as every vertex has them.
+#[derive(Default)]
+struct Vertices {
+    positions: Vec<DVec3>,
+    normals: Option<Vec<DVec3>>,
+    uvs: Option<Vec<[f64; 2]>>,
+}
 
-fn vertex_data(vertices: Vec<PlyVertex>) -> Result<VertexData, MeshError> {
-    let mut positions = Vec::with_capacity(vertices.len());
-    for (i, v) in vertices.iter().enumerate() {
+impl Vertices {
+    fn with_capacity(n: usize) -> Vertices {
+        Vertices {
+            positions: Vec::with_capacity(n),
+            normals: Some(Vec::new()),
+            uvs: Some(Vec::new()),
+        }
+    }
+
+    /// Keep vertex `i`, or say what is wrong with it.
+    fn push(&mut self, i: usize, v: PlyVertex) -> Result<(), MeshError> {
         if let Some(k) = (0..3).find(|&k| !v.has(1 << k)) {
             return Err(MeshError::new(format!(
                 "vertex {i} has no number `{}`",
                 ["x", "y", "z"][k]
             )));
         }
-        positions.push(DVec3::new(v.values[0], v.values[1], v.values[2]));
-    }
-    let any = !vertices.is_empty();
-    for (i, v) in vertices.iter().enumerate() {
         for (k, name) in ["x", "y", "z", "nx", "ny", "nz", "u", "v"]
             .iter()
             .enumerate()
@@ -141,18 +150,144 @@ fn vertex_data(vertices: Vec<PlyVertex>) -> Result<VertexData, MeshError> {
                 )));
             }
         }
+        self.positions
+            .push(DVec3::new(v.values[0], v.values[1], v.values[2]));
+        // Normals and texture coordinates are kept only where every vertex has them.
+        if v.has(0b111_000) {
+            let n = DVec3::new(v.values[3], v.values[4], v.values[5]);
+            if let Some(list) = &mut self.normals {
+                list.push(n.normalize_or_zero());
+            }
+        } else {
+            self.normals = None;
+        }
+        if v.has(0b1100_0000) {
+            if let Some(list) = &mut self.uvs {
+                list.push([v.values[6], v.values[7]]);
+            }
+        } else {
+            self.uvs = None;
+        }
+        Ok(())
     }
-    let normals = (any && vertices.iter().all(|v| v.has(0b111_000))).then(|| {
-        let n = |v: &PlyVertex| DVec3::new(v.values[3], v.values[4], v.values[5]);
-        vertices.iter().map(|v| n(v).normalize_or_zero()).collect()
-    });
-    let uvs = (any && vertices.iter().all(|v| v.has(0b1100_0000))).then(|| {
-        vertices
-            .iter()
-            .map(|v| [v.values[6], v.values[7]])
-            .collect()
-    });
-    Ok((positions, normals, uvs))
+}
+
+/// A PLY file's faces as they are read, each polygon split into a fan of triangles.
+#[derive(Default)]
+struct Faces {
+    triangles: Vec<[u32; 3]>,
+    /// The faces whose largest index is larger than every earlier face's (with it): where the
+    /// faces come before the vertices, the first face naming a vertex the file does not have
+    /// is found among them once the vertices are counted.
+    records: Vec<(usize, u32)>,
+}
+
+impl Faces {
+    /// Keep face `f`, or say what is wrong with it; `vertices`, how many the file has, where
+    /// they were read before the faces.
+    fn push(&mut self, f: usize, face: PlyFace, vertices: Option<usize>) -> Result<(), MeshError> {
+        if !face.given {
+            return Err(MeshError::new(format!(
+                "face {f} has no integer list `vertex_indices` (or `vertex_index`)"
+            )));
+        }
+        let list = &face.indices;
+        let largest = list.iter().copied().max().unwrap_or(0);
+        if let Some(bad) = face.out_of_range.or_else(|| {
+            let n = vertices?;
+            list.iter()
+                .find(|&&i| i as usize >= n)
+                .map(|&i| i64::from(i))
+        }) {
+            return Err(out_of_range(f, bad, vertices));
+        }
+        if list.len() < 3 {
+            return Err(MeshError::new(format!(
+                "face {f} has {} corners; a face needs 3 or more",
+                list.len()
+            )));
+        }
+        if self.records.last().is_none_or(|&(_, r)| largest > r) {
+            self.records.push((f, largest));
+        }
+        for k in 1..list.len() - 1 {
+            self.triangles.push([list[0], list[k], list[k + 1]]);
+        }
+        Ok(())
+    }
+
+    /// Check, once the vertices are counted, that no face names one the file does not have.
+    fn check(&self, vertices: usize) -> Result<(), MeshError> {
+        match self.records.iter().find(|&&(_, i)| i as usize >= vertices) {
+            Some(&(f, i)) => Err(out_of_range(f, i64::from(i), Some(vertices))),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Face `f` names vertex `bad`, which the file does not have.
+fn out_of_range(f: usize, bad: i64, vertices: Option<usize>) -> MeshError {
+    let n = vertices.map_or(String::from("fewer"), |n| n.to_string());
+    MeshError::new(format!(
+        "face {f} names vertex {bad}; the file has {n} (counted from 0)"
+    ))
+}
+
+/// Read element `def`'s entries one by one, handing each to `each` with its number: nothing
+/// of the element is held but what `each` keeps (a scanned mesh has millions of entries).
+/// `line` is the line the next entry starts on (each entry counts as a line, as the parser
+/// counts them in a binary file too).
+fn each_entry<E: ply_rs_bw::ply::PropertyAccess, R: std::io::BufRead>(
+    reader: &mut R,
+    header: &ply_rs_bw::ply::Header,
+    def: &ply_rs_bw::ply::ElementDef,
+    line: &mut usize,
+    mut each: impl FnMut(usize, E) -> Result<(), MeshError>,
+) -> Result<(), MeshError> {
+    use ply_rs_bw::ply::Encoding;
+    let parser = ply_rs_bw::parser::Parser::<E>::new();
+    let ended = |i: usize, line: usize| MeshError {
+        line: Some(line),
+        message: format!(
+            "not a readable PLY file: it ends in element `{}` after {i} of its {} entries",
+            crate::text::shown(&def.name),
+            def.count
+        ),
+    };
+    let mut text = String::new();
+    for i in 0..def.count {
+        let entry = match header.encoding {
+            Encoding::Ascii => {
+                text.clear();
+                let read = reader.read_line(&mut text).map_err(|e| MeshError {
+                    line: Some(*line),
+                    message: format!("cannot read it: {e}"),
+                })?;
+                if read == 0 {
+                    return Err(ended(i, *line));
+                }
+                parser.read_ascii_element(&text, def)
+            }
+            Encoding::BinaryLittleEndian => parser.read_little_endian_element(reader, def),
+            Encoding::BinaryBigEndian => parser.read_big_endian_element(reader, def),
+        };
+        let entry = match entry {
+            Ok(entry) => entry,
+            Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => return Err(ended(i, *line)),
+            Err(e) => {
+                return Err(MeshError {
+                    line: Some(*line),
+                    message: ply_message(&e),
+                })
+            }
+        };
+        each(i, entry).map_err(|e| MeshError {
+            line: e.line.or(Some(*line)),
+            ..e
+        })?;
+        *line += 1;
+    }
+    Ok(())
 }
 
 /// A PLY parser's error in this project's words: its message's first line, and the line of
@@ -234,74 +369,43 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
         .read_header(&mut reader)
         .map_err(unreadable)?;
     check_counts(&header, size)?;
-    let (mut vertices, mut faces) = (None, None);
-    // Elements are read in the header's order, each by the type that keeps what it needs.
+    // The line of the first entry (the parser counts the one after the header.s last).
+    let mut line = reader.line();
+    let mut reader = reader.into_inner();
+    let (mut vertices, mut faces) = (None::<Vertices>, None::<Faces>);
+    // Elements are read in the header's order, each entry straight into the buffers it ends
+    // in: the entries as read are never held.
     for (name, def) in &header.elements {
         match name.as_str() {
-            // Made into positions (and normals, texture coordinates) at once, so that the
-            // elements as read are freed before the faces are read.
             "vertex" => {
-                vertices = Some(vertex_data(
-                    Parser::<PlyVertex>::new()
-                        .read_payload_for_element(&mut reader, def, &header)
-                        .map_err(unreadable)?,
-                )?)
+                let mut v = Vertices::with_capacity(def.count);
+                each_entry(&mut reader, &header, def, &mut line, |i, e| v.push(i, e))?;
+                vertices = Some(v);
             }
             "face" => {
-                faces = Some(
-                    Parser::<PlyFace>::new()
-                        .read_payload_for_element(&mut reader, def, &header)
-                        .map_err(unreadable)?,
-                )
+                let mut f = Faces::default();
+                f.triangles.reserve(def.count);
+                let n = vertices.as_ref().map(|v| v.positions.len());
+                each_entry(&mut reader, &header, def, &mut line, |i, e| f.push(i, e, n))?;
+                faces = Some(f);
             }
-            _ => {
-                Parser::<PlySkip>::new()
-                    .read_payload_for_element(&mut reader, def, &header)
-                    .map_err(unreadable)?;
-            }
+            _ => each_entry(&mut reader, &header, def, &mut line, |_, PlySkip| Ok(()))?,
         }
     }
-    let (positions, vertex_normals, vertex_uvs) =
-        vertices.ok_or_else(|| MeshError::new("it has no `vertex` element"))?;
+    let vertices = vertices.ok_or_else(|| MeshError::new("it has no `vertex` element"))?;
+    let faces = faces.ok_or_else(|| MeshError::new("it has no `face` element"))?;
+    faces.check(vertices.positions.len())?;
     let mut mesh = MeshData {
-        positions,
+        positions: vertices.positions,
+        triangles: faces.triangles,
         ..Default::default()
     };
-    let faces = faces.ok_or_else(|| MeshError::new("it has no `face` element"))?;
-    let n = mesh.positions.len() as i64;
-    mesh.triangles.reserve(faces.len());
-    for (f, face) in faces.iter().enumerate() {
-        if !face.given {
-            return Err(MeshError::new(format!(
-                "face {f} has no integer list `vertex_indices` (or `vertex_index`)"
-            )));
-        }
-        let list = &face.indices;
-        if let Some(bad) = face.out_of_range.or_else(|| {
-            list.iter()
-                .find(|&&i| i64::from(i) >= n)
-                .map(|&i| i64::from(i))
-        }) {
-            return Err(MeshError::new(format!(
-                "face {f} names vertex {bad}; the file has {n} (counted from 0)"
-            )));
-        }
-        if list.len() < 3 {
-            return Err(MeshError::new(format!(
-                "face {f} has {} corners; a face needs 3 or more",
-                list.len()
-            )));
-        }
-        for k in 1..list.len() - 1 {
-            mesh.triangles.push([list[0], list[k], list[k + 1]]);
-        }
-    }
-    drop(faces);
-    if let Some(n) = vertex_normals {
+    let any = !mesh.positions.is_empty();
+    if let Some(n) = vertices.normals.filter(|_| any) {
         let at = |t: &[u32; 3]| t.map(|i| n[i as usize]);
         mesh.normals = Some(mesh.triangles.iter().map(at).collect());
     }
-    if let Some(uv) = vertex_uvs {
+    if let Some(uv) = vertices.uvs.filter(|_| any) {
         let at = |t: &[u32; 3]| t.map(|i| uv[i as usize]);
         mesh.uvs = Some(mesh.triangles.iter().map(at).collect());
     }
