@@ -148,9 +148,8 @@ impl MeshInstance {
     #[inline]
     pub fn triangle(&self, id: u64) -> Primitive {
         let t = self.mesh.triangles()[id as usize];
-        let p = self.mesh.positions();
         Primitive::Triangle {
-            v: t.map(|i| self.place.point(p[i as usize])),
+            v: t.map(|i| self.place.point(self.mesh.position(i))),
         }
     }
 
@@ -167,11 +166,7 @@ impl MeshInstance {
     /// The mesh copied to this placement: what the instance stands for.
     pub fn copied(&self) -> IndexedMesh {
         IndexedMesh::new(
-            self.mesh
-                .positions()
-                .iter()
-                .map(|&p| self.place.point(p))
-                .collect(),
+            self.mesh.positions().map(|p| self.place.point(p)).collect(),
             self.mesh.triangles().to_vec(),
         )
     }

@@ -377,7 +377,7 @@ fn mesh_geometry(
     let mut g = Geometry::new(device, RTC_GEOMETRY_TYPE_TRIANGLE)?;
     let p = mesh.positions();
     let verts = g.new_buffer::<[f32; 3]>(RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, p.len())?;
-    for (slot, &x) in verts.iter_mut().zip(p) {
+    for (slot, x) in verts.iter_mut().zip(p) {
         *slot = f3(x - center);
     }
     // The index buffer is the mesh's own, not a copy (12 bytes a triangle saved).
