@@ -8,6 +8,7 @@ mod common;
 mod allocations;
 mod at_rest;
 mod backend_names;
+mod compact_scenes;
 mod every_isa;
 // It counts the bench's primary hits (src/bench/primary.rs).
 #[cfg(feature = "cli")]

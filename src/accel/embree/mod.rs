@@ -48,10 +48,18 @@ pub struct EmbreeBackend {
     /// The Embree scenes of meshes several objects place, made on this backend's device and
     /// shared by every group's scene that instances them.
     mesh_scenes: Arc<scene::MeshScenes>,
+    /// From how many triangles a group's scene (or a shared mesh's) is built compact.
+    compact_from: u64,
     /// A test hook: a user-geometry callback panics (`REST_EMBREE_FAULT=callback`), to prove
     /// that the panic is caught at the FFI boundary and the render fails with an error.
     inject_fault: Option<Option<Callback>>,
 }
+
+/// From how many triangles a scene is built compact (`SceneBuilder::compact`): about 34 bytes
+/// a triangle for Embree's structure instead of about 61, for a slightly slower traversal.
+/// From a million triangles on, the structure is most of the process's memory (a 10M-triangle
+/// mesh fits in 64 bytes a triangle at the process's peak only so); below, speed matters more.
+pub const COMPACT_FROM_TRIANGLES: u64 = 1 << 20;
 
 /// The environment variable of the fault-injection test hook (`EmbreeBackend::configured_by_env`).
 pub(crate) const FAULT_ENV: &str = "REST_EMBREE_FAULT";
@@ -65,6 +73,7 @@ impl EmbreeBackend {
             faults: Arc::default(),
             inject_fault: None,
             mesh_scenes: Arc::default(),
+            compact_from: COMPACT_FROM_TRIANGLES,
         }
     }
 
@@ -90,6 +99,18 @@ impl EmbreeBackend {
             mesh_scenes: Arc::default(),
             ..self
         })
+    }
+
+    /// The same backend building compact every scene of `triangles` or more (a test of the
+    /// compact scenes on small meshes; the default is [`COMPACT_FROM_TRIANGLES`]).
+    #[cfg(test)]
+    pub fn compact_from(self, triangles: u64) -> Self {
+        Self {
+            compact_from: triangles,
+            // Shared meshes' scenes are kept as built.
+            mesh_scenes: Arc::default(),
+            ..self
+        }
     }
 
     /// The same backend with a panic in the first user-geometry callback that runs (a test of
@@ -130,7 +151,12 @@ impl EmbreeBackend {
     pub fn accelerator(&self, geometry: Arc<Geometry>) -> crate::Result<EmbreeAccel> {
         let device = self.device()?;
         let width = self.packet_width.unwrap_or(device.native_width());
-        let scene = scene::EmbreeScene::build(device.clone(), &geometry, &self.mesh_scenes)?;
+        let scene = scene::EmbreeScene::build(
+            device.clone(),
+            &geometry,
+            &self.mesh_scenes,
+            self.compact_from,
+        )?;
         let bounds = geometry.bounds();
         let diag = bounds.diagonal();
         Ok(EmbreeAccel {
@@ -300,6 +326,12 @@ fn lane_geometry<R: Real>(
 }
 
 impl EmbreeAccel {
+    /// Whether its scene was built compact (`EmbreeBackend::compact_from`).
+    #[cfg(test)]
+    pub fn is_compact(&self) -> bool {
+        self.scene.rtc.is_compact()
+    }
+
     #[inline(always)]
     fn embree_ray(&self, r: &Ray) -> EmbreeRay {
         if !r.is_active() {

@@ -128,10 +128,13 @@ pub struct EmbreeScene {
 }
 
 impl EmbreeScene {
+    /// The scene of `geo`, compact (`SceneBuilder::compact`) where it holds `compact_from`
+    /// triangles or more, and the scene of each shared mesh it places likewise.
     pub fn build(
         device: Arc<Device>,
         geo: &SceneGeometry,
         scenes: &MeshScenes,
+        compact_from: u64,
     ) -> crate::Result<EmbreeScene> {
         let center = geo.bounds().centroid();
         let center = if center.is_finite() {
@@ -176,6 +179,18 @@ impl EmbreeScene {
         let rounds = (!rounds.is_empty()).then(|| Box::new(Shapes(rounds)));
         let cuboids = (!cuboids.is_empty()).then(|| Box::new(Shapes(cuboids)));
         let mut builder = SceneBuilder::new(&device)?;
+        let triangles = tris.len() as u64
+            + geo
+                .implicit
+                .iter()
+                .map(|r| match &r.shape {
+                    Implicit::Mesh(mesh) => mesh.len(),
+                    _ => 0,
+                })
+                .sum::<u64>();
+        if triangles >= compact_from {
+            builder.compact();
+        }
         let mut maps = Vec::new();
         if !tris.is_empty() {
             let mut g = Geometry::new(&device, RTC_GEOMETRY_TYPE_TRIANGLE)?;
@@ -237,8 +252,15 @@ impl EmbreeScene {
         }
         // Placements of shared meshes: one Embree scene per mesh, an instance per placement,
         // after every other geometry.
-        let mesh_instances =
-            attach_mesh_instances(&device, &mut builder, geo, center, first_instance, scenes)?;
+        let mesh_instances = attach_mesh_instances(
+            &device,
+            &mut builder,
+            geo,
+            center,
+            first_instance,
+            scenes,
+            compact_from,
+        )?;
         let exact_runs = ExactRuns::of(&maps).filter(|_| mesh_instances.is_empty());
         Ok(EmbreeScene {
             rtc: builder.commit()?,
@@ -302,10 +324,13 @@ type MeshScene = (std::sync::Weak<IndexedMesh>, Arc<CommittedScene>, DVec3);
 
 impl MeshScenes {
     /// `mesh`'s scene and the centre its coordinates are taken about, built on first use.
+    /// (Compact where the mesh has `compact_from` triangles or more: the backend asks the same
+    /// of every scene, so a scene found here was built as asked.)
     fn of(
         &self,
         device: &Arc<Device>,
         mesh: &Arc<IndexedMesh>,
+        compact_from: u64,
     ) -> crate::Result<(Arc<CommittedScene>, DVec3)> {
         let mut scenes = self.0.lock().unwrap_or_else(|e| e.into_inner());
         // Meshes no longer held anywhere (a scene the viewer read again, say) leave with their
@@ -321,6 +346,9 @@ impl MeshScenes {
         let own = mesh.bounds().centroid();
         let own = if own.is_finite() { own } else { DVec3::ZERO };
         let mut child = SceneBuilder::new(device)?;
+        if mesh.len() >= compact_from {
+            child.compact();
+        }
         child.attach(mesh_geometry(device, mesh, own)?)?;
         let scene = Arc::new(child.commit()?);
         scenes.insert(key, (Arc::downgrade(mesh), scene.clone(), own));
@@ -338,6 +366,7 @@ fn attach_mesh_instances(
     center: DVec3,
     first_id: u32,
     scenes: &MeshScenes,
+    compact_from: u64,
 ) -> crate::Result<MeshInstances> {
     let mut out = MeshInstances {
         first_id,
@@ -347,7 +376,7 @@ fn attach_mesh_instances(
         let Implicit::Instance(inst) = &run.shape else {
             continue;
         };
-        let (scene, own) = scenes.of(device, &inst.mesh)?;
+        let (scene, own) = scenes.of(device, &inst.mesh, compact_from)?;
         let own = &own;
         // x in the mesh's scene is the mesh's point x + own; placed, less `center`:
         // A (x + own) + translate - center, with A the linear map times the scale.
