@@ -177,7 +177,7 @@ def main():
         f"- whole command against Mitsuba llvm_ad_rgb's load and render: {r['whole']:.2f} s against "
         f"{l['import'] + l['load'] + l['render']:.2f} s ({r['whole'] / (l['import'] + l['load'] + l['render']):.2f}x): "
         f"{met(r['whole'] <= l['import'] + l['load'] + l['render'])} (target: at most 1x);",
-        f"- peak memory: {r['peak'] * 1048576 / faces:.0f} bytes a triangle (the whole process; target 64).",
+        f"- peak memory: {r['peak'] * 1048576 / faces:.0f} bytes a triangle with every pass, {c['peak'] * 1048576 / faces:.0f} with colour and alpha alone (the whole process; target 64).",
     ]
     text = "\n".join(lines) + "\n"
     os.makedirs(os.path.dirname(OUT), exist_ok=True)
