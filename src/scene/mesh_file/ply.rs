@@ -156,6 +156,9 @@ impl Vertices {
         if v.has(0b111_000) {
             let n = DVec3::new(v.values[3], v.values[4], v.values[5]);
             if let Some(list) = &mut self.normals {
+                if list.is_empty() {
+                    list.reserve_exact(self.positions.capacity());
+                }
                 list.push(n.normalize_or_zero());
             }
         } else {
@@ -163,6 +166,9 @@ impl Vertices {
         }
         if v.has(0b1100_0000) {
             if let Some(list) = &mut self.uvs {
+                if list.is_empty() {
+                    list.reserve_exact(self.positions.capacity());
+                }
                 list.push([v.values[6], v.values[7]]);
             }
         } else {
@@ -227,10 +233,11 @@ impl Faces {
 
 /// Face `f` names vertex `bad`, which the file does not have.
 fn out_of_range(f: usize, bad: i64, vertices: Option<usize>) -> MeshError {
-    let n = vertices.map_or(String::from("fewer"), |n| n.to_string());
-    MeshError::new(format!(
-        "face {f} names vertex {bad}; the file has {n} (counted from 0)"
-    ))
+    MeshError::new(match vertices {
+        Some(n) => format!("face {f} names vertex {bad}; the file has {n} (counted from 0)"),
+        // The faces come first, and the index is no vertex's in any file (negative, say).
+        None => format!("face {f} names vertex {bad}, not a vertex's number (counted from 0)"),
+    })
 }
 
 /// Read element `def`'s entries one by one, handing each to `each` with its number: nothing
@@ -410,4 +417,127 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
         mesh.uvs = Some(mesh.triangles.iter().map(at).collect());
     }
     Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{read, MeshData, MeshError};
+    use glam::DVec3;
+
+    /// `bytes` written as a PLY file and read.
+    fn read_bytes(name: &str, bytes: &[u8]) -> Result<MeshData, MeshError> {
+        let dir =
+            std::env::temp_dir().join(format!("rest-embree-ply-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("t.ply");
+        std::fs::write(&p, bytes).unwrap();
+        let m = read(&p);
+        std::fs::remove_dir_all(&dir).unwrap();
+        m
+    }
+
+    /// Nine lines: the first vertex is line 10, the first face line 14.
+    const HEADER: &str = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n";
+    const VERTICES: &str = "0 0 0\n1 0 0\n0 1 0\n1 1 0\n";
+
+    /// Each entry is read into the mesh as it comes: polygons split into fans, normals kept
+    /// where every vertex has them, and what is wrong named with its entry's line.
+    #[test]
+    fn ply_entries_are_read_one_by_one() {
+        let m = read_bytes(
+            "fan",
+            format!("{HEADER}{VERTICES}4 0 1 3 2\n3 1 3 2\n").as_bytes(),
+        )
+        .unwrap();
+        assert_eq!(m.triangles, [[0, 1, 3], [0, 3, 2], [1, 3, 2]]);
+        assert_eq!(m.positions[3], DVec3::new(1.0, 1.0, 0.0));
+        assert_eq!((m.normals, m.uvs), (None, None));
+
+        let bad = format!("{HEADER}0 0 0\n1 x 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n");
+        let e = read_bytes("number", bad.as_bytes()).unwrap_err();
+        assert_eq!(e.line, Some(11), "{}", e.message);
+        assert!(e.message.contains("`1 x 0`"), "{}", e.message);
+        let e = read_bytes(
+            "range",
+            format!("{HEADER}{VERTICES}3 0 1 2\n3 1 7 2\n").as_bytes(),
+        )
+        .unwrap_err();
+        assert_eq!(e.line, Some(15));
+        assert_eq!(
+            e.message,
+            "face 1 names vertex 7; the file has 4 (counted from 0)"
+        );
+        let e = read_bytes(
+            "negative",
+            format!("{HEADER}{VERTICES}3 0 1 2\n3 1 -3 2\n").as_bytes(),
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.message,
+            "face 1 names vertex -3; the file has 4 (counted from 0)"
+        );
+        let e = read_bytes("short", format!("{HEADER}0 0 0\n1 0 0\n").as_bytes()).unwrap_err();
+        assert_eq!(e.line, Some(12));
+        assert!(
+            e.message
+                .contains("ends in element `vertex` after 2 of its 4 entries"),
+            "{}",
+            e.message
+        );
+
+        // Faces before the vertices: checked once the vertices are counted, naming the first
+        // face that names a vertex the file does not have.
+        let faces_first = "ply\nformat ascii 1.0\nelement face 3\nproperty list uchar int vertex_indices\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+        let e = read_bytes(
+            "first",
+            format!("{faces_first}3 0 1 3\n3 1 5 2\n3 0 9 2\n{VERTICES}").as_bytes(),
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.message,
+            "face 1 names vertex 5; the file has 4 (counted from 0)"
+        );
+        let m = read_bytes(
+            "first-ok",
+            format!("{faces_first}3 0 1 3\n3 1 3 2\n4 0 1 3 2\n{VERTICES}").as_bytes(),
+        )
+        .unwrap();
+        assert_eq!(m.triangles.len(), 4);
+        let e = read_bytes(
+            "first-negative",
+            format!("{faces_first}3 0 1 3\n3 1 -1 2\n3 0 1 2\n{VERTICES}").as_bytes(),
+        )
+        .unwrap_err();
+        assert_eq!(
+            (e.line, e.message.as_str()),
+            (
+                Some(11),
+                "face 1 names vertex -1, not a vertex's number (counted from 0)"
+            )
+        );
+
+        let normals = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0 0 2\n1 0 0 0 0 1\n0 1 0 1 0 0\n3 0 1 2\n";
+        let m = read_bytes("normals", normals.as_bytes()).unwrap();
+        assert_eq!(m.normals, Some(vec![[DVec3::Z, DVec3::Z, DVec3::X]]));
+
+        // Binary, whole and cut short.
+        let mut bin = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n".to_vec();
+        for x in [0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.5] {
+            bin.extend_from_slice(&x.to_le_bytes());
+        }
+        bin.push(3);
+        for i in [0i32, 1, 2] {
+            bin.extend_from_slice(&i.to_le_bytes());
+        }
+        let m = read_bytes("binary", &bin).unwrap();
+        assert_eq!(m.triangles, [[0, 1, 2]]);
+        assert_eq!(m.positions[2], DVec3::new(0.0, 1.0, 0.5));
+        let e = read_bytes("cut", &bin[..bin.len() - 5]).unwrap_err();
+        assert!(
+            e.message
+                .contains("ends in element `face` after 0 of its 1 entries"),
+            "{}",
+            e.message
+        );
+    }
 }
