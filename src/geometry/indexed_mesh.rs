@@ -53,11 +53,11 @@ impl Vertices {
     }
 
     #[inline(always)]
-    fn at(&self, i: u32) -> DVec3 {
+    fn at(&self, i: usize) -> DVec3 {
         match self {
-            Vertices::Wide(v) => v[i as usize],
+            Vertices::Wide(v) => v[i],
             Vertices::Narrow(v) => {
-                let [x, y, z] = v[i as usize];
+                let [x, y, z] = v[i];
                 DVec3::new(x.into(), y.into(), z.into())
             }
         }
@@ -127,14 +127,14 @@ impl IndexedMesh {
     pub fn triangle(&self, id: u64) -> Primitive {
         let t = self.triangles[id as usize];
         Primitive::Triangle {
-            v: t.map(|i| self.positions.at(i)),
+            v: t.map(|i| self.positions.at(i as usize)),
         }
     }
 
     /// Vertex number `i` (below [`vertex_count`](Self::vertex_count)).
     #[inline]
     pub fn position(&self, i: u32) -> DVec3 {
-        self.positions.at(i)
+        self.positions.at(i as usize)
     }
 
     /// How many vertices.
@@ -144,7 +144,7 @@ impl IndexedMesh {
 
     /// The vertices, in order.
     pub fn positions(&self) -> impl ExactSizeIterator<Item = DVec3> + '_ {
-        (0..self.vertex_count() as u32).map(|i| self.positions.at(i))
+        (0..self.vertex_count()).map(|i| self.positions.at(i))
     }
 
     /// The triangles, as indices into the vertices.

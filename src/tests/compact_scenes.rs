@@ -1,8 +1,9 @@
 //! Scenes of many triangles are built compact (`EmbreeBackend::compact_from`,
 //! `COMPACT_FROM_TRIANGLES`): Embree's leaves name their triangles' vertices by index instead
 //! of holding copies, about half the memory. Both run Embree's robust test on the same f32
-//! vertices, so every hit is the same hit: a mesh held as itself, listed triangles and a shared
-//! mesh's placements, traced one ray at a time and in packets, under every instruction set the
+//! vertices, so rays at random find the same hits, and rays at shared edges the same points.
+//! Traced: a mesh held as itself, listed triangles and a shared mesh's placements (its own
+//! scene compact or not), one ray at a time and in packets, under every instruction set the
 //! CPU has.
 
 #![cfg(feature = "embree")]
@@ -87,6 +88,7 @@ fn compact_scenes_hit_as_the_others_do() {
     );
     // And rays at points of the big terrain's shared edges, where which of two triangles is
     // met is decided by f32 rounding: the same decision in both kinds of scene.
+    let random = rays.len();
     let big = terrain(90);
     let mut rng = Rng(0xc0c0_a5e5_0000_0054);
     for _ in 0..6000 {
@@ -113,8 +115,10 @@ fn compact_scenes_hit_as_the_others_do() {
     let triangles = 2 * 90 * 90 + 6;
     let on = |isa: Isa| EmbreeBackend::new().on_isa(isa).unwrap();
     for isa in Isa::on_cpu() {
-        let usual = on(isa).accelerator(geometry.clone()).unwrap();
+        let usual_backend = on(isa);
+        let usual = usual_backend.accelerator(geometry.clone()).unwrap();
         assert!(!usual.is_compact(), "{isa:?}: a small scene is not compact");
+        assert_eq!(usual_backend.shared_scenes_compact(), [false], "{isa:?}");
         // Compact from as many triangles as the group has, and not from one more.
         let compact = on(isa)
             .compact_from(triangles)
@@ -126,10 +130,17 @@ fn compact_scenes_hit_as_the_others_do() {
             .accelerator(geometry.clone())
             .unwrap()
             .is_compact());
-        for width in [1, 4, 16] {
+        // And compact from the placed terrain's size: its own scene too.
+        let everything = on(isa).compact_from(2 * 12 * 12);
+        let all = everything.accelerator(geometry.clone()).unwrap();
+        assert_eq!(everything.shared_scenes_compact(), [true], "{isa:?}");
+        for (compact, width) in [&compact, &all]
+            .into_iter()
+            .flat_map(|c| [1, 4, 16].map(|w| (c, w)))
+        {
             let (a, b) = (
                 super::hits(&usual, &rays, width),
-                super::hits(&compact, &rays, width),
+                super::hits(compact, &rays, width),
             );
             let met = a.iter().filter(|h| h.is_some()).count();
             assert!(met > rays.len() / 3, "{isa:?}: {met} hits");
@@ -144,7 +155,6 @@ fn compact_scenes_hit_as_the_others_do() {
                 "{isa:?}: the hits meet every object: {kinds:?}"
             );
             // Rays at random: the same hits, to the bit, and the same occlusions.
-            let random = rays.len() / 2;
             for (i, (x, y)) in a.iter().zip(&b).enumerate().take(random) {
                 let same = match (x, y) {
                     (Some(x), Some(y)) => x.prim == y.prim && x.t.to_bits() == y.t.to_bits(),
@@ -155,7 +165,7 @@ fn compact_scenes_hit_as_the_others_do() {
             }
             let (oa, ob) = (
                 super::occluded(&usual, &rays[..random], width),
-                super::occluded(&compact, &rays[..random], width),
+                super::occluded(compact, &rays[..random], width),
             );
             assert_eq!(oa, ob, "{isa:?}, {width} wide");
             // Rays at shared edges: Embree runs each kind's test as compiled for its own

@@ -55,10 +55,10 @@ pub struct EmbreeBackend {
     inject_fault: Option<Option<Callback>>,
 }
 
-/// From how many triangles a scene is built compact (`SceneBuilder::compact`): about 34 bytes
-/// a triangle for Embree's structure instead of about 61, for a slightly slower traversal.
-/// From a million triangles on, the structure is most of the process's memory (a 10M-triangle
-/// mesh fits in 64 bytes a triangle at the process's peak only so); below, speed matters more.
+/// From how many triangles a scene is built compact (`SceneBuilder::compact`): Embree's
+/// structure in about half the memory, for a slower traversal. From a million triangles on,
+/// the structure is most of the process's memory (docs/bench/terrain.md has the peak of a
+/// 10M-triangle mesh); below, speed matters more.
 pub const COMPACT_FROM_TRIANGLES: u64 = 1 << 20;
 
 /// The environment variable of the fault-injection test hook (`EmbreeBackend::configured_by_env`).
@@ -111,6 +111,12 @@ impl EmbreeBackend {
             mesh_scenes: Arc::default(),
             ..self
         }
+    }
+
+    /// Whether each shared mesh's scene this backend holds was built compact.
+    #[cfg(test)]
+    pub fn shared_scenes_compact(&self) -> Vec<bool> {
+        self.mesh_scenes.compact()
     }
 
     /// The same backend with a panic in the first user-geometry callback that runs (a test of

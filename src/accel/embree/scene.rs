@@ -323,6 +323,13 @@ pub struct MeshScenes(std::sync::Mutex<std::collections::HashMap<usize, MeshScen
 type MeshScene = (std::sync::Weak<IndexedMesh>, Arc<CommittedScene>, DVec3);
 
 impl MeshScenes {
+    /// Whether each scene held was built compact.
+    #[cfg(test)]
+    pub fn compact(&self) -> Vec<bool> {
+        let scenes = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        scenes.values().map(|(_, s, _)| s.is_compact()).collect()
+    }
+
     /// `mesh`'s scene and the centre its coordinates are taken about, built on first use.
     /// (Compact where the mesh has `compact_from` triangles or more: the backend asks the same
     /// of every scene, so a scene found here was built as asked.)

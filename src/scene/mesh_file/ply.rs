@@ -182,39 +182,60 @@ impl Vertices {
 #[derive(Default)]
 struct Faces {
     triangles: Vec<[u32; 3]>,
-    /// The faces whose largest index is larger than every earlier face's (with it): where the
-    /// faces come before the vertices, the first face naming a vertex the file does not have
-    /// is found among them once the vertices are counted.
-    records: Vec<(usize, u32)>,
+    /// Where the faces come before the vertices, what is checked once the vertices are
+    /// counted: the faces whose largest index is larger than every earlier face's (number,
+    /// that index, line), among which is the first face naming a vertex the file does not
+    /// have; and the first face that is wrong otherwise, from which on nothing is kept.
+    records: Vec<(usize, u32, Option<usize>)>,
+    wrong: Option<MeshError>,
 }
 
 impl Faces {
-    /// Keep face `f`, or say what is wrong with it; `vertices`, how many the file has, where
-    /// they were read before the faces.
-    fn push(&mut self, f: usize, face: PlyFace, vertices: Option<usize>) -> Result<(), MeshError> {
-        if !face.given {
-            return Err(MeshError::new(format!(
-                "face {f} has no integer list `vertex_indices` (or `vertex_index`)"
-            )));
+    /// Keep face `f` (on `line`, in an ASCII file), or say what is wrong with it; `vertices`,
+    /// how many the file has, where they were read before the faces.
+    fn push(
+        &mut self,
+        f: usize,
+        face: PlyFace,
+        vertices: Option<usize>,
+        line: Option<usize>,
+    ) -> Result<(), MeshError> {
+        if self.wrong.is_some() {
+            return Ok(());
         }
         let list = &face.indices;
-        let largest = list.iter().copied().max().unwrap_or(0);
-        if let Some(bad) = face.out_of_range.or_else(|| {
-            let n = vertices?;
-            list.iter()
-                .find(|&&i| i as usize >= n)
-                .map(|&i| i64::from(i))
-        }) {
-            return Err(out_of_range(f, bad, vertices));
-        }
-        if list.len() < 3 {
-            return Err(MeshError::new(format!(
+        let missing = vertices.and_then(|n| list.iter().find(|&&i| i as usize >= n));
+        let wrong = if !face.given {
+            Some(MeshError::new(format!(
+                "face {f} has no integer list `vertex_indices` (or `vertex_index`)"
+            )))
+        } else if let Some(bad) = face.out_of_range {
+            Some(no_vertex(f, bad))
+        } else if let (Some(&bad), Some(n)) = (missing, vertices) {
+            Some(missing_vertex(f, bad, n))
+        } else if list.len() < 3 {
+            Some(MeshError::new(format!(
                 "face {f} has {} corners; a face needs 3 or more",
                 list.len()
-            )));
+            )))
+        } else {
+            None
+        };
+        if let Some(e) = wrong {
+            let e = MeshError { line, ..e };
+            if vertices.is_some() {
+                return Err(e);
+            }
+            // An earlier face may name a vertex the file lacks: which comes first is known
+            // once the vertices are counted.
+            self.wrong = Some(e);
+            return Ok(());
         }
-        if self.records.last().is_none_or(|&(_, r)| largest > r) {
-            self.records.push((f, largest));
+        if vertices.is_none() {
+            let largest = list.iter().copied().max().unwrap_or(0);
+            if self.records.last().is_none_or(|&(_, r, _)| largest > r) {
+                self.records.push((f, largest, line));
+            }
         }
         for k in 1..list.len() - 1 {
             self.triangles.push([list[0], list[k], list[k + 1]]);
@@ -222,56 +243,72 @@ impl Faces {
         Ok(())
     }
 
-    /// Check, once the vertices are counted, that no face names one the file does not have.
-    fn check(&self, vertices: usize) -> Result<(), MeshError> {
-        match self.records.iter().find(|&&(_, i)| i as usize >= vertices) {
-            Some(&(f, i)) => Err(out_of_range(f, i64::from(i), Some(vertices))),
+    /// Once the vertices are counted: the first face that names a vertex the file does not
+    /// have, or is wrong otherwise, if any (every face recorded came before the wrong one).
+    fn check(&mut self, vertices: usize) -> Result<(), MeshError> {
+        let missing = self
+            .records
+            .iter()
+            .find(|&&(_, i, _)| i as usize >= vertices)
+            .map(|&(f, i, line)| MeshError {
+                line,
+                ..missing_vertex(f, i, vertices)
+            });
+        match missing.or_else(|| self.wrong.take()) {
+            Some(e) => Err(e),
             None => Ok(()),
         }
     }
 }
 
-/// Face `f` names vertex `bad`, which the file does not have.
-fn out_of_range(f: usize, bad: i64, vertices: Option<usize>) -> MeshError {
-    MeshError::new(match vertices {
-        Some(n) => format!("face {f} names vertex {bad}; the file has {n} (counted from 0)"),
-        // The faces come first, and the index is no vertex's in any file (negative, say).
-        None => format!("face {f} names vertex {bad}, not a vertex's number (counted from 0)"),
-    })
+/// Face `f` names vertex `bad` of a file of `vertices`.
+fn missing_vertex(f: usize, bad: u32, vertices: usize) -> MeshError {
+    MeshError::new(format!(
+        "face {f} names vertex {bad}; the file has {vertices} (counted from 0)"
+    ))
 }
 
-/// Read element `def`'s entries one by one, handing each to `each` with its number: nothing
-/// of the element is held but what `each` keeps (a scanned mesh has millions of entries).
-/// `line` is the line the next entry starts on (each entry counts as a line, as the parser
-/// counts them in a binary file too).
+/// Face `f` names `bad`, which is no vertex's number in any file (negative, or past u32).
+fn no_vertex(f: usize, bad: i64) -> MeshError {
+    MeshError::new(format!(
+        "face {f} names vertex {bad}, not a vertex's number (counted from 0)"
+    ))
+}
+
+/// Read element `def`'s entries one by one, handing each to `each` with its number and, in an
+/// ASCII file, its line: nothing of the element is held but what `each` keeps (a scanned mesh
+/// has millions of entries). `line` is the line the next entry starts on; a binary file's
+/// entries have none, and its errors name none.
 fn each_entry<E: ply_rs_bw::ply::PropertyAccess, R: std::io::BufRead>(
     reader: &mut R,
     header: &ply_rs_bw::ply::Header,
     def: &ply_rs_bw::ply::ElementDef,
     line: &mut usize,
-    mut each: impl FnMut(usize, E) -> Result<(), MeshError>,
+    mut each: impl FnMut(usize, E, Option<usize>) -> Result<(), MeshError>,
 ) -> Result<(), MeshError> {
     use ply_rs_bw::ply::Encoding;
     let parser = ply_rs_bw::parser::Parser::<E>::new();
-    let ended = |i: usize, line: usize| MeshError {
-        line: Some(line),
-        message: format!(
-            "not a readable PLY file: it ends in element `{}` after {i} of its {} entries",
-            crate::text::shown(&def.name),
-            def.count
-        ),
-    };
+    let ascii = matches!(header.encoding, Encoding::Ascii);
     let mut text = String::new();
     for i in 0..def.count {
+        let at = ascii.then_some(*line);
+        let ended = || MeshError {
+            line: at,
+            message: format!(
+                "not a readable PLY file: it ends in element `{}` after {i} of its {} entries",
+                crate::text::shown(&def.name),
+                def.count
+            ),
+        };
         let entry = match header.encoding {
             Encoding::Ascii => {
                 text.clear();
                 let read = reader.read_line(&mut text).map_err(|e| MeshError {
-                    line: Some(*line),
+                    line: at,
                     message: format!("cannot read it: {e}"),
                 })?;
                 if read == 0 {
-                    return Err(ended(i, *line));
+                    return Err(ended());
                 }
                 parser.read_ascii_element(&text, def)
             }
@@ -280,16 +317,21 @@ fn each_entry<E: ply_rs_bw::ply::PropertyAccess, R: std::io::BufRead>(
         };
         let entry = match entry {
             Ok(entry) => entry,
-            Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => return Err(ended(i, *line)),
+            Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => return Err(ended()),
             Err(e) => {
-                return Err(MeshError {
-                    line: Some(*line),
-                    message: ply_message(&e),
-                })
+                let mut message = ply_message(&e);
+                // Not every parser error quotes its line (a number out of its type's range).
+                if ascii && !message.contains("(the line reads") {
+                    message.push_str(&format!(
+                        " (the line reads `{}`)",
+                        crate::text::shown(text.trim_end())
+                    ));
+                }
+                return Err(MeshError { line: at, message });
             }
         };
-        each(i, entry).map_err(|e| MeshError {
-            line: e.line.or(Some(*line)),
+        each(i, entry, at).map_err(|e| MeshError {
+            line: e.line.or(at),
             ..e
         })?;
         *line += 1;
@@ -376,7 +418,7 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
         .read_header(&mut reader)
         .map_err(unreadable)?;
     check_counts(&header, size)?;
-    // The line of the first entry (the parser counts the one after the header.s last).
+    // The line of the first entry (the parser counts the one after the header's last).
     let mut line = reader.line();
     let mut reader = reader.into_inner();
     let (mut vertices, mut faces) = (None::<Vertices>, None::<Faces>);
@@ -386,21 +428,23 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
         match name.as_str() {
             "vertex" => {
                 let mut v = Vertices::with_capacity(def.count);
-                each_entry(&mut reader, &header, def, &mut line, |i, e| v.push(i, e))?;
+                each_entry(&mut reader, &header, def, &mut line, |i, e, _| v.push(i, e))?;
                 vertices = Some(v);
             }
             "face" => {
                 let mut f = Faces::default();
                 f.triangles.reserve(def.count);
                 let n = vertices.as_ref().map(|v| v.positions.len());
-                each_entry(&mut reader, &header, def, &mut line, |i, e| f.push(i, e, n))?;
+                each_entry(&mut reader, &header, def, &mut line, |i, e, at| {
+                    f.push(i, e, n, at)
+                })?;
                 faces = Some(f);
             }
-            _ => each_entry(&mut reader, &header, def, &mut line, |_, PlySkip| Ok(()))?,
+            _ => each_entry(&mut reader, &header, def, &mut line, |_, PlySkip, _| Ok(()))?,
         }
     }
     let vertices = vertices.ok_or_else(|| MeshError::new("it has no `vertex` element"))?;
-    let faces = faces.ok_or_else(|| MeshError::new("it has no `face` element"))?;
+    let mut faces = faces.ok_or_else(|| MeshError::new("it has no `face` element"))?;
     faces.check(vertices.positions.len())?;
     let mut mesh = MeshData {
         positions: vertices.positions,
@@ -474,7 +518,20 @@ mod tests {
         .unwrap_err();
         assert_eq!(
             e.message,
-            "face 1 names vertex -3; the file has 4 (counted from 0)"
+            "face 1 names vertex -3, not a vertex's number (counted from 0)"
+        );
+        // A number its type does not hold: the line is quoted all the same.
+        let uint = HEADER.replace("uchar int", "uchar uint");
+        let e = read_bytes(
+            "uint",
+            format!("{uint}{VERTICES}3 0 1 2\n3 0 -1 2\n").as_bytes(),
+        )
+        .unwrap_err();
+        assert_eq!(e.line, Some(15));
+        assert!(
+            e.message.contains("(the line reads `3 0 -1 2`)"),
+            "{}",
+            e.message
         );
         let e = read_bytes("short", format!("{HEADER}0 0 0\n1 0 0\n").as_bytes()).unwrap_err();
         assert_eq!(e.line, Some(12));
@@ -494,8 +551,28 @@ mod tests {
         )
         .unwrap_err();
         assert_eq!(
-            e.message,
-            "face 1 names vertex 5; the file has 4 (counted from 0)"
+            (e.line, e.message.as_str()),
+            (
+                Some(11),
+                "face 1 names vertex 5; the file has 4 (counted from 0)"
+            )
+        );
+        // A face of two corners after it: face 1 is still the one named.
+        let e = read_bytes(
+            "first-two",
+            format!("{faces_first}3 0 1 3\n3 1 5 2\n2 0 1\n{VERTICES}").as_bytes(),
+        )
+        .unwrap_err();
+        assert_eq!(e.line, Some(11), "{}", e.message);
+        // And the two corners named where no face before names a missing vertex.
+        let e = read_bytes(
+            "first-two-only",
+            format!("{faces_first}3 0 1 3\n2 0 1\n3 1 5 2\n{VERTICES}").as_bytes(),
+        )
+        .unwrap_err();
+        assert_eq!(
+            (e.line, e.message.as_str()),
+            (Some(11), "face 1 has 2 corners; a face needs 3 or more")
         );
         let m = read_bytes(
             "first-ok",
@@ -533,6 +610,7 @@ mod tests {
         assert_eq!(m.triangles, [[0, 1, 2]]);
         assert_eq!(m.positions[2], DVec3::new(0.0, 1.0, 0.5));
         let e = read_bytes("cut", &bin[..bin.len() - 5]).unwrap_err();
+        assert_eq!(e.line, None, "a binary file has no lines");
         assert!(
             e.message
                 .contains("ends in element `face` after 0 of its 1 entries"),
