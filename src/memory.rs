@@ -51,8 +51,9 @@ pub(crate) const STRIP_PIXELS: u64 = 1 << 18;
 pub(crate) const BYTES_PER_PIXEL_EXR: u64 = 380;
 
 /// What a triangle of a mesh held as itself costs rendered, its corner data aside: its share of
-/// the shared vertices and of its indices, and of Embree's triangle geometry and tree (the
-/// bench's 10-million-triangle PLY peaks at 135 bytes a triangle, reading included).
+/// the shared vertices and of its indices, and of the backend's structure and its build (the
+/// f64 BVH's build holds an 80-byte item a triangle, and the whole process peaked at 159 bytes
+/// a triangle on the bench's 10-million-triangle PLY; Embree's compact structure, far less).
 pub(crate) const BYTES_PER_HELD_TRIANGLE: u64 = 160;
 
 /// A mesh triangle's corner normals: three, in f64.

@@ -3,7 +3,7 @@
 //! mesh's tree tests the same triangle, so both find the same hits to the bit.
 
 use super::{Hit, Ray};
-use crate::geometry::{Aabb, BoxTree, IndexedMesh};
+use crate::geometry::{BoxTree, IndexedMesh};
 use std::sync::Arc;
 
 pub(super) struct MeshTree {
@@ -15,11 +15,10 @@ pub(super) struct MeshTree {
 
 impl MeshTree {
     pub fn build(first: u32, mesh: &Arc<IndexedMesh>) -> MeshTree {
-        let boxes: Vec<Aabb> = (0..mesh.len()).map(|i| mesh.triangle(i).bounds()).collect();
         MeshTree {
             first,
             mesh: mesh.clone(),
-            tree: BoxTree::build(&boxes),
+            tree: BoxTree::build_from(mesh.len() as usize, |i| mesh.triangle(i as u64).bounds()),
         }
     }
 

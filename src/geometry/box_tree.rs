@@ -124,14 +124,20 @@ impl BoxTree {
 
     /// Build over the boxes of `n` items (binned SAH, leaves of up to 4 items).
     pub fn build(boxes: &[Aabb]) -> BoxTree {
-        let n = boxes.len();
-        let mut items: Vec<Item> = boxes
-            .iter()
-            .enumerate()
-            .map(|(i, b)| Item {
-                bounds: *b,
-                centroid: b.centroid(),
-                index: i as u32,
+        BoxTree::build_from(boxes.len(), |i| boxes[i])
+    }
+
+    /// The same tree as [`build`](Self::build) over the boxes `bounds` gives items `0..n`,
+    /// made as they are needed (a mesh's 10 million triangles' boxes are not held twice).
+    pub fn build_from(n: usize, bounds: impl Fn(usize) -> Aabb) -> BoxTree {
+        let mut items: Vec<Item> = (0..n)
+            .map(|i| {
+                let b = bounds(i);
+                Item {
+                    bounds: b,
+                    centroid: b.centroid(),
+                    index: i as u32,
+                }
             })
             .collect();
         let mut nodes = Vec::with_capacity(2 * n.div_ceil(MAX_LEAF).max(1));
