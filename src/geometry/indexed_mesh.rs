@@ -93,7 +93,6 @@ impl IndexedMesh {
             .all(|t| t.iter().all(|&i| (i as usize) < positions.len())));
         // The union of the triangles' boxes: the vertices they use.
         let mut bounds = Aabb::EMPTY;
-        // (Every index is below the count: the reader checked.)
         for t in &triangles {
             for &i in t {
                 bounds.grow(positions[i as usize]);

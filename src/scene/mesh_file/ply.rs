@@ -115,7 +115,6 @@ impl ply_rs_bw::ply::PropertyAccess for PlySkip {
 
 /// A PLY file's vertices as they are read: positions, and normals and texture coordinates
 /// for as long as every vertex has them.
-#[derive(Default)]
 struct Vertices {
     positions: Vec<DVec3>,
     normals: Option<Vec<DVec3>>,
@@ -126,8 +125,8 @@ impl Vertices {
     fn with_capacity(n: usize) -> Vertices {
         Vertices {
             positions: Vec::with_capacity(n),
-            normals: Some(Vec::new()),
-            uvs: Some(Vec::new()),
+            normals: None,
+            uvs: None,
         }
     }
 
@@ -150,31 +149,28 @@ impl Vertices {
                 )));
             }
         }
+        let (first, capacity) = (self.positions.is_empty(), self.positions.capacity());
         self.positions
             .push(DVec3::new(v.values[0], v.values[1], v.values[2]));
-        // Normals and texture coordinates are kept only where every vertex has them.
-        if v.has(0b111_000) {
-            let n = DVec3::new(v.values[3], v.values[4], v.values[5]);
-            if let Some(list) = &mut self.normals {
-                if list.is_empty() {
-                    list.reserve_exact(self.positions.capacity());
-                }
-                list.push(n.normalize_or_zero());
-            }
-        } else {
-            self.normals = None;
-        }
-        if v.has(0b1100_0000) {
-            if let Some(list) = &mut self.uvs {
-                if list.is_empty() {
-                    list.reserve_exact(self.positions.capacity());
-                }
-                list.push([v.values[6], v.values[7]]);
-            }
-        } else {
-            self.uvs = None;
-        }
+        let normal = v
+            .has(0b111_000)
+            .then(|| DVec3::new(v.values[3], v.values[4], v.values[5]).normalize_or_zero());
+        keep(&mut self.normals, normal, first, capacity);
+        let uv = v.has(0b1100_0000).then(|| [v.values[6], v.values[7]]);
+        keep(&mut self.uvs, uv, first, capacity);
         Ok(())
+    }
+}
+
+/// Keep a vertex's `value` in `list` for as long as every vertex has one: the `first` vertex's
+/// starts it (room for `capacity`), a vertex without one ends it.
+fn keep<T>(list: &mut Option<Vec<T>>, value: Option<T>, first: bool, capacity: usize) {
+    if first {
+        *list = value.is_some().then(|| Vec::with_capacity(capacity));
+    }
+    match (list.as_mut(), value) {
+        (Some(l), Some(x)) => l.push(x),
+        _ => *list = None,
     }
 }
 
@@ -321,11 +317,8 @@ fn each_entry<E: ply_rs_bw::ply::PropertyAccess, R: std::io::BufRead>(
             Err(e) => {
                 let mut message = ply_message(&e);
                 // Not every parser error quotes its line (a number out of its type's range).
-                if ascii && !message.contains("(the line reads") {
-                    message.push_str(&format!(
-                        " (the line reads `{}`)",
-                        crate::text::shown(text.trim_end())
-                    ));
+                if ascii && !message.contains(LINE_READS) {
+                    message.push_str(&line_reads(&text));
                 }
                 return Err(MeshError { line: at, message });
             }
@@ -353,10 +346,17 @@ fn ply_message(e: &ply_rs_bw::parser::ParseError) -> String {
     };
     let mut message = format!("not a readable PLY file: {}", crate::text::shown(first));
     if let Some(line) = parts.find_map(|p| p.strip_prefix("String: ")) {
-        let line = line.trim_matches('\'').trim_end();
-        message.push_str(&format!(" (the line reads `{}`)", crate::text::shown(line)));
+        message.push_str(&line_reads(line.trim_matches('\'')));
     }
     message
+}
+
+/// How an error quotes the line of the file it read.
+const LINE_READS: &str = " (the line reads `";
+
+/// `LINE_READS` with `line` (cut short, its control characters escaped, as `text::shown`).
+fn line_reads(line: &str) -> String {
+    format!("{LINE_READS}{}`)", crate::text::shown(line.trim_end()))
 }
 
 /// Refuse a PLY header whose elements the file cannot hold: an element without properties
@@ -451,12 +451,11 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshData, MeshError> {
         triangles: faces.triangles,
         ..Default::default()
     };
-    let any = !mesh.positions.is_empty();
-    if let Some(n) = vertices.normals.filter(|_| any) {
+    if let Some(n) = vertices.normals {
         let at = |t: &[u32; 3]| t.map(|i| n[i as usize]);
         mesh.normals = Some(mesh.triangles.iter().map(at).collect());
     }
-    if let Some(uv) = vertices.uvs.filter(|_| any) {
+    if let Some(uv) = vertices.uvs {
         let at = |t: &[u32; 3]| t.map(|i| uv[i as usize]);
         mesh.uvs = Some(mesh.triangles.iter().map(at).collect());
     }
@@ -480,6 +479,11 @@ mod tests {
         m
     }
 
+    /// Why `text`, written as a PLY file, is refused.
+    fn refused(name: &str, text: &str) -> MeshError {
+        read_bytes(name, text.as_bytes()).unwrap_err()
+    }
+
     /// Nine lines: the first vertex is line 10, the first face line 14.
     const HEADER: &str = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n";
     const VERTICES: &str = "0 0 0\n1 0 0\n0 1 0\n1 1 0\n";
@@ -498,42 +502,33 @@ mod tests {
         assert_eq!((m.normals, m.uvs), (None, None));
 
         let bad = format!("{HEADER}0 0 0\n1 x 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n");
-        let e = read_bytes("number", bad.as_bytes()).unwrap_err();
+        let e = refused("number", &bad);
         assert_eq!(e.line, Some(11), "{}", e.message);
         assert!(e.message.contains("`1 x 0`"), "{}", e.message);
-        let e = read_bytes(
-            "range",
-            format!("{HEADER}{VERTICES}3 0 1 2\n3 1 7 2\n").as_bytes(),
-        )
-        .unwrap_err();
+        let e = refused("range", &format!("{HEADER}{VERTICES}3 0 1 2\n3 1 7 2\n"));
         assert_eq!(e.line, Some(15));
         assert_eq!(
             e.message,
             "face 1 names vertex 7; the file has 4 (counted from 0)"
         );
-        let e = read_bytes(
+        let e = refused(
             "negative",
-            format!("{HEADER}{VERTICES}3 0 1 2\n3 1 -3 2\n").as_bytes(),
-        )
-        .unwrap_err();
+            &format!("{HEADER}{VERTICES}3 0 1 2\n3 1 -3 2\n"),
+        );
         assert_eq!(
             e.message,
             "face 1 names vertex -3, not a vertex's number (counted from 0)"
         );
         // A number its type does not hold: the line is quoted all the same.
         let uint = HEADER.replace("uchar int", "uchar uint");
-        let e = read_bytes(
-            "uint",
-            format!("{uint}{VERTICES}3 0 1 2\n3 0 -1 2\n").as_bytes(),
-        )
-        .unwrap_err();
+        let e = refused("uint", &format!("{uint}{VERTICES}3 0 1 2\n3 0 -1 2\n"));
         assert_eq!(e.line, Some(15));
         assert!(
             e.message.contains("(the line reads `3 0 -1 2`)"),
             "{}",
             e.message
         );
-        let e = read_bytes("short", format!("{HEADER}0 0 0\n1 0 0\n").as_bytes()).unwrap_err();
+        let e = refused("short", &format!("{HEADER}0 0 0\n1 0 0\n"));
         assert_eq!(e.line, Some(12));
         assert!(
             e.message
@@ -545,11 +540,10 @@ mod tests {
         // Faces before the vertices: checked once the vertices are counted, naming the first
         // face that names a vertex the file does not have.
         let faces_first = "ply\nformat ascii 1.0\nelement face 3\nproperty list uchar int vertex_indices\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-        let e = read_bytes(
+        let e = refused(
             "first",
-            format!("{faces_first}3 0 1 3\n3 1 5 2\n3 0 9 2\n{VERTICES}").as_bytes(),
-        )
-        .unwrap_err();
+            &format!("{faces_first}3 0 1 3\n3 1 5 2\n3 0 9 2\n{VERTICES}"),
+        );
         assert_eq!(
             (e.line, e.message.as_str()),
             (
@@ -558,18 +552,22 @@ mod tests {
             )
         );
         // A face of two corners after it: face 1 is still the one named.
-        let e = read_bytes(
+        let e = refused(
             "first-two",
-            format!("{faces_first}3 0 1 3\n3 1 5 2\n2 0 1\n{VERTICES}").as_bytes(),
-        )
-        .unwrap_err();
-        assert_eq!(e.line, Some(11), "{}", e.message);
+            &format!("{faces_first}3 0 1 3\n3 1 5 2\n2 0 1\n{VERTICES}"),
+        );
+        assert_eq!(
+            (e.line, e.message.as_str()),
+            (
+                Some(11),
+                "face 1 names vertex 5; the file has 4 (counted from 0)"
+            )
+        );
         // And the two corners named where no face before names a missing vertex.
-        let e = read_bytes(
+        let e = refused(
             "first-two-only",
-            format!("{faces_first}3 0 1 3\n2 0 1\n3 1 5 2\n{VERTICES}").as_bytes(),
-        )
-        .unwrap_err();
+            &format!("{faces_first}3 0 1 3\n2 0 1\n3 1 5 2\n{VERTICES}"),
+        );
         assert_eq!(
             (e.line, e.message.as_str()),
             (Some(11), "face 1 has 2 corners; a face needs 3 or more")
@@ -580,11 +578,10 @@ mod tests {
         )
         .unwrap();
         assert_eq!(m.triangles.len(), 4);
-        let e = read_bytes(
+        let e = refused(
             "first-negative",
-            format!("{faces_first}3 0 1 3\n3 1 -1 2\n3 0 1 2\n{VERTICES}").as_bytes(),
-        )
-        .unwrap_err();
+            &format!("{faces_first}3 0 1 3\n3 1 -1 2\n3 0 1 2\n{VERTICES}"),
+        );
         assert_eq!(
             (e.line, e.message.as_str()),
             (
