@@ -159,7 +159,8 @@ pub(crate) fn memory_need(scene: &scene::Scene, format: output::Format, threads:
     let (fw, fh) = scene.image.frame_size();
     let pixels = u64::from(fw) * u64::from(fh);
     let row = u64::from(w) * u64::from(render::TILE);
-    let strip = |least: u64| least.max(4 * threads as u64 * row) + 2 * row;
+    let per_thread = memory::STRIP_TILE_ROWS_PER_THREAD * threads as u64;
+    let strip = |least: u64| least.max(per_thread * row) + 2 * row;
     let held = match format {
         output::Format::Exr => pixels
             .min(strip(memory::STRIP_PIXELS))

@@ -50,6 +50,7 @@ use crate::scene::Scene;
 use crate::spectrum::Sampled;
 use glam::DVec3;
 use rayon::prelude::*;
+use smallvec::SmallVec;
 use std::time::{Duration, Instant};
 
 pub(crate) const TILE: u32 = 16;
@@ -216,11 +217,11 @@ pub(crate) fn render_world_in_strips<E: From<crate::Error>>(
     mut put: impl FnMut(&Frame) -> Result<(), E>,
 ) -> Result<RenderStats, E> {
     let (w, h) = scene.image.frame_size();
-    // At least four rows of tiles per thread, so that every thread has work to the strip's
-    // end; an even number: whole 32-row blocks of an EXR (PIZ's).
+    // An even number of rows of tiles: whole 32-row blocks of an EXR (PIZ's).
+    let per_thread = crate::memory::STRIP_TILE_ROWS_PER_THREAD;
     let tile_rows = min_pixels
         .div_ceil(u64::from(w.max(1)) * u64::from(TILE))
-        .max(4 * rayon::current_num_threads() as u64)
+        .max(per_thread * rayon::current_num_threads() as u64)
         .next_multiple_of(2);
     let rows_per_strip = u32::try_from(tile_rows * u64::from(TILE)).unwrap_or(u32::MAX);
     let rows = Rows::new(scene, world, passes, progress);
@@ -335,62 +336,91 @@ impl<'a> Rows<'a> {
         } else {
             frame.mattes.clear();
         }
-        let row = ((w * TILE) as usize).max(1);
-        let rows_of_tiles = frame.pixels.len().div_ceil(row);
-        // Each row's mattes beside its pixels (none in a render of colour alone).
-        let mut mattes: Vec<&mut [Mattes]> = frame.mattes.chunks_mut(row).collect();
-        mattes.resize_with(rows_of_tiles, Default::default);
-        let per_row: Vec<(u64, u64)> = frame
-            .pixels
-            .par_chunks_mut(row)
-            .zip(mattes.into_par_iter())
-            .enumerate()
-            .map(|(b, (out, out_mattes))| {
-                let y0 = rows.start + b as u32 * TILE;
-                let (mut counts, mut scratch) = ((0, 0), tile::TileScratch::default());
-                for x0 in (0..w).step_by(TILE as usize) {
-                    let xy = (x0, y0);
-                    let (cam, cull) = (&self.cam, self.cull.as_ref());
-                    let view = tile::View {
-                        cam,
-                        cull,
-                        stars: self.stars.as_ref(),
-                        cones: self.cones.as_ref(),
-                        emitters: self.emitters.as_ref(),
-                        sample_base: self.sample_base,
-                    };
-                    let tile = if self.spectral {
-                        let seen = Seen::of(scene);
-                        let s = &mut scratch;
-                        tile::render_tile::<Sampled>(seen, scene, world, &view, xy, passes, s)
-                    } else {
-                        let s = &mut scratch;
-                        let seen = Seen::NONE;
-                        tile::render_tile::<DVec3>(seen, scene, world, &view, xy, passes, s)
-                    };
-                    counts.0 += tile.primary_rays;
-                    counts.1 += tile.nonfinite;
-                    if let Some(p) = self.progress {
-                        p.add(tile.pixels.len() as u64);
-                    }
-                    for p in tile.pixels {
-                        let at = ((p.y - y0) * w + p.x) as usize;
-                        out[at] = p.value;
-                        if let Some(m) = out_mattes.get_mut(at) {
-                            *m = p.mattes;
-                        }
+        // Tiles, not rows of them, are the unit of work: a strip of few rows of tiles is
+        // still shared out evenly between the threads.
+        let tiles = strip_tiles(w, rows.start, &mut frame.pixels, &mut frame.mattes);
+        let per_tile: Vec<(u64, u64)> = tiles
+            .into_par_iter()
+            .map_init(tile::TileScratch::default, |scratch, mut out| {
+                let xy = (out.x0, out.y0);
+                let (cam, cull) = (&self.cam, self.cull.as_ref());
+                let view = tile::View {
+                    cam,
+                    cull,
+                    stars: self.stars.as_ref(),
+                    cones: self.cones.as_ref(),
+                    emitters: self.emitters.as_ref(),
+                    sample_base: self.sample_base,
+                };
+                let tile = if self.spectral {
+                    let seen = Seen::of(scene);
+                    tile::render_tile::<Sampled>(seen, scene, world, &view, xy, passes, scratch)
+                } else {
+                    let seen = Seen::NONE;
+                    tile::render_tile::<DVec3>(seen, scene, world, &view, xy, passes, scratch)
+                };
+                if let Some(p) = self.progress {
+                    p.add(tile.pixels.len() as u64);
+                }
+                for p in tile.pixels {
+                    let (dx, dy) = ((p.x - out.x0) as usize, (p.y - out.y0) as usize);
+                    out.pixels[dy][dx] = p.value;
+                    if let Some(line) = out.mattes.get_mut(dy) {
+                        line[dx] = p.mattes;
                     }
                 }
-                counts
+                (tile.primary_rays, tile.nonfinite)
             })
             .collect();
         let mut stats = RenderStats::default();
-        for (rays, nonfinite) in per_row {
+        for (rays, nonfinite) in per_tile {
             stats.primary_rays += rays;
             stats.nonfinite_pixels += nonfinite;
         }
         stats
     }
+}
+
+/// Where one tile of a strip writes: its corner in the frame, and the runs of its lines in the
+/// strip's pixels and mattes (no mattes in a render of colour alone).
+struct TileOut<'f> {
+    x0: u32,
+    y0: u32,
+    pixels: SmallVec<[&'f mut [PixelValue]; TILE as usize]>,
+    mattes: SmallVec<[&'f mut [Mattes]; TILE as usize]>,
+}
+
+/// The tiles of a strip `w` pixels wide whose first row is the frame's `y0`, row of tiles by
+/// row of tiles, left to right, each holding its own parts of `pixels` and `mattes` (empty, or
+/// one per pixel).
+fn strip_tiles<'f>(
+    w: u32,
+    y0: u32,
+    pixels: &'f mut [PixelValue],
+    mattes: &'f mut [Mattes],
+) -> Vec<TileOut<'f>> {
+    let (line, side) = ((w as usize).max(1), TILE as usize);
+    let columns = line.div_ceil(side);
+    let rows = pixels.len().div_ceil(line * side);
+    let mut tiles: Vec<TileOut> = (0..rows * columns)
+        .map(|i| TileOut {
+            x0: (i % columns * side) as u32,
+            y0: y0 + (i / columns * side) as u32,
+            pixels: SmallVec::new(),
+            mattes: SmallVec::new(),
+        })
+        .collect();
+    for (l, runs) in pixels.chunks_mut(line).enumerate() {
+        for (c, run) in runs.chunks_mut(side).enumerate() {
+            tiles[l / side * columns + c].pixels.push(run);
+        }
+    }
+    for (l, runs) in mattes.chunks_mut(line).enumerate() {
+        for (c, run) in runs.chunks_mut(side).enumerate() {
+            tiles[l / side * columns + c].mattes.push(run);
+        }
+    }
+    tiles
 }
 
 /// Make `v` hold `n` values, keeping its memory where it has the room; the values it already

@@ -3,8 +3,12 @@
 
 use crate::accel::backend_by_name;
 use crate::output::srgb_encode;
-use crate::render::{render_world_in_strips, render_world_passes, Frame, Passes, World};
+use crate::render::{
+    render_tile, render_world_in_strips, render_world_passes, CameraRays, Frame, Passes, Seen,
+    TileScratch, View, World, TILE,
+};
 use crate::scene::paper::paper;
+use glam::DVec3;
 
 fn lattice(sets: &[&str]) -> crate::scene::Scene {
     let mut all: Vec<String> = vec![
@@ -27,7 +31,7 @@ fn strips_hold_the_whole_frame() {
         let world = World::build(&s, backend_by_name("bvh").unwrap().as_ref()).unwrap();
         let (whole, whole_stats) = render_world_passes(&s, &world, Passes::Colour);
         let (w, _) = s.image.frame_size();
-        // On one thread a strip is at least four rows of tiles (64 rows): several strips.
+        // On one thread a strip is at least two rows of tiles (32 rows): several strips.
         let one = rayon::ThreadPoolBuilder::new()
             .num_threads(1)
             .build()
@@ -55,6 +59,62 @@ fn strips_hold_the_whole_frame() {
             }
         }
     }
+}
+
+/// The strips of every pass, on two threads, whose tiles are shared out one by one: each pixel
+/// and its mattes are where the tile rendered alone puts them, in every strip.
+#[test]
+fn every_tile_lands_in_its_place() {
+    // 72 wide: a last column of tiles half as wide; 150 high: a last row of tiles of 6 rows.
+    let s = lattice(&["image.samples=2"]);
+    let world = World::build(&s, backend_by_name("bvh").unwrap().as_ref()).unwrap();
+    let (w, h) = s.image.frame_size();
+    let two = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let mut frame = Frame::new(w, 0);
+    let mut strips = 0;
+    two.install(|| {
+        render_world_in_strips(&s, &world, Passes::All, 1, None, |b| {
+            assert_eq!(b.mattes.len(), b.pixels.len());
+            frame.pixels.extend_from_slice(&b.pixels);
+            frame.mattes.extend_from_slice(&b.mattes);
+            frame.height += b.height;
+            strips += 1;
+            Ok::<(), crate::Error>(())
+        })
+    })
+    .unwrap();
+    assert!(strips > 1, "several strips");
+    assert_eq!(frame.height, h);
+    let cam = CameraRays::new(&s.camera, s.image.width, s.image.height);
+    let view = View {
+        cam: &cam,
+        cull: None,
+        stars: None,
+        cones: None,
+        emitters: None,
+        sample_base: 0,
+    };
+    let mut scratch = TileScratch::default();
+    let (mut seen, mut hits) = (0, 0);
+    for y0 in (0..h).step_by(TILE as usize) {
+        for x0 in (0..w).step_by(TILE as usize) {
+            let all = Passes::All;
+            let tile =
+                render_tile::<DVec3>(Seen::NONE, &s, &world, &view, (x0, y0), all, &mut scratch);
+            for p in tile.pixels {
+                let at = (p.y * w + p.x) as usize;
+                assert_eq!(frame.pixels[at], p.value, "pixel ({}, {})", p.x, p.y);
+                assert_eq!(frame.mattes[at], p.mattes, "mattes ({}, {})", p.x, p.y);
+                seen += 1;
+                hits += usize::from(p.value.object_id > 0);
+            }
+        }
+    }
+    assert_eq!(seen, frame.pixels.len(), "every pixel is some tile's");
+    assert!(hits > 0 && hits < seen, "objects and background both seen");
 }
 
 #[test]
