@@ -130,6 +130,19 @@ impl Primitive {
         }
     }
 
+    /// Where `o + t d` crosses a triangle's plane, with `tmin < t < tmax`; None for the other
+    /// primitives and for a ray along the plane. For a hit another test found on the triangle
+    /// that [`intersect`](Self::intersect) finds just outside it: a ray at an edge the triangle
+    /// shares, which meets the neighbour at that point of the plane.
+    pub fn plane_crossing(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<f64> {
+        let Primitive::Triangle { v } = *self else {
+            return None;
+        };
+        let n = (v[1] - v[0]).cross(v[2] - v[0]);
+        let t = (v[0] - o).dot(n) / d.dot(n);
+        (t > tmin && t < tmax).then_some(t)
+    }
+
     /// The signed distance from `p` to a solid primitive (negative inside); None for a
     /// triangle, which bounds nothing. It changes by at most |Δp| as p moves.
     pub fn distance(&self, p: DVec3) -> Option<f64> {
@@ -465,6 +478,37 @@ fn triangle_hit(v: [DVec3; 3], o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Opti
 mod tests {
     use super::Primitive;
     use glam::DVec3;
+
+    /// A triangle's plane crossing: where `intersect` meets it, the same t; beside it, where
+    /// the ray crosses the plane; along the plane, behind the interval and for a solid, none.
+    #[test]
+    fn plane_crossings() {
+        let tri = Primitive::Triangle {
+            v: [
+                DVec3::new(0.0, 0.0, 1.0),
+                DVec3::new(1.0, 0.0, 2.0),
+                DVec3::new(0.0, 1.0, 1.0),
+            ],
+        };
+        let o = DVec3::new(0.2, 0.3, -3.0);
+        let d = DVec3::new(0.0, 0.0, 2.0);
+        let inside = tri.intersect(o, d, 0.0, 10.0).unwrap();
+        assert_eq!(tri.plane_crossing(o, d, 0.0, 10.0), Some(inside));
+        // z = 1 + x on the plane: from (1.5, 0.3, -3) along +z it is crossed at z = 2.5.
+        let beside = DVec3::new(1.5, 0.3, -3.0);
+        assert_eq!(tri.intersect(beside, d, 0.0, 10.0), None);
+        assert_eq!(tri.plane_crossing(beside, d, 0.0, 10.0), Some(2.75));
+        assert_eq!(tri.plane_crossing(beside, d, 0.0, 2.5), None);
+        assert_eq!(
+            tri.plane_crossing(o, DVec3::new(1.0, 0.0, 1.0), 0.0, 10.0),
+            None
+        );
+        let ball = Primitive::Sphere {
+            center: DVec3::ZERO,
+            radius: 1.0,
+        };
+        assert_eq!(ball.plane_crossing(o, d, 0.0, 10.0), None);
+    }
 
     /// A capsule's normal at points of its surface: across the axis beside the segment, and
     /// from the end ball's centre beyond either end; for rods along each axis (either end first)

@@ -423,12 +423,13 @@ impl EmbreeAccel {
         let k = scale(r.len);
         let t = (t_embree as f64 - offset) / k;
         let slack = 1e-4 * t.abs().max(self.pullback / k) + 4.0 * self.pullback / k;
-        let refined = p.intersect(
-            r.origin,
-            r.dir,
-            (t - slack).max(r.tmin),
-            (t + slack).min(r.tmax),
-        );
+        let (lo, hi) = ((t - slack).max(r.tmin), (t + slack).min(r.tmax));
+        // Where Embree's f32 test met the triangle and the f64 one finds the ray just outside
+        // it (a ray at an edge the triangle shares), the ray meets the neighbour where it
+        // crosses this plane: that crossing in f64, not Embree's t.
+        let refined = p
+            .intersect(r.origin, r.dir, lo, hi)
+            .or_else(|| p.plane_crossing(r.origin, r.dir, lo, hi));
         let t = refined.unwrap_or(t);
         (t > r.tmin && t < r.tmax).then_some(Hit { t, prim })
     }
