@@ -40,7 +40,7 @@ pub(crate) fn scene_bytes(text: &[u8]) -> u64 {
 /// Bytes per pixel of a PNG render's strip: the frame's rows, and their 8-bit encoding.
 pub(crate) const BYTES_PER_PIXEL_PNG: u64 = 96;
 /// Pixels a render to a file holds at a time, at least (whole pairs of rows of tiles,
-/// [`STRIP_TILE_ROWS_PER_THREAD`] or more): a PNG or EXR is written strip by strip as it is
+/// [`STRIP_TILE_ROWS_PER_THREAD`] per thread or more): a PNG or EXR is written strip by strip as it is
 /// rendered, an EXR strip's blocks compressed in parallel. Smaller strips hold less (on a big
 /// mesh, the strip is most of what a render adds to the scene's memory) at the cost of a wait
 /// for the slowest tile at each strip's end.
@@ -48,12 +48,13 @@ pub(crate) const STRIP_PIXELS: u64 = 1 << 16;
 /// Rows of tiles a strip has per thread at least, so that every thread has work to the strip's
 /// end.
 pub(crate) const STRIP_TILE_ROWS_PER_THREAD: u64 = 2;
-/// Bytes per pixel of an EXR render's strip: the frame (92), its mattes (96), and the
-/// encoder's 46 channels of 4 bytes. The encoder holds no copy of the strip's channels any
-/// more, but each thread's line, block in flight (ZIP's predicted bytes, or another
-/// compression's block) and compressed block (a block is 32 rows or fewer, a strip at least 32
-/// rows per thread): less than that copy, so the figure stays an upper bound.
-pub(crate) const BYTES_PER_PIXEL_EXR: u64 = 380;
+/// Bytes per pixel of an EXR render's strip, at most: the frame (92), its mattes (96), each
+/// thread's block in flight (ZIP's predicted bytes, or another compression's block: at most
+/// the thread's share of the strip, 32 rows of 46 channels of 4 bytes, 184 bytes a pixel, as a
+/// strip has at least 32 rows per thread), and compressed chunks as large as the raw blocks at
+/// worst (no compression, or noise): the strip's own and the two earlier strips' the writer
+/// may still hold (`exr_out::write_blocks`), 3 × 184.
+pub(crate) const BYTES_PER_PIXEL_EXR: u64 = 92 + 96 + 184 + 3 * 184;
 
 /// What a triangle of a mesh held as itself costs rendered, its corner data aside: its share of
 /// the shared vertices and of its indices, and of the backend's structure and its build (the

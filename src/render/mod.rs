@@ -178,8 +178,8 @@ pub(crate) fn tiles(scene: &Scene) -> Vec<(u32, u32)> {
         .collect()
 }
 
-/// Render with acceleration structures already built. Each row of tiles is rendered tile
-/// by tile straight into its rows of the frame (no second copy of the image in flight).
+/// Render with acceleration structures already built. Each tile is rendered straight into
+/// its place in the frame (no second copy of the image in flight).
 pub(crate) fn render_world(scene: &Scene, world: &World) -> (Frame, RenderStats) {
     render_world_passes(scene, world, Passes::All)
 }
@@ -322,8 +322,8 @@ impl<'a> Rows<'a> {
     }
 
     /// Rows `rows` of the frame into `frame` (made their size, its memory reused where it
-    /// has the room; every pixel is written). Each row of tiles is rendered tile by tile
-    /// straight into its rows (no second copy of the image in flight).
+    /// has the room; every pixel is written). Each tile is a task of its own, rendered
+    /// straight into its place (no second copy of the image in flight).
     fn render_into(&self, rows: std::ops::Range<u32>, frame: &mut Frame) -> RenderStats {
         debug_assert!(rows.start.is_multiple_of(TILE));
         let (scene, world, passes) = (self.scene, self.world, self.passes);

@@ -91,11 +91,14 @@ fn compact_scenes_hit_as_the_others_do() {
     let random = rays.len();
     let big = terrain(90);
     let mut rng = Rng(0xc0c0_a5e5_0000_0054);
+    // Each edge ray's edge, by its vertices.
+    let mut edges = Vec::new();
     for _ in 0..6000 {
         // An inner square's triangle: its edges are shared.
         let (i, j) = (1 + rng.next_u64() % 88, 1 + rng.next_u64() % 88);
         let t = big.triangles()[(i * 180 + 2 * j + rng.next_u64() % 2) as usize];
         let k = (rng.next_u64() % 3) as usize;
+        edges.push((t[k], t[(k + 1) % 3]));
         let (a, b) = (big.position(t[k]), big.position(t[(k + 1) % 3]));
         let aim = a.lerp(b, rng.range(0.0, 1.0));
         let origin = DVec3::new(
@@ -176,14 +179,22 @@ fn compact_scenes_hit_as_the_others_do() {
             // two triangles meet, rounding may offer the other one. Either way a hit at the
             // edge is where the ray was aimed, t = 1, refined in f64: on the triangle, or
             // where the ray crosses its plane when the f64 test finds it just outside (Embree's
-            // f32 t is a millionth off there).
-            for (i, h) in a[random..].iter().chain(&b[random..]).enumerate() {
-                if let Some(h) = h.filter(|h| (h.t - 1.0).abs() < 1e-4) {
-                    let off = (h.t - 1.0).abs();
-                    assert!(
-                        off < 1e-12,
-                        "{isa:?}, {width} wide, ray {i}: t - 1 = {off:e}"
-                    );
+            // f32 t is a millionth off there). A hit on the edge: on one of the big terrain's
+            // (object 0's) triangles that hold both its vertices.
+            let on_edge = |prim: u32, (p, q): (u32, u32)| {
+                let part = geometry.part_of(prim);
+                let tri = || big.triangles()[(prim - part.start) as usize];
+                part.object == 0 && tri().contains(&p) && tri().contains(&q)
+            };
+            for (kind, hits) in [("usual", a.as_slice()), ("compact", b.as_slice())] {
+                for (i, (h, &edge)) in hits[random..].iter().zip(&edges).enumerate() {
+                    if let Some(h) = h.filter(|h| on_edge(h.prim, edge)) {
+                        let off = (h.t - 1.0).abs();
+                        assert!(
+                            off < 1e-12,
+                            "{isa:?}, {width} wide, {kind}, edge ray {i}: t - 1 = {off:e}"
+                        );
+                    }
                 }
             }
             // Rarely (a few in ten thousand, in the usual scene as in the compact one)

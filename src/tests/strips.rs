@@ -8,6 +8,7 @@ use crate::render::{
     TileScratch, View, World, TILE,
 };
 use crate::scene::paper::paper;
+use crate::scene::Scene;
 use glam::DVec3;
 
 fn lattice(sets: &[&str]) -> crate::scene::Scene {
@@ -65,9 +66,18 @@ fn strips_hold_the_whole_frame() {
 /// and its mattes are where the tile rendered alone puts them, in every strip.
 #[test]
 fn every_tile_lands_in_its_place() {
-    // 72 wide: a last column of tiles half as wide; 150 high: a last row of tiles of 6 rows.
-    let s = lattice(&["image.samples=2"]);
-    let world = World::build(&s, backend_by_name("bvh").unwrap().as_ref()).unwrap();
+    // 72 wide: a last column of tiles half as wide; 150 high: a last row of tiles of 6 rows;
+    // and a crop of 35 x 126 at (5, 7).
+    for crop in [None, Some("image.crop=[5, 7, 40, 133]")] {
+        let mut sets = vec!["image.samples=2"];
+        sets.extend(crop);
+        tiles_land_in_their_places(&lattice(&sets));
+    }
+}
+
+/// [`every_tile_lands_in_its_place`] on scene `s`.
+fn tiles_land_in_their_places(s: &Scene) {
+    let world = World::build(s, backend_by_name("bvh").unwrap().as_ref()).unwrap();
     let (w, h) = s.image.frame_size();
     let two = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
@@ -76,7 +86,7 @@ fn every_tile_lands_in_its_place() {
     let mut frame = Frame::new(w, 0);
     let mut strips = 0;
     two.install(|| {
-        render_world_in_strips(&s, &world, Passes::All, 1, None, |b| {
+        render_world_in_strips(s, &world, Passes::All, 1, None, |b| {
             assert_eq!(b.mattes.len(), b.pixels.len());
             frame.pixels.extend_from_slice(&b.pixels);
             frame.mattes.extend_from_slice(&b.mattes);
@@ -103,7 +113,7 @@ fn every_tile_lands_in_its_place() {
         for x0 in (0..w).step_by(TILE as usize) {
             let all = Passes::All;
             let tile =
-                render_tile::<DVec3>(Seen::NONE, &s, &world, &view, (x0, y0), all, &mut scratch);
+                render_tile::<DVec3>(Seen::NONE, s, &world, &view, (x0, y0), all, &mut scratch);
             for p in tile.pixels {
                 let at = (p.y * w + p.x) as usize;
                 assert_eq!(frame.pixels[at], p.value, "pixel ({}, {})", p.x, p.y);
