@@ -40,10 +40,10 @@ pub(crate) fn scene_bytes(text: &[u8]) -> u64 {
 /// Bytes per pixel of a PNG render's strip: the frame's rows, and their 8-bit encoding.
 pub(crate) const BYTES_PER_PIXEL_PNG: u64 = 96;
 /// Pixels a render to a file holds at a time, at least (whole pairs of rows of tiles,
-/// [`STRIP_TILE_ROWS_PER_THREAD`] per thread or more): a PNG or EXR is written strip by strip as it is
-/// rendered, an EXR strip's blocks compressed in parallel. Smaller strips hold less (on a big
-/// mesh, the strip is most of what a render adds to the scene's memory) at the cost of a wait
-/// for the slowest tile at each strip's end.
+/// [`STRIP_TILE_ROWS_PER_THREAD`] per thread or more): a PNG or EXR is written strip by strip
+/// as it is rendered, an EXR strip's blocks compressed in parallel. Smaller strips hold less
+/// (on a big mesh, the strip is most of what a render adds to the scene's memory) at the cost
+/// of a wait for the slowest tile at each strip's end.
 pub(crate) const STRIP_PIXELS: u64 = 1 << 16;
 /// Rows of tiles a strip has per thread at least, so that every thread has work to the strip's
 /// end.

@@ -410,17 +410,28 @@ fn strip_tiles<'f>(
             mattes: SmallVec::new(),
         })
         .collect();
-    for (l, runs) in pixels.chunks_mut(line).enumerate() {
-        for (c, run) in runs.chunks_mut(side).enumerate() {
-            tiles[l / side * columns + c].pixels.push(run);
-        }
+    for (i, run) in tile_runs(pixels, line) {
+        tiles[i].pixels.push(run);
     }
-    for (l, runs) in mattes.chunks_mut(line).enumerate() {
-        for (c, run) in runs.chunks_mut(side).enumerate() {
-            tiles[l / side * columns + c].mattes.push(run);
-        }
+    for (i, run) in tile_runs(mattes, line) {
+        tiles[i].mattes.push(run);
     }
     tiles
+}
+
+/// The runs of `values` (lines `line` long, one value a pixel) that each tile of their strip
+/// holds, line by line, with the tile's number (row of tiles by row, left to right).
+fn tile_runs<T>(values: &mut [T], line: usize) -> impl Iterator<Item = (usize, &mut [T])> {
+    let (side, columns) = (TILE as usize, line.div_ceil(TILE as usize));
+    values
+        .chunks_mut(line)
+        .enumerate()
+        .flat_map(move |(l, runs)| {
+            let first = l / side * columns;
+            runs.chunks_mut(side)
+                .enumerate()
+                .map(move |(c, run)| (first + c, run))
+        })
 }
 
 /// Make `v` hold `n` values, keeping its memory where it has the room; the values it already

@@ -98,8 +98,9 @@ fn compact_scenes_hit_as_the_others_do() {
         let (i, j) = (1 + rng.next_u64() % 88, 1 + rng.next_u64() % 88);
         let t = big.triangles()[(i * 180 + 2 * j + rng.next_u64() % 2) as usize];
         let k = (rng.next_u64() % 3) as usize;
-        edges.push((t[k], t[(k + 1) % 3]));
-        let (a, b) = (big.position(t[k]), big.position(t[(k + 1) % 3]));
+        let (p, q) = (t[k], t[(k + 1) % 3]);
+        edges.push((p, q));
+        let (a, b) = (big.position(p), big.position(q));
         let aim = a.lerp(b, rng.range(0.0, 1.0));
         let origin = DVec3::new(
             rng.range(-6.0, 6.0),

@@ -540,55 +540,32 @@ mod tests {
         // Faces before the vertices: checked once the vertices are counted, naming the first
         // face that names a vertex the file does not have.
         let faces_first = "ply\nformat ascii 1.0\nelement face 3\nproperty list uchar int vertex_indices\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-        let e = refused(
-            "first",
-            &format!("{faces_first}3 0 1 3\n3 1 5 2\n3 0 9 2\n{VERTICES}"),
-        );
-        assert_eq!(
-            (e.line, e.message.as_str()),
+        let missing = "face 1 names vertex 5; the file has 4 (counted from 0)";
+        for (name, faces, why) in [
+            ("first", "3 0 1 3\n3 1 5 2\n3 0 9 2\n", missing),
+            // A face of two corners after it: face 1 is still the one named.
+            ("first-two", "3 0 1 3\n3 1 5 2\n2 0 1\n", missing),
+            // And the two corners named where no face before names a missing vertex.
             (
-                Some(11),
-                "face 1 names vertex 5; the file has 4 (counted from 0)"
-            )
-        );
-        // A face of two corners after it: face 1 is still the one named.
-        let e = refused(
-            "first-two",
-            &format!("{faces_first}3 0 1 3\n3 1 5 2\n2 0 1\n{VERTICES}"),
-        );
-        assert_eq!(
-            (e.line, e.message.as_str()),
+                "first-two-only",
+                "3 0 1 3\n2 0 1\n3 1 5 2\n",
+                "face 1 has 2 corners; a face needs 3 or more",
+            ),
             (
-                Some(11),
-                "face 1 names vertex 5; the file has 4 (counted from 0)"
-            )
-        );
-        // And the two corners named where no face before names a missing vertex.
-        let e = refused(
-            "first-two-only",
-            &format!("{faces_first}3 0 1 3\n2 0 1\n3 1 5 2\n{VERTICES}"),
-        );
-        assert_eq!(
-            (e.line, e.message.as_str()),
-            (Some(11), "face 1 has 2 corners; a face needs 3 or more")
-        );
+                "first-negative",
+                "3 0 1 3\n3 1 -1 2\n3 0 1 2\n",
+                "face 1 names vertex -1, not a vertex's number (counted from 0)",
+            ),
+        ] {
+            let e = refused(name, &format!("{faces_first}{faces}{VERTICES}"));
+            assert_eq!((e.line, e.message.as_str()), (Some(11), why), "{name}");
+        }
         let m = read_bytes(
             "first-ok",
             format!("{faces_first}3 0 1 3\n3 1 3 2\n4 0 1 3 2\n{VERTICES}").as_bytes(),
         )
         .unwrap();
         assert_eq!(m.triangles.len(), 4);
-        let e = refused(
-            "first-negative",
-            &format!("{faces_first}3 0 1 3\n3 1 -1 2\n3 0 1 2\n{VERTICES}"),
-        );
-        assert_eq!(
-            (e.line, e.message.as_str()),
-            (
-                Some(11),
-                "face 1 names vertex -1, not a vertex's number (counted from 0)"
-            )
-        );
 
         let normals = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0 0 2\n1 0 0 0 0 1\n0 1 0 1 0 0\n3 0 1 2\n";
         let m = read_bytes("normals", normals.as_bytes()).unwrap();
