@@ -28,6 +28,7 @@ pub mod stars;
 mod surfaces;
 mod texture;
 mod timing;
+pub(crate) mod toml_runs;
 pub(crate) mod toml_tree;
 mod transform;
 mod worldline;

@@ -111,7 +111,7 @@ impl Lines {
     pub fn new(text: &str) -> Self {
         Lines(
             std::iter::once(0)
-                .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+                .chain(memchr::memchr_iter(b'\n', text.as_bytes()).map(|i| i + 1))
                 .collect(),
         )
     }

@@ -28,8 +28,23 @@ pub struct TomlError {
 }
 
 /// Parse a whole document. Values take the line of their key; elements of arrays their own.
+/// A long file of many `[[group]]` tables is read in runs on every thread where it can be
+/// (toml_runs.rs); the tree is the same either way.
 pub(crate) fn parse_document(text: &str, lines: &Lines) -> Result<Node, TomlError> {
+    let threads = rayon::current_num_threads();
+    if threads > 1 && text.len() >= super::toml_runs::RUNS_FROM {
+        if let Some(root) = super::toml_runs::in_runs(text, lines, 4 * threads) {
+            return Ok(root);
+        }
+    }
+    parse_part(text, lines, 0)
+}
+
+/// Parse `text`, a whole document or the part of one that starts at byte `offset` of the file
+/// `lines` counts (at the start of a line, outside any value); errors point into `text`.
+pub(super) fn parse_part(text: &str, lines: &Lines, offset: usize) -> Result<Node, TomlError> {
     let mut b = Builder::new(text, Some(lines), Origin::line(1));
+    b.place.offset = offset;
     let source = Source::new(text);
     let mut first: Option<ParseError> = None;
     // The grammar is a sequence of expressions (a key/value, a header), each ending at a newline
@@ -190,6 +205,8 @@ struct Header {
 #[derive(Clone, Copy)]
 struct Place<'l> {
     lines: Option<&'l Lines>,
+    /// Where the parsed text starts in the file `lines` counts.
+    offset: usize,
     /// The origin of every node when there are no lines (a `--set` value).
     fixed: Origin,
 }
@@ -197,7 +214,7 @@ struct Place<'l> {
 impl Place<'_> {
     fn at(&self, byte: usize) -> Origin {
         match self.lines {
-            Some(l) => Origin::line(l.line_of(byte)),
+            Some(l) => Origin::line(l.line_of(self.offset + byte)),
             None => self.fixed,
         }
     }
@@ -246,7 +263,11 @@ impl<'i, 'l> Builder<'i, 'l> {
     fn new(text: &'i str, lines: Option<&'l Lines>, fixed: Origin) -> Self {
         Builder {
             source: Source::new(text),
-            place: Place { lines, fixed },
+            place: Place {
+                lines,
+                offset: 0,
+                fixed,
+            },
             root: table(fixed, Form::TABLE),
             current: table(fixed, Form::TABLE),
             header: None,
