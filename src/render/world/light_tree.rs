@@ -90,6 +90,37 @@ pub(crate) fn reach_box(rest: &Aabb, v: &Velocity, light: DVec3, t_a: f64, t_b: 
     Motion::new(rest, v).reach_box(light, t_a, t_b)
 }
 
+/// From this many groups on, a slice's boxes are worked out on every thread.
+const PIECES_FROM: usize = 8192;
+
+/// `piece` of the runs of 0..n, joined in order: for long runs on every thread, one run each.
+///
+/// Plain scoped threads, not rayon's: this runs inside a slice's first use (a `OnceLock`),
+/// where the other workers wait for it (so their cores are free) and where a rayon worker,
+/// waiting on its own jobs, could take up a tile that waits on this very slice.
+fn in_pieces<T: Send>(n: usize, piece: impl Fn(std::ops::Range<usize>) -> Vec<T> + Sync) -> Vec<T> {
+    let threads = rayon::current_num_threads().min(n / PIECES_FROM).max(1);
+    if threads == 1 {
+        return piece(0..n);
+    }
+    let run = |i: usize| i * n / threads..(i + 1) * n / threads;
+    let piece = &piece;
+    std::thread::scope(|scope| {
+        let others: Vec<_> = (1..threads)
+            .map(|i| scope.spawn(move || piece(run(i))))
+            .collect();
+        let mut all = piece(run(0));
+        for other in others {
+            all.extend(
+                other
+                    .join()
+                    .unwrap_or_else(|p| std::panic::resume_unwind(p)),
+            );
+        }
+        all
+    })
+}
+
 impl LightTree {
     /// For the light at rest at `light`: `count` slices of emission times covering
     /// [t_first, t_last].
@@ -132,9 +163,12 @@ impl LightTree {
     /// emission times the rays are given.
     fn reach(&self, t_a: f64, t_b: f64) -> impl Fn(u32) -> Aabb + '_ {
         let pad = self.slack();
-        let motions = self
-            .motions
-            .get_or_init(|| self.groups.iter().map(|(b, v)| Motion::new(b, v)).collect());
+        let motions = self.motions.get_or_init(|| {
+            in_pieces(self.groups.len(), |run| {
+                run.map(|g| Motion::new(&self.groups[g].0, &self.groups[g].1))
+                    .collect()
+            })
+        });
         // Also padded in space: packets walk the rays backwards from the light, which the
         // rays reach only to within rounding.
         move |g| {
@@ -185,15 +219,19 @@ impl LightTree {
                 let members: Vec<u32> = match self.causal_box(self.span(first).0) {
                     Some(region) => {
                         let whole = self.reach(self.span(first).0, self.span(last).1);
-                        (0..self.groups.len() as u32)
-                            .filter(|&g| whole(g).overlaps(&region))
-                            .collect()
+                        in_pieces(self.groups.len(), |run| {
+                            run.map(|g| g as u32)
+                                .filter(|&g| whole(g).overlaps(&region))
+                                .collect()
+                        })
                     }
                     None => Vec::new(),
                 };
                 let (t_a, t_b) = self.span(middle);
                 let reach = self.reach(t_a, t_b);
-                let boxes: Vec<Aabb> = members.iter().map(|&g| reach(g)).collect();
+                let boxes = in_pieces(members.len(), |run| {
+                    run.map(|i| reach(members[i])).collect()
+                });
                 Ok(Shape {
                     tree: (self.cullers)(&boxes)?,
                     members,
@@ -208,14 +246,13 @@ impl LightTree {
             .get_or_init(|| {
                 let (t_a, t_b) = self.span(k);
                 let reach = self.reach(t_a, t_b);
-                let mut box_of = |i: u32| reach(shape.members[i as usize]);
-                match shape.tree.refitted(&mut box_of) {
+                let members = &shape.members;
+                let boxes = in_pieces(members.len(), |run| {
+                    run.map(|i| reach(members[i])).collect()
+                });
+                match shape.tree.refitted(&mut |i: u32| boxes[i as usize]) {
                     Some(t) => Ok(t),
-                    None => {
-                        let boxes: Vec<Aabb> =
-                            (0..shape.members.len() as u32).map(box_of).collect();
-                        (self.cullers)(&boxes)
-                    }
+                    None => (self.cullers)(&boxes),
                 }
             })
             .as_ref()

@@ -56,7 +56,9 @@ impl RestGroups {
         type Key = ([u64; 4], Option<[u64; 10]>, Option<usize>);
         type Set = (Velocity, Option<Box<Window>>, Vec<usize>);
         let mut sets: Vec<Set> = Vec::new();
-        let mut index: std::collections::HashMap<Key, usize> = std::collections::HashMap::new();
+        // Sized for every group at once: 100,000 groups otherwise pay for the map's regrowth.
+        let mut index: hashbrown::HashMap<Key, usize> =
+            hashbrown::HashMap::with_capacity(scene.groups.len());
         for (i, g) in scene.groups.iter().enumerate() {
             if g.geometry.is_empty() {
                 continue;
