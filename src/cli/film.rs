@@ -159,7 +159,15 @@ pub(super) fn run(
         }
         let t1 = std::time::Instant::now();
         let world = render::World::aim(&frame_scene, &rest, backend)?;
-        let stats = render_to_file(&frame_scene, &world, backend_name, format, args, &path)?;
+        let stats = render_to_file(
+            &frame_scene,
+            &world,
+            backend_name,
+            format,
+            args,
+            &path,
+            None,
+        )?;
         let secs = t1.elapsed().as_secs_f64();
         render_secs += secs;
         rendered += 1;

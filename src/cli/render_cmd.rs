@@ -11,6 +11,32 @@ use std::path::{Path, PathBuf};
 /// and with several samples their extra ray per pixel, are skipped), written strip by strip as it
 /// is rendered, so a large image is never held whole. A bar shows the progress when stderr is a
 /// terminal (and not --quiet).
+/// The EXR's options for a render of `scene`: its header's attributes and Cryptomatte
+/// manifests, the compression and sample type the flags ask for.
+pub(super) fn exr_options(
+    scene: &scene::Scene,
+    backend_name: &str,
+    args: &RenderArgs,
+) -> output::ExrOptions {
+    output::ExrOptions {
+        compression: args.compression.unwrap_or_default(),
+        half: args.half,
+        // The flags that change nothing in the picture (--threads, -o) stay out of the
+        // header: the same render makes the same file.
+        ..output::ExrOptions::for_render(
+            scene,
+            backend_name,
+            &args.scene.display().to_string(),
+            &args
+                .overrides()
+                .into_iter()
+                .map(|(shown, _)| shown)
+                .collect::<Vec<_>>(),
+        )
+    }
+}
+
+/// Render `scene` into `path`; an EXR's options are `made` already, or made here.
 pub(super) fn render_to_file(
     scene: &scene::Scene,
     world: &render::World,
@@ -18,6 +44,7 @@ pub(super) fn render_to_file(
     format: output::Format,
     args: &RenderArgs,
     path: &Path,
+    made: Option<output::ExrOptions>,
 ) -> crate::Result<render::RenderStats> {
     use std::io::IsTerminal;
     let t1 = std::time::Instant::now();
@@ -33,21 +60,9 @@ pub(super) fn render_to_file(
     let mut stats = render::RenderStats::default();
     let written = match format {
         output::Format::Exr => {
-            let exr = output::ExrOptions {
-                compression: args.compression.unwrap_or_default(),
-                half: args.half,
-                // The flags that change nothing in the picture (--threads, -o) stay out of the
-                // header: the same render makes the same file.
-                ..output::ExrOptions::for_render(
-                    scene,
-                    backend_name,
-                    &args.scene.display().to_string(),
-                    &args
-                        .overrides()
-                        .into_iter()
-                        .map(|(shown, _)| shown)
-                        .collect::<Vec<_>>(),
-                )
+            let exr = match made {
+                Some(exr) => exr,
+                None => exr_options(scene, backend_name, args),
             };
             let written = output::write_exr_in_strips(path, (w, h), true, &exr, |put| {
                 let strip = memory::STRIP_PIXELS;
@@ -290,8 +305,17 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
         }
     }
     let t0 = std::time::Instant::now();
-    let world = render::World::build(&scene, backend.as_ref())?;
-    let build_time = t0.elapsed();
+    // The EXR's header (the render id hashes the whole scene; 100,000 groups' Cryptomatte
+    // names) is made on a thread of its own while the world builds, mostly on one core.
+    let (world, exr) = std::thread::scope(|s| {
+        let exr = (format == output::Format::Exr)
+            .then(|| s.spawn(|| exr_options(&scene, &backend_name, args)));
+        let world = render::World::build(&scene, backend.as_ref());
+        let build_time = t0.elapsed();
+        let exr = exr.map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));
+        (world.map(|w| (w, build_time)), exr)
+    });
+    let (world, build_time) = world?;
     // Into a folder that does not exist yet, as a film's frames go.
     if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| {
@@ -301,7 +325,15 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
             )
         })?;
     }
-    let mut stats = render_to_file(&scene, &world, &backend_name, format, args, &args.output)?;
+    let mut stats = render_to_file(
+        &scene,
+        &world,
+        &backend_name,
+        format,
+        args,
+        &args.output,
+        exr,
+    )?;
     stats.build_time = build_time;
     warn_nonfinite(&stats, args.quiet);
     if !args.quiet {
