@@ -185,12 +185,13 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     };
     let textures = textures(&root)?;
     let (mut materials, material_ids) = materials(&root, &textures)?;
-    let mut groups: Vec<Group> = Vec::new();
+    let group_tables = root.tables("group")?;
+    // Sized for a group each (a worldline's segments and a glTF file's nodes may add more).
+    let mut groups: Vec<Group> = Vec::with_capacity(group_tables.len());
     let mut objects = Vec::new();
     let mut total: u64 = 0;
-    let mut group_names = std::collections::HashSet::new();
+    let mut group_names = hashbrown::HashSet::with_capacity(group_tables.len());
     let mut imports = gltf_object::Imports::default();
-    let group_tables = root.tables("group")?;
     let mut meshes = super::shared_meshes::SharedMeshes::scan(&group_tables)?;
     for t in &group_tables {
         let name = t.req_string("name")?;

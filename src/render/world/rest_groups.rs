@@ -54,8 +54,8 @@ impl RestGroups {
         // Which scene groups share a rest frame and the times they are seen at, in file order.
         // An accelerated segment is never merged (its key holds its index).
         type Key = ([u64; 4], Option<[u64; 10]>, Option<usize>);
-        type Set = (Velocity, Option<Box<Window>>, Vec<usize>);
-        let mut sets: Vec<Set> = Vec::new();
+        type Set = (Velocity, Option<Box<Window>>, smallvec::SmallVec<[usize; 1]>);
+        let mut sets: Vec<Set> = Vec::with_capacity(scene.groups.len());
         // Sized for every group at once: 100,000 groups otherwise pay for the map's regrowth.
         let mut index: hashbrown::HashMap<Key, usize> =
             hashbrown::HashMap::with_capacity(scene.groups.len());
@@ -73,7 +73,7 @@ impl RestGroups {
                 Some(&k) => sets[k].2.push(i),
                 None => {
                     index.insert(key, sets.len());
-                    sets.push((v, g.window.clone(), vec![i]));
+                    sets.push((v, g.window.clone(), smallvec::smallvec![i]));
                 }
             }
         }
