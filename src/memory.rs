@@ -29,10 +29,18 @@ pub(crate) const BYTES_PER_SCENE_VALUE: u64 = 192;
 /// What reading `text` as a scene costs at most: its bytes, and a value for each `,`, `[`, `{`
 /// and `=` (every value of TOML follows one; comments and strings only make it more).
 pub(crate) fn scene_bytes(text: &[u8]) -> u64 {
-    let values = text
-        .iter()
-        .filter(|b| matches!(b, b',' | b'[' | b'{' | b'='))
-        .count() as u64;
+    // In chunks whose counts fit a u32, a form the compiler turns into vector compares (a
+    // 26 MB scene took 55 ms byte by byte).
+    let values: u64 = text
+        .chunks(1 << 16)
+        .map(|c| {
+            let n: u32 = c
+                .iter()
+                .map(|&b| u32::from(matches!(b, b',' | b'[' | b'{' | b'=')))
+                .sum();
+            u64::from(n)
+        })
+        .sum();
     (text.len() as u64)
         .saturating_mul(BYTES_PER_SCENE_BYTE)
         .saturating_add(values.saturating_mul(BYTES_PER_SCENE_VALUE))
