@@ -91,7 +91,7 @@ pub(crate) fn reach_box(rest: &Aabb, v: &Velocity, light: DVec3, t_a: f64, t_b: 
 }
 
 /// From this many groups on, a slice's boxes are worked out on every thread.
-const PIECES_FROM: usize = 8192;
+const PIECES_FROM: usize = 1024;
 
 /// `piece` of the runs of 0..n, joined in order: for long runs on every thread, one run each.
 ///
