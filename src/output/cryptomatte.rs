@@ -10,12 +10,58 @@ use super::Attribute;
 use crate::render::{Mattes, MATTE_RANKS};
 
 /// The name of each object and material, by index, for the mattes' manifests.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default)]
 pub struct MatteNames {
     /// Each `[[group.object]]`'s name, in file order.
     pub objects: Vec<String>,
     /// Each material's name, by index.
     pub materials: Vec<String>,
+    /// What [`MatteNames::made`] makes from the names, kept.
+    made: std::sync::OnceLock<[Made; 2]>,
+}
+
+/// Names are equal when their names are (whether their ids are made yet does not count).
+impl PartialEq for MatteNames {
+    fn eq(&self, other: &MatteNames) -> bool {
+        (&self.objects, &self.materials) == (&other.objects, &other.materials)
+    }
+}
+
+/// A layer's ids by index + 1 ([`id_table`]) and its header attributes (the manifest), made
+/// from the names alone: once, for the header and the blocks alike.
+#[derive(Clone, Debug)]
+pub(crate) struct Made {
+    /// The layer's name ([`LAYERS`]).
+    pub layer: &'static str,
+    pub ids: Vec<f32>,
+    pub attributes: Vec<(String, Attribute)>,
+}
+
+impl MatteNames {
+    /// The names of the objects and the materials, by index.
+    pub fn new(objects: Vec<String>, materials: Vec<String>) -> MatteNames {
+        MatteNames {
+            objects,
+            materials,
+            made: Default::default(),
+        }
+    }
+
+    /// Each layer's ([`LAYERS`]) ids and attributes, made on first use (100,000 objects'
+    /// hashes and manifest take a tenth of a second: a render makes them beside its build).
+    pub(crate) fn made(&self) -> &[Made; 2] {
+        self.made.get_or_init(|| {
+            [(LAYERS[0], &self.objects), (LAYERS[1], &self.materials)].map(|(layer, names)| {
+                let ids = id_table(names);
+                let attributes = attributes(layer, names, &ids);
+                Made {
+                    layer,
+                    ids,
+                    attributes,
+                }
+            })
+        })
+    }
 }
 
 /// MurmurHash3, 32 bits, seed 0, of `name`'s UTF-8 bytes.
@@ -57,17 +103,15 @@ pub(crate) fn id_table(names: &[String]) -> Vec<f32> {
         .collect()
 }
 
-/// The channels and header attributes of one kind of matte (`layer`, e.g. `CryptoObject`),
-/// `pick` choosing the ranks from a pixel's mattes and `names` naming each index (ids are
-/// index + 1).
-pub fn layer(
-    layer: &str,
+/// The channels and header attributes of one kind of matte (`made`: its ids and attributes,
+/// from [`MatteNames::made`]), `pick` choosing the ranks from a pixel's mattes.
+pub(crate) fn layer(
     mattes: &[Mattes],
     pick: Pick,
-    names: &[String],
+    made: &Made,
 ) -> (Channels, Vec<(String, Attribute)>) {
     use rayon::prelude::*;
-    let ids = id_table(names);
+    let (ids, layer) = (&made.ids, made.layer);
     // Column c holds rank c / 2's id (c even) or share (c odd): RGBA of level c / 4. The
     // columns are made in parallel, each in one pass over the pixels.
     let channels = (0..2 * MATTE_RANKS)
@@ -85,26 +129,83 @@ pub fn layer(
             (channel_name(layer, c), values)
         })
         .collect();
-    let manifest: serde_json::Map<String, serde_json::Value> = names
-        .iter()
-        .zip(&ids[1..])
-        .map(|(n, i)| (n.clone(), format!("{:08x}", i.to_bits()).into()))
-        .collect();
+    (channels, made.attributes.clone())
+}
+
+/// The header attributes of `layer` whose `names` have `ids` (by index + 1): its name, hash,
+/// conversion and manifest, under `cryptomatte/<key>/`.
+fn attributes(layer: &str, names: &[String], ids: &[f32]) -> Vec<(String, Attribute)> {
     let key = &format!("{:08x}", murmur3(layer))[..7];
     let attr =
         |field: &str, value: String| (format!("cryptomatte/{key}/{field}"), Attribute::Text(value));
-    let attributes = vec![
+    vec![
         attr("name", layer.into()),
         attr("hash", "MurmurHash3_32".into()),
         attr("conversion", "uint32_to_float32".into()),
-        attr("manifest", serde_json::Value::Object(manifest).to_string()),
-    ];
-    (channels, attributes)
+        attr("manifest", manifest(names, ids)),
+    ]
+}
+
+/// The manifest: a JSON object from each name to its id's bits in hexadecimal, in the order
+/// of the names' bytes, each name once (as a `serde_json::Map` writes it, without a map of
+/// 100,000 entries on the way).
+fn manifest(names: &[String], ids: &[f32]) -> String {
+    let mut pairs: Vec<(&str, u32)> = names
+        .iter()
+        .map(String::as_str)
+        .zip(ids[1..].iter().map(|i| i.to_bits()))
+        .collect();
+    // One name has one id, so which of its entries is kept does not matter.
+    pairs.sort_unstable_by(|a, b| a.0.cmp(b.0));
+    pairs.dedup_by(|a, b| a.0 == b.0);
+    let mut json = Vec::with_capacity(pairs.iter().map(|p| p.0.len() + 14).sum::<usize>() + 2);
+    json.push(b'{');
+    for (k, (name, bits)) in pairs.iter().enumerate() {
+        if k > 0 {
+            json.push(b',');
+        }
+        serde_json::to_writer(&mut json, name).expect("a string is written to memory");
+        json.extend_from_slice(format!(":\"{bits:08x}\"").as_bytes());
+    }
+    json.push(b'}');
+    String::from_utf8(json).expect("JSON of UTF-8 names")
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The manifest is the JSON a `serde_json::Map` of the names writes, byte for byte: names
+    /// in byte order, escaped, each once.
+    #[test]
+    fn the_manifest_is_serde_jsons() {
+        let names: Vec<String> = [
+            "cube",
+            "floor",
+            "a \"quoted\" \\ name",
+            "tab\there",
+            "\u{1}",
+            "雪",
+            "cube",
+            "",
+            "Zed",
+            "zed",
+            "é",
+        ]
+        .map(String::from)
+        .to_vec();
+        let ids = id_table(&names);
+        let map: serde_json::Map<String, serde_json::Value> = names
+            .iter()
+            .zip(&ids[1..])
+            .map(|(n, i)| (n.clone(), format!("{:08x}", i.to_bits()).into()))
+            .collect();
+        assert_eq!(
+            manifest(&names, &ids),
+            serde_json::Value::Object(map).to_string()
+        );
+        assert_eq!(manifest(&[], &[0.0]), "{}");
+    }
 
     #[test]
     fn murmur3_matches_the_reference_and_ids_are_ordinary_floats() {

@@ -92,9 +92,7 @@ impl Layout {
             .iter()
             .map(|c| Some((source(&c.name.to_string(), names.is_some())?, c.sample_type)))
             .collect::<Option<_>>()?;
-        let ids = names.map_or_else(Default::default, |n| {
-            [&n.objects, &n.materials].map(|names| cryptomatte::id_table(names))
-        });
+        let ids = names.map_or_else(Default::default, |n| n.made().clone().map(|m| m.ids));
         Some(Layout { columns, ids })
     }
 
@@ -308,10 +306,10 @@ mod tests {
             p.material_id = f().abs() as u32;
             p.primitive_id = f().abs() as u32;
         }
-        let names = MatteNames {
-            objects: (0..5).map(|i| format!("object {i}")).collect(),
-            materials: vec!["white".into(), "red".into()],
-        };
+        let names = MatteNames::new(
+            (0..5).map(|i| format!("object {i}")).collect(),
+            vec!["white".into(), "red".into()],
+        );
         frame.mattes = (0..w * h)
             .map(|i| Mattes {
                 object: std::array::from_fn(|r| ((i + r) as u32 % 6, r as f32 / 7.0)),

@@ -70,12 +70,9 @@ pub(super) fn channels(
     let mut extra = Vec::new();
     let mattes = mattes && options.passes.has(Pass::Cryptomatte);
     if let (Some(names), true) = (&options.mattes, mattes) {
-        let kinds: [(&str, cryptomatte::Pick, &[String]); 2] = [
-            (cryptomatte::LAYERS[0], |m| &m.object, &names.objects),
-            (cryptomatte::LAYERS[1], |m| &m.material, &names.materials),
-        ];
-        for (layer, pick, names) in kinds {
-            let (channels, attributes) = cryptomatte::layer(layer, &frame.mattes, pick, names);
+        let picks: [cryptomatte::Pick; 2] = [|m| &m.object, |m| &m.material];
+        for (pick, made) in picks.into_iter().zip(names.made()) {
+            let (channels, attributes) = cryptomatte::layer(&frame.mattes, pick, made);
             // Ids are bit patterns: always full float.
             list.extend(
                 channels

@@ -225,7 +225,7 @@ pub(crate) fn matte_names(scene: &Scene) -> MatteNames {
         })
         .collect();
     let materials = scene.materials.iter().map(|m| m.name.clone()).collect();
-    MatteNames { objects, materials }
+    MatteNames::new(objects, materials)
 }
 
 #[cfg(test)]

@@ -121,9 +121,12 @@ impl ExrOptions {
         scene_file: &str,
         overrides: &[String],
     ) -> ExrOptions {
+        let names = header::matte_names(scene);
+        // The mattes' ids and manifests now, where a render makes its header beside its build.
+        names.made();
         ExrOptions {
             attributes: header::attributes(scene, backend, scene_file, overrides),
-            mattes: Some(header::matte_names(scene)),
+            mattes: Some(names),
             placement: Placement::of(&scene.image),
             passes: scene.image.passes,
             ..Default::default()
