@@ -31,8 +31,9 @@ as whole commands, the latter the fastest of three on each backend):
 - **build s**: building the acceleration structures; **render s**: a full render (shading,
   shadow and secondary rays, passes), the fastest of as many runs as fit in a quarter second
   after a warm-up; **primary Mrays/s**: tracing primary rays alone, through the renderer's own
-  tiles and packets; **whole s**: what the command takes, load (parsing or generating the
-  scene) + build + the first render + writing the file as `render` writes it (an EXR with every
+  tiles and packets; **whole s**: what the command takes, load (reading the scene: for a
+  scene the bench generates, its parse, not the writing of its text) + build + the first
+  render + writing the file as `render` writes it (an EXR with every
   pass, a PNG for colour-only settings); **peak MiB**: the process's resident memory during
   the row's build and renders. It starts from what the process holds already, the heap the
   allocator kept from earlier rows included (since the bench writes a file per row, about an

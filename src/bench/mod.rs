@@ -79,8 +79,12 @@ pub(crate) struct Case {
     /// A scene measured beside this one (`beside`), with what it is: the same boxes in one
     /// group beside many groups, or the same scene with the Doppler and searchlight effects off.
     pub beside: Option<(String, Scene)>,
-    /// How long making the scene took (set by `run`: making the case, less the scene beside).
+    /// How long making the scene took (set by `run`: making the case, less the scene beside
+    /// and the writing of a generated scene's text).
     pub load_s: f64,
+    /// How long writing the scene's text took, where the bench generates it (`written_in`):
+    /// a command reads a file instead.
+    pub text_s: f64,
     /// How long making the scene beside took (`beside`).
     pub beside_load_s: f64,
 }
@@ -96,8 +100,15 @@ impl Case {
             hi_reference: true,
             beside: None,
             load_s: 0.0,
+            text_s: 0.0,
             beside_load_s: 0.0,
         }
+    }
+    /// The scene's text was written in `text_s` seconds before it was read (a generated
+    /// scene): the row's load leaves that out.
+    pub fn written_in(mut self, text_s: f64) -> Case {
+        self.text_s = text_s;
+        self
     }
     /// Measure the scene `load` makes, which is `what`, beside this case (`beside`). Its load
     /// is timed apart: the row's load is its own scene's.
@@ -528,7 +539,7 @@ pub(crate) fn run(
         progress(&lazy.name);
         let t = Instant::now();
         let mut case = lazy.build()?;
-        case.load_s = t.elapsed().as_secs_f64() - case.beside_load_s;
+        case.load_s = t.elapsed().as_secs_f64() - case.beside_load_s - case.text_s;
         // The scene beside was made within the case's making (never before: `LazyCase::ready`
         // cases have none).
         debug_assert!(case.load_s >= 0.0, "a scene beside made outside its case");

@@ -41,6 +41,24 @@ pub(crate) fn many_groups(
     one_group: bool,
     size: u32,
 ) -> Result<crate::scene::Scene, SceneError> {
+    many_groups_timed(n, one_group, size).map(|(scene, _)| scene)
+}
+
+/// [`many_groups`], and how long writing its text took: a bench-made scene's cost that a
+/// command, reading a file, does not pay (the row's load leaves it out, `Case::written_in`).
+pub(crate) fn many_groups_timed(
+    n: usize,
+    one_group: bool,
+    size: u32,
+) -> Result<(crate::scene::Scene, f64), SceneError> {
+    let t = std::time::Instant::now();
+    let s = many_groups_text(n, one_group, size);
+    let text_s = t.elapsed().as_secs_f64();
+    Ok((load_str(&format!("many-groups-{n}"), &s, &[])?, text_s))
+}
+
+/// The text of [`many_groups`].
+fn many_groups_text(n: usize, one_group: bool, size: u32) -> String {
     let mut r = Rng(2024);
     let mut s = format!(
         "[camera]\nposition = [0, -120, 0]\nlook_at = [0, 0, 0]\nfov_y = 50\ntime = 120\n[image]\nwidth = {size}\nheight = {size}\n\
@@ -81,7 +99,7 @@ pub(crate) fn many_groups(
             c[2] + h
         );
     }
-    load_str(&format!("many-groups-{n}"), &s, &[])
+    s
 }
 
 /// The 11 × 11 bars, each bar its own group, all at one velocity (merging makes them one).
@@ -440,12 +458,14 @@ fn group_cases(quick: bool, px: u32, out: &mut Vec<LazyCase>) {
     out.push(LazyCase::new(
         &format!("{top} boxes in 1 group"),
         move || {
+            let (scene, text_s) = many_groups_timed(top, true, gpx)?;
             Ok(Case::new(
                 &format!("{top} boxes in 1 group"),
-                many_groups(top, true, gpx)?,
+                scene,
                 &["embree", "bvh"],
             )
-            .without_hi_reference())
+            .without_hi_reference()
+            .written_in(text_s))
         },
     ));
     for g in many[1..].iter().copied() {
@@ -457,13 +477,11 @@ fn group_cases(quick: bool, px: u32, out: &mut Vec<LazyCase>) {
                 } else {
                     &["embree", "bvh"]
                 };
-                Case::new(
-                    &format!("{g} boxes in {g} groups"),
-                    many_groups(g, false, gpx)?,
-                    settings,
-                )
-                .without_hi_reference()
-                .beside("the same boxes in one group", || many_groups(g, true, gpx))
+                let (scene, text_s) = many_groups_timed(g, false, gpx)?;
+                Case::new(&format!("{g} boxes in {g} groups"), scene, settings)
+                    .without_hi_reference()
+                    .written_in(text_s)
+                    .beside("the same boxes in one group", || many_groups(g, true, gpx))
             },
         ));
     }
@@ -471,8 +489,10 @@ fn group_cases(quick: bool, px: u32, out: &mut Vec<LazyCase>) {
     if !quick {
         let name = "100000 boxes in 100000 groups at 1024^2";
         out.push(LazyCase::new(name, move || {
-            Case::new(name, many_groups(100_000, false, 1024)?, &["embree"])
+            let (scene, text_s) = many_groups_timed(100_000, false, 1024)?;
+            Case::new(name, scene, &["embree"])
                 .without_hi_reference()
+                .written_in(text_s)
                 .beside("the same boxes in one group", || {
                     many_groups(100_000, true, 1024)
                 })
