@@ -31,8 +31,8 @@ as whole commands, the latter the fastest of three on each backend):
 - **build s**: building the acceleration structures; **render s**: a full render (shading,
   shadow and secondary rays, passes), the fastest of as many runs as fit in a quarter second
   after a warm-up; **primary Mrays/s**: tracing primary rays alone, through the renderer's own
-  tiles and packets; **whole s**: what the command takes, load (reading the scene: for a
-  scene the bench generates, its parse, not the writing of its text) + build + the first
+  tiles and packets; **whole s**: what the command takes, load (reading the scene: for the
+  many-group scenes the bench generates, their parse, not the writing of their text) + build + the first
   render + writing the file as `render` writes it (an EXR with every
   pass, a PNG for colour-only settings); **peak MiB**: the process's resident memory during
   the row's build and renders. It starts from what the process holds already, the heap the

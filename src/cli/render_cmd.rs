@@ -7,10 +7,6 @@ use crate::render::Passes;
 use crate::{accel, memory, output, render, scene, Error};
 use std::path::{Path, PathBuf};
 
-/// Render to `args.output`: an EXR with every pass, whole; a PNG with colour alone (the passes,
-/// and with several samples their extra ray per pixel, are skipped), written strip by strip as it
-/// is rendered, so a large image is never held whole. A bar shows the progress when stderr is a
-/// terminal (and not --quiet).
 /// The EXR's options for a render of `scene`: its header's attributes and Cryptomatte
 /// manifests, the compression and sample type the flags ask for.
 pub(super) fn exr_options(
@@ -36,7 +32,11 @@ pub(super) fn exr_options(
     }
 }
 
-/// Render `scene` into `path`; an EXR's options are `made` already, or made here.
+/// Render `scene` to `path`: an EXR with every pass, whole; a PNG with colour alone (the passes,
+/// and with several samples their extra ray per pixel, are skipped), written strip by strip as it
+/// is rendered, so a large image is never held whole. A bar shows the progress when stderr is a
+/// terminal (and not --quiet).
+/// An EXR's options are `made` already, or made here.
 pub(super) fn render_to_file(
     scene: &scene::Scene,
     world: &render::World,
@@ -308,8 +308,8 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     // The EXR's header (the render id hashes the whole scene; 100,000 groups' Cryptomatte
     // names) is made on a thread of its own while the world builds, mostly on one core.
     let (world, exr) = std::thread::scope(|s| {
-        let exr = (format == output::Format::Exr)
-            .then(|| s.spawn(|| exr_options(&scene, &backend_name, args)));
+        let beside = format == output::Format::Exr && rayon::current_num_threads() > 1;
+        let exr = beside.then(|| s.spawn(|| exr_options(&scene, &backend_name, args)));
         let world = render::World::build(&scene, backend.as_ref());
         let build_time = t0.elapsed();
         let exr = exr.map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));

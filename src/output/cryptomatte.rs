@@ -13,9 +13,9 @@ use crate::render::{Mattes, MATTE_RANKS};
 #[derive(Clone, Debug, Default)]
 pub struct MatteNames {
     /// Each `[[group.object]]`'s name, in file order.
-    pub objects: Vec<String>,
+    objects: Vec<String>,
     /// Each material's name, by index.
-    pub materials: Vec<String>,
+    materials: Vec<String>,
     /// What [`MatteNames::made`] makes from the names, kept.
     made: std::sync::OnceLock<[Made; 2]>,
 }

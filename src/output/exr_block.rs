@@ -92,7 +92,9 @@ impl Layout {
             .iter()
             .map(|c| Some((source(&c.name.to_string(), names.is_some())?, c.sample_type)))
             .collect::<Option<_>>()?;
-        let ids = names.map_or_else(Default::default, |n| n.made().clone().map(|m| m.ids));
+        let ids = names.map_or_else(Default::default, |n| {
+            n.made().each_ref().map(|m| m.ids.clone())
+        });
         Some(Layout { columns, ids })
     }
 

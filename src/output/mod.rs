@@ -123,7 +123,9 @@ impl ExrOptions {
     ) -> ExrOptions {
         let names = header::matte_names(scene);
         // The mattes' ids and manifests now, where a render makes its header beside its build.
-        names.made();
+        if scene.image.passes.has(crate::scene::Pass::Cryptomatte) {
+            names.made();
+        }
         ExrOptions {
             attributes: header::attributes(scene, backend, scene_file, overrides),
             mattes: Some(names),

@@ -31,10 +31,13 @@ pub struct TomlError {
 /// A long file of many `[[group]]` tables is read in runs on every thread where it can be
 /// (toml_runs.rs); the tree is the same either way.
 pub(crate) fn parse_document(text: &str, lines: &Lines) -> Result<Node, TomlError> {
-    let threads = rayon::current_num_threads();
-    if threads > 1 && text.len() >= super::toml_runs::RUNS_FROM {
-        if let Some(root) = super::toml_runs::in_runs(text, lines, 4 * threads) {
-            return Ok(root);
+    // The length first: asking for the thread count starts rayon's pool.
+    if text.len() >= super::toml_runs::RUNS_FROM {
+        let threads = rayon::current_num_threads();
+        if threads > 1 {
+            if let Some(root) = super::toml_runs::in_runs(text, lines, 4 * threads) {
+                return Ok(root);
+            }
         }
     }
     parse_part(text, lines, 0)

@@ -102,9 +102,18 @@ fn same(a: &Node, b: &Node) -> bool {
     }
 }
 
-/// Both read `text` to the same tree, or both refuse it.
+/// Both read `text` to the same tree, or both refuse it; and where the file read in runs
+/// (scene/toml_runs.rs, used for long files) gives a tree, it is ours.
 fn agree(text: &str) -> Result<bool, String> {
-    let ours = parse_document(text, &Lines::new(text));
+    let lines = Lines::new(text);
+    let ours = parse_document(text, &lines);
+    for runs in [2, 3, 7] {
+        if let Some(tree) = crate::scene::toml_runs::in_runs(text, &lines, runs) {
+            if ours.as_ref().ok() != Some(&tree) {
+                return Err(format!("read in {runs} runs to another tree:\n{text}"));
+            }
+        }
+    }
     match (ours, reference(text)) {
         (Ok(a), Some(b)) if same(&a, &b) => Ok(true),
         (Err(_), None) => Ok(false),
