@@ -54,7 +54,11 @@ impl RestGroups {
         // Which scene groups share a rest frame and the times they are seen at, in file order.
         // An accelerated segment is never merged (its key holds its index).
         type Key = ([u64; 4], Option<[u64; 10]>, Option<usize>);
-        type Set = (Velocity, Option<Box<Window>>, smallvec::SmallVec<[usize; 1]>);
+        type Set = (
+            Velocity,
+            Option<Box<Window>>,
+            smallvec::SmallVec<[usize; 1]>,
+        );
         let mut sets: Vec<Set> = Vec::with_capacity(scene.groups.len());
         // Sized for every group at once: 100,000 groups otherwise pay for the map's regrowth.
         let mut index: hashbrown::HashMap<Key, usize> =
