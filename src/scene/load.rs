@@ -193,6 +193,20 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
     let mut group_names = hashbrown::HashSet::with_capacity(group_tables.len());
     let mut imports = gltf_object::Imports::default();
     let mut meshes = super::shared_meshes::SharedMeshes::scan(&group_tables)?;
+    // Many groups of plain objects are read on every thread (scene/many_groups.rs); where
+    // that cannot give what the loop below gives, the loop reads them (fresh tables).
+    let group_tables = match super::many_groups::plain(&group_tables) {
+        Some(counts) => {
+            match super::many_groups::read(group_tables, &counts, &material_ids, &materials) {
+                Some(read) => {
+                    (groups, objects, total) = read;
+                    Vec::new()
+                }
+                None => root.tables("group")?,
+            }
+        }
+        None => group_tables,
+    };
     for t in &group_tables {
         let name = t.req_string("name")?;
         if !group_names.insert(name.to_string()) {
@@ -204,7 +218,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
             name,
             ids,
             &mut materials,
-            &mut objects,
+            (&mut objects, 0),
             index,
             &mut total,
             &mut imports,
@@ -316,13 +330,15 @@ fn materials(
 /// `objects`; `total` counts the scene's primitives. A group with a worldline of several
 /// segments is a group per segment; a glTF file's top-level nodes that are groups of their own
 /// (`groups = "nodes"`, or keyframed) follow, named `<name>/<node>`.
+/// `objects` takes the group's objects, whose ids start at the second number plus the
+/// objects already in it.
 #[allow(clippy::too_many_arguments)]
-fn group(
+pub(super) fn group(
     t: &Table,
     name: &str,
     material_ids: &HashMap<String, u32>,
     materials: &mut Vec<Material>,
-    objects: &mut Vec<ObjectInfo>,
+    (objects, id_base): (&mut Vec<ObjectInfo>, usize),
     index: usize,
     total: &mut u64,
     imports: &mut gltf_object::Imports,
@@ -338,7 +354,7 @@ fn group(
     let entries = t.tables("object")?;
     let mut own_groups = Vec::new();
     for (k, o) in entries.iter().enumerate() {
-        let id = objects.len() as u32;
+        let id = (id_base + objects.len()) as u32;
         let (first, implicit, parts) = (
             geometry.prims.len(),
             geometry.implicit.len(),
@@ -418,7 +434,7 @@ fn group(
                     format!("two top-level nodes are named `{}`: each is a group of its own, `{name}/{}`, and groups need names of their own (rename one in the file)", g.node, g.node),
                 ));
             }
-            let id = objects.len() as u32;
+            let id = (id_base + objects.len()) as u32;
             let mut geometry = Geometry::default();
             let (geo, chosen) = (&mut geometry, chosen.clone());
             add_mesh_data(o, id, mat, place, geo, total, g.mesh, chosen, material_ids)?;

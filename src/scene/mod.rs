@@ -14,6 +14,7 @@ mod model;
 mod node;
 mod objects;
 // Only the bench and the tests load the paper's scenes by name.
+mod many_groups;
 #[cfg(any(test, feature = "cli"))]
 pub(crate) mod paper;
 mod pass_set;

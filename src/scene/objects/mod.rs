@@ -82,6 +82,12 @@ fn material_ref(
     }
 }
 
+/// Whether a scene of `total` primitives passes [`budget`]'s checks.
+pub(crate) fn within_budget(total: u64) -> bool {
+    let need = total.saturating_mul(crate::memory::BYTES_PER_PRIMITIVE);
+    total <= MAX_PRIMITIVES && crate::memory::too_much(need, "").is_none()
+}
+
 pub(super) fn budget(t: &Table, key: &str, total: &mut u64, add: u64) -> SceneResult<()> {
     *total = total.saturating_add(add);
     if *total > MAX_PRIMITIVES {
