@@ -150,6 +150,7 @@ fn attributes(layer: &str, names: &[String], ids: &[f32]) -> Vec<(String, Attrib
 /// of the names' bytes, each name once (as a `serde_json::Map` writes it, without a map of
 /// 100,000 entries on the way).
 fn manifest(names: &[String], ids: &[f32]) -> String {
+    use std::io::Write as _;
     let mut pairs: Vec<(&str, u32)> = names
         .iter()
         .map(String::as_str)
@@ -165,7 +166,7 @@ fn manifest(names: &[String], ids: &[f32]) -> String {
             json.push(b',');
         }
         serde_json::to_writer(&mut json, name).expect("a string is written to memory");
-        json.extend_from_slice(format!(":\"{bits:08x}\"").as_bytes());
+        write!(json, ":\"{bits:08x}\"").expect("written to memory");
     }
     json.push(b'}');
     String::from_utf8(json).expect("JSON of UTF-8 names")

@@ -330,8 +330,8 @@ fn materials(
 /// `objects`; `total` counts the scene's primitives. A group with a worldline of several
 /// segments is a group per segment; a glTF file's top-level nodes that are groups of their own
 /// (`groups = "nodes"`, or keyframed) follow, named `<name>/<node>`.
-/// `objects` takes the group's objects, whose ids start at the second number plus the
-/// objects already in it.
+/// An object's id is the number beside `objects` (the ids before a list that starts
+/// mid-scene, scene/many_groups.rs) plus the objects already in the list.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn group(
     t: &Table,

@@ -105,7 +105,10 @@ pub(super) fn read(
                 }
                 groups.extend(made);
             }
-            (mats.len() == materials.len()).then_some((groups, objects, total))
+            // The ids counted beforehand are the ids given: one object a table.
+            let counted: usize = counts[first..first + run.len()].iter().sum();
+            (mats.len() == materials.len() && objects.len() == counted)
+                .then_some((groups, objects, total))
         })
         .collect();
     let (mut groups, mut objects, mut total) = (Vec::with_capacity(n), Vec::new(), 0u64);

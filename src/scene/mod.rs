@@ -9,12 +9,12 @@ mod gltf_file;
 mod gltf_object;
 mod lights;
 mod load;
+mod many_groups;
 mod mesh_file;
 mod model;
 mod node;
 mod objects;
 // Only the bench and the tests load the paper's scenes by name.
-mod many_groups;
 #[cfg(any(test, feature = "cli"))]
 pub(crate) mod paper;
 mod pass_set;

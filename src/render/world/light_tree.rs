@@ -177,6 +177,14 @@ impl LightTree {
         }
     }
 
+    /// The reach boxes of `members` for emission times in `(t_a, t_b)`, in their order.
+    fn boxes(&self, members: &[u32], (t_a, t_b): (f64, f64)) -> Vec<Aabb> {
+        let reach = self.reach(t_a, t_b);
+        in_pieces(members.len(), |run| {
+            run.map(|i| reach(members[i])).collect()
+        })
+    }
+
     /// Slice k's emission times.
     fn span(&self, k: usize) -> (f64, f64) {
         let t_a = self.t_first + k as f64 * self.width;
@@ -227,11 +235,7 @@ impl LightTree {
                     }
                     None => Vec::new(),
                 };
-                let (t_a, t_b) = self.span(middle);
-                let reach = self.reach(t_a, t_b);
-                let boxes = in_pieces(members.len(), |run| {
-                    run.map(|i| reach(members[i])).collect()
-                });
+                let boxes = self.boxes(&members, self.span(middle));
                 Ok(Shape {
                     tree: (self.cullers)(&boxes)?,
                     members,
@@ -244,12 +248,7 @@ impl LightTree {
         }
         let tree = self.slices[k]
             .get_or_init(|| {
-                let (t_a, t_b) = self.span(k);
-                let reach = self.reach(t_a, t_b);
-                let members = &shape.members;
-                let boxes = in_pieces(members.len(), |run| {
-                    run.map(|i| reach(members[i])).collect()
-                });
+                let boxes = self.boxes(&shape.members, self.span(k));
                 match shape.tree.refitted(&mut |i: u32| boxes[i as usize]) {
                     Some(t) => Ok(t),
                     None => (self.cullers)(&boxes),
