@@ -62,8 +62,12 @@ impl Spin {
     /// Where the body's point now (group time `t`) at `p` was at its epoch, by which textures
     /// stay painted on the turning body: `p` turned back by ω (t − epoch).
     pub fn unturned(&self, p: DVec3, t: f64) -> DVec3 {
-        let back = glam::DQuat::from_axis_angle(self.axis, -self.omega * (t - self.epoch));
-        self.centre + back * (p - self.centre)
+        self.centre + self.back(t) * (p - self.centre)
+    }
+
+    /// The turn that takes the body as it stands at group time `t` back to its epoch.
+    pub fn back(&self, t: f64) -> glam::DQuat {
+        glam::DQuat::from_axis_angle(self.axis, -self.omega * (t - self.epoch))
     }
 
     /// A direction of the shape at its epoch as it points at group time `t`.

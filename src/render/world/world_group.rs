@@ -128,7 +128,7 @@ impl WorldGroup {
     pub(super) fn occluded_as(&self, rays: &[Ray], out: &mut [bool], scattered: bool) {
         if let Some(parts) = &self.turning {
             for (r, o) in rays.iter().zip(out.iter_mut()) {
-                *o = turning::intersect(&self.geometry, parts, r, self.turn_time).is_some();
+                *o = turning::occluded(&self.geometry, parts, r, self.turn_time);
             }
             return;
         }
