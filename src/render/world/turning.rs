@@ -397,6 +397,23 @@ impl Along {
     }
 }
 
+/// Where the ray is within the ball about the spin's centre that holds the part at every
+/// turn: between the roots of a quadratic in t, or None.
+fn swept_ball(part: &TurningPart, ray: &Ray) -> Option<(f64, f64)> {
+    let oc = ray.origin - part.spin.centre;
+    let (a, b, c) = (
+        ray.dir.length_squared(),
+        oc.dot(ray.dir),
+        oc.length_squared() - part.reach * part.reach,
+    );
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    let root = disc.sqrt();
+    Some(((-b - root) / a, (-b + root) / a))
+}
+
 /// Sphere tracing through one turning part, within the ball it sweeps, a primitive at a time:
 /// each where the ray's height, distance from the axis and turned-back angle can reach it,
 /// stepping by its own distance over a bound on how fast that distance changes there.
@@ -410,19 +427,8 @@ fn march(
 ) -> Option<Hit> {
     let sp = &part.spin;
     let s = ray.len;
-    // The ball about the centre that holds the part at every turn.
     let oc = ray.origin - sp.centre;
-    let (a, b, c) = (
-        ray.dir.length_squared(),
-        oc.dot(ray.dir),
-        oc.length_squared() - part.reach * part.reach,
-    );
-    let disc = b * b - a * c;
-    if disc < 0.0 {
-        return None;
-    }
-    let root = disc.sqrt();
-    let (enter, leave) = ((-b - root) / a, (-b + root) / a);
+    let (enter, leave) = swept_ball(part, ray)?;
     let (mut t, mut end) = (enter.max(ray.tmin), leave.min(tmax));
     // Height along the axis and distance from it do not change as the body turns: along the
     // ray the first is linear and the second's square quadratic, so the march is kept to
@@ -689,22 +695,9 @@ mod tests {
     /// the union's distance over its Lipschitz bound for the whole reach. Slow and plain,
     /// so the reference the per-primitive march must agree with.
     fn union_march(g: &Geometry, part: &TurningPart, ray: &Ray, t0: f64) -> Option<Hit> {
-        let sp = &part.spin;
-        let s = ray.len;
-        let oc = ray.origin - sp.centre;
-        let (a, b, c) = (
-            ray.dir.length_squared(),
-            oc.dot(ray.dir),
-            oc.length_squared() - part.reach * part.reach,
-        );
-        let disc = b * b - a * c;
-        if disc < 0.0 {
-            return None;
-        }
-        let (mut t, end) = (
-            ((-b - disc.sqrt()) / a).max(ray.tmin),
-            ((-b + disc.sqrt()) / a).min(ray.tmax),
-        );
+        let (sp, s) = (&part.spin, ray.len);
+        let (enter, leave) = swept_ball(part, ray)?;
+        let (mut t, end) = (enter.max(ray.tmin), leave.min(ray.tmax));
         let lipschitz = s * (1.0 + sp.omega.abs() * part.reach);
         let tol = 1e-10 * part.reach;
         while t < end {
