@@ -40,7 +40,7 @@ pub struct Spin {
     /// The angular velocity.
     pub omega: f64,
     /// Whether its shape turns (it is not a body of revolution about the axis): its rays are
-    /// then followed to the turning shape (render/world/turning.rs).
+    /// then followed to the turning shape (render/world/turning/).
     pub turning: bool,
     /// The group time at which the body stands as the scene file gives it: 0 from a file, moved
     /// by a spacetime translation of the scene (`Geometry::moved`).

@@ -17,7 +17,7 @@ use std::sync::Arc;
 pub(crate) const MAX_SEGMENTS: usize = 4096;
 
 /// The most primitives a group with an accelerated segment or a turning spinning body may
-/// have: each ray tries them all (render/world/accelerated.rs, render/world/turning.rs).
+/// have: each ray tries them all (render/world/accelerated.rs, render/world/turning/).
 pub(crate) const MAX_ACCELERATED_PRIMS: u32 = 4096;
 
 /// Why a group's geometry cannot take an accelerated segment, if it cannot: too many

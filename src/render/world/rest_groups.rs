@@ -27,7 +27,7 @@ pub(super) struct RestGroup {
     pub spins: bool,
     /// Its hyperbolic motion, for a segment of constant proper acceleration.
     pub accelerated: Option<crate::scene::Accelerated>,
-    /// Its turning bodies, if any (world/turning.rs).
+    /// Its turning bodies, if any (world/turning/).
     pub turning: Option<Arc<[super::TurningPart]>>,
     /// Its primitives, where it has no accelerator and is intersected one primitive at a time
     /// against lanes of rays (world/direct.rs).
