@@ -147,12 +147,9 @@ impl Primitive {
     /// triangle, which bounds nothing. It changes by at most |Δp| as p moves.
     pub fn distance(&self, p: DVec3) -> Option<f64> {
         Some(match *self {
-            Primitive::Sphere { center, radius } => (p - center).length() - radius,
-            Primitive::Capsule { a, b, radius } => {
-                let ab = b - a;
-                let h =
-                    ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-                (p - (a + h * ab)).length() - radius
+            Primitive::Sphere { .. } | Primitive::Capsule { .. } => {
+                let (off, radius) = self.core_offset(p)?;
+                off.length() - radius
             }
             Primitive::Cuboid { min, max } => {
                 let (c, h) = (0.5 * (min + max), 0.5 * (max - min));
@@ -161,6 +158,22 @@ impl Primitive {
             }
             Primitive::Triangle { .. } => return None,
         })
+    }
+
+    /// For a sphere or a rod: `p`'s offset from the nearest point of its centre (a rod's
+    /// centre segment), and its radius; its signed distance is the offset's length less the
+    /// radius, and the offset's direction the distance's gradient. None for other primitives.
+    pub fn core_offset(&self, p: DVec3) -> Option<(DVec3, f64)> {
+        match *self {
+            Primitive::Sphere { center, radius } => Some((p - center, radius)),
+            Primitive::Capsule { a, b, radius } => {
+                let ab = b - a;
+                let h =
+                    ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+                Some((p - (a + h * ab), radius))
+            }
+            _ => None,
+        }
     }
 
     /// The outward geometric normal at a point on the surface (unit).

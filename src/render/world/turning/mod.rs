@@ -140,9 +140,9 @@ fn march(
         return None;
     }
     let tol = 1e-10 * part.reach.max(1e-300);
-    let at = |t: f64| sp.unturned(ray.origin + t * ray.dir, t0 - s * t);
-    // The turned-back point and its velocity: the ray's direction turned back, and the turn's
-    // own sweep of the point at rate ω s about the axis.
+    // The turned-back point (`Spin::unturned` of the ray's point at its group time) and its
+    // velocity: the ray's direction turned back, and the turn's own sweep of the point at
+    // rate ω s about the axis.
     let moving = |t: f64| {
         let back = sp.back(t0 - s * t);
         let q = sp.centre + back * (ray.origin + t * ray.dir - sp.centre);
@@ -151,7 +151,7 @@ fn march(
     };
     // A ray that starts within the part's shape, where the march begins at its open lower
     // end, is taken to meet none of it (as by the march through the whole part).
-    if t <= ray.tmin && distance(geometry, part, at(t)).0 < tol {
+    if t <= ray.tmin && distance(geometry, part, moving(t).0).0 < tol {
         return None;
     }
     let turn = turned_angles(part, (w0, dw), s, t0, (t, end));
@@ -204,16 +204,7 @@ fn march(
 /// gradient's rate of change outside the primitive (the inverse of its radius): for spheres
 /// and rods. None for others, whose march takes plain steps.
 fn distance_and_slope(prim: &Primitive, q: DVec3) -> Option<(f64, DVec3, f64)> {
-    // The same arithmetic as `Primitive::distance`, so the same distances.
-    let (off, radius) = match *prim {
-        Primitive::Sphere { center, radius } => (q - center, radius),
-        Primitive::Capsule { a, b, radius } => {
-            let ab = b - a;
-            let h = ((q - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-            (q - (a + h * ab), radius)
-        }
-        _ => return None,
-    };
+    let (off, radius) = prim.core_offset(q)?;
     let len = off.length();
     (radius > 0.0 && len > 0.0).then(|| (len - radius, off / len, 1.0 / radius))
 }
