@@ -59,13 +59,28 @@ impl World {
         let mut hits: [Option<Hit>; CHUNK] = [None; CHUNK];
         // Each lane's lookbacks in the group's window, where it has any.
         let mut within: [Option<(f64, f64)>; CHUNK] = [None; CHUNK];
+        let latest = self.latest_emissions();
         for (rays, out) in rays.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
             let n = rays.len();
             let mut best = [f64::INFINITY; CHUNK];
             out.iter_mut().for_each(|o| *o = None);
             // What the chunk's rays span, for the groups' test in the world frame.
             let span = self.clip_rays.then(|| RaySpan::of(rays));
-            for gi in self.visiting_order() {
+            // Whether a lane found a hit since the groups left were last looked at.
+            let mut found = false;
+            for (k, gi) in self.visiting_order().enumerate() {
+                // Every lane's hit lies before any emission the groups left can show: none
+                // of them can give any lane lookbacks (`in_window` gives every lane None,
+                // since lo ≥ t − latest ≥ best ≥ hi), so they are passed over at once (a
+                // worldline's segments, once a chunk has met the later ones).
+                if std::mem::take(&mut found)
+                    && rays
+                        .iter()
+                        .zip(&best)
+                        .all(|(r, &b)| b <= r.origin.t - latest[k])
+                {
+                    break;
+                }
                 let g = &self.groups[gi];
                 // The lookbacks each ray may still meet the group at, and their hull.
                 let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -132,10 +147,30 @@ impl World {
                     if hit.lambda < best[i] {
                         best[i] = hit.lambda;
                         out[i] = Some(hit);
+                        found = true;
                     }
                 }
             }
         }
+    }
+
+    /// For each place in the visiting order, the latest world time at which the groups from
+    /// there on can emit what a ray meets: the end of their windows of world times, or +∞
+    /// where any has none (a group seen at all times, or a window in a moving frame).
+    fn latest_emissions(&self) -> smallvec::SmallVec<[f64; 16]> {
+        let order: smallvec::SmallVec<[usize; 16]> = self.visiting_order().collect();
+        let mut latest = smallvec::SmallVec::from_elem(f64::NEG_INFINITY, order.len());
+        let mut later = f64::NEG_INFINITY;
+        for (k, &gi) in order.iter().enumerate().rev() {
+            let g = &self.groups[gi];
+            let to = match (g.world_window, &g.window) {
+                (Some((_, to)), _) if !to.is_nan() => to,
+                _ => f64::INFINITY,
+            };
+            later = later.max(to);
+            latest[k] = later;
+        }
+        latest
     }
 
     /// Primary rays among many groups: packets through the apparent tree.
