@@ -4,7 +4,7 @@
 //! (`direct::AtRest`).
 
 use super::moving_bounds::RaySpan;
-use super::{hit_on, ApparentTree, RestRay, SurfaceHit, World, INACTIVE};
+use super::{hit_on, ApparentTree, RestRay, SurfaceHit, World, WorldGroup, INACTIVE};
 use crate::accel::{Hit, Ray};
 use crate::geometry::PACKET;
 use crate::spacetime::NullRay;
@@ -59,7 +59,6 @@ impl World {
         let mut hits: [Option<Hit>; CHUNK] = [None; CHUNK];
         // Each lane's lookbacks in the group's window, where it has any.
         let mut within: [Option<(f64, f64)>; CHUNK] = [None; CHUNK];
-        let latest = self.latest_emissions();
         for (rays, out) in rays.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
             let n = rays.len();
             let mut best = [f64::INFINITY; CHUNK];
@@ -74,10 +73,11 @@ impl World {
                 // since lo ≥ t − latest ≥ best ≥ hi), so they are passed over at once (a
                 // worldline's segments, once a chunk has met the later ones).
                 if std::mem::take(&mut found)
-                    && rays
-                        .iter()
-                        .zip(&best)
-                        .all(|(r, &b)| b <= r.origin.t - latest[k])
+                    && self.latest.get(k).is_some_and(|&latest| {
+                        rays.iter()
+                            .zip(&best)
+                            .all(|(r, &b)| b <= r.origin.t - latest)
+                    })
                 {
                     break;
                 }
@@ -152,25 +152,6 @@ impl World {
                 }
             }
         }
-    }
-
-    /// For each place in the visiting order, the latest world time at which the groups from
-    /// there on can emit what a ray meets: the end of their windows of world times, or +∞
-    /// where any has none (a group seen at all times, or a window in a moving frame).
-    fn latest_emissions(&self) -> smallvec::SmallVec<[f64; 16]> {
-        let order: smallvec::SmallVec<[usize; 16]> = self.visiting_order().collect();
-        let mut latest = smallvec::SmallVec::from_elem(f64::NEG_INFINITY, order.len());
-        let mut later = f64::NEG_INFINITY;
-        for (k, &gi) in order.iter().enumerate().rev() {
-            let g = &self.groups[gi];
-            let to = match (g.world_window, &g.window) {
-                (Some((_, to)), _) if !to.is_nan() => to,
-                _ => f64::INFINITY,
-            };
-            later = later.max(to);
-            latest[k] = later;
-        }
-        latest
     }
 
     /// Primary rays among many groups: packets through the apparent tree.
@@ -264,4 +245,26 @@ impl World {
         let later = self.latest_first;
         (0..n).map(move |k| if later { n - 1 - k } else { k })
     }
+}
+
+/// For each place in a visiting order of `groups` (given in that order), the latest world
+/// time at which the groups from there on can emit what a ray meets: the end of their windows
+/// of world times, or +∞ where any has none (a group seen at all times, or a window in a
+/// moving frame).
+pub(super) fn latest_emissions<'a>(
+    groups: impl DoubleEndedIterator<Item = &'a WorldGroup>,
+) -> Box<[f64]> {
+    let mut latest: Vec<f64> = groups
+        .rev()
+        .scan(f64::NEG_INFINITY, |later, g| {
+            let to = match (g.world_window, &g.window) {
+                (Some((_, to)), _) if !to.is_nan() => to,
+                _ => f64::INFINITY,
+            };
+            *later = later.max(to);
+            Some(*later)
+        })
+        .collect();
+    latest.reverse();
+    latest.into()
 }

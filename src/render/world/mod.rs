@@ -151,6 +151,10 @@ pub struct World {
     /// smallest lookbacks), and once it has a hit there, the earlier segments' windows lie
     /// beyond it and are passed over before any boost.
     latest_first: bool,
+    /// Visiting last to first, for each place in that order: the latest world time at which
+    /// the groups from there on can emit what a ray meets (`latest_emissions`). Empty when
+    /// visiting first to last: no group is then passed over.
+    latest: Box<[f64]>,
     /// Where the backend records what went wrong while tracing, and how many faults it had
     /// when this world was made (`check`).
     faults: Option<(Arc<Faults>, u64)>,
@@ -273,8 +277,14 @@ impl World {
             !(latest_first && at_rest.is_some()),
             "AtRest visits first to last"
         );
+        let latest = if latest_first {
+            closest_hits::latest_emissions(groups.iter().rev())
+        } else {
+            Box::default()
+        };
         Ok(World {
             latest_first,
+            latest,
             event,
             groups,
             options,
@@ -366,6 +376,7 @@ impl World {
     #[cfg(test)]
     pub fn first_to_last(mut self) -> World {
         self.latest_first = false;
+        self.latest = Box::default();
         self
     }
 
