@@ -2,8 +2,8 @@
 //! its control characters escaped, so that no file's content can write a 20 MB message, set a
 //! terminal's title or clear its screen through an error (`shown`); and a whole message made
 //! safe for a terminal the same way line by line, as the command line prints it
-//! (`terminal_safe`); a line on standard output that a closed pipe does not turn into a
-//! panic (`say`).
+//! (`terminal_safe`); a line on standard output or error that a closed pipe or a full device
+//! does not turn into a panic (`say`, `warn`).
 
 /// Write a line to standard output. A reader that has gone (`rest-embree backends | head -1`)
 /// wants no more: the rest is dropped, quietly. Any other failure is said on standard error;
@@ -12,10 +12,18 @@ pub(crate) fn say(line: impl std::fmt::Display) {
     use std::io::Write;
     match writeln!(std::io::stdout().lock(), "{line}") {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            eprintln!("error: cannot write to standard output: {e}");
+            warn(format_args!("error: cannot write to standard output: {e}"));
         }
         _ => {}
     }
+}
+
+/// Write a line to standard error, as `eprintln!` does, but without its panic where standard
+/// error cannot be written (`2>/dev/full`, a closed pipe): the line is lost, the command's exit
+/// status stands.
+pub(crate) fn warn(line: impl std::fmt::Display) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
 }
 
 /// The most characters of a file's text an error quotes.

@@ -112,7 +112,7 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
             bar.set_message(name.to_string());
             started += 1;
         }
-        None => eprintln!("bench: {name}"),
+        None => crate::text::warn(format_args!("bench: {name}")),
     });
     if let Some(bar) = &bar {
         bar.finish_and_clear();
@@ -164,10 +164,10 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
     write("bench.md", &md)?;
     write("bench.csv", &bench::csv(&rows))?;
     bench::plot_svg(&rows, &args.out.join("bench.svg"))?;
-    eprintln!(
+    crate::text::warn(format_args!(
         "bench: wrote bench.md, bench.csv and bench.svg to {}",
         args.out.display()
-    );
+    ));
     Ok(())
 }
 

@@ -667,15 +667,15 @@ fn submit(jobs: &[Job], logs: &Path, args: &SlurmArgs) -> crate::Result<()> {
             .to_string();
         say(&id);
         let (tasks, file) = (job.tasks, job.file.display());
-        eprintln!(
+        crate::text::warn(format_args!(
             "farm: submitted job {id} ({tasks} task{}): {file}",
             plural(tasks)
-        );
+        ));
         previous = Some(id);
     }
-    eprintln!(
+    crate::text::warn(format_args!(
         "farm: watch with `squeue --me` or `sacct -j JOBID`; stop with `scancel JOBID`; logs in {}",
         logs.display()
-    );
+    ));
     Ok(())
 }

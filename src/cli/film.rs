@@ -150,10 +150,10 @@ pub(super) fn run(
                 skipped += 1;
                 continue;
             }
-            Some(Err(why)) if !args.quiet => eprintln!(
+            Some(Err(why)) if !args.quiet => crate::text::warn(format_args!(
                 "frame {k}: {} is not a finished frame of this render ({why}): rendering it again",
                 path.display()
-            ),
+            )),
             Some(Err(_)) => {}
             None => {}
         }
@@ -173,19 +173,19 @@ pub(super) fn run(
         rendered += 1;
         warn_nonfinite(&stats, args.quiet);
         if !args.quiet {
-            eprintln!(
+            crate::text::warn(format_args!(
                 "frame {k} ({} of {}..{last}), view time {:?}: {} in {secs:.3} s",
                 k - first + 1,
                 first,
                 film.time(k),
                 path.display()
-            );
+            ));
         }
     }
     if !args.quiet {
-        eprintln!(
+        crate::text::warn(format_args!(
             "film: {rendered} frames rendered, {skipped} already there; build {build:.3} s once, frames {render_secs:.3} s ({backend_name})"
-        );
+        ));
     }
     Ok(())
 }

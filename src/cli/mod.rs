@@ -32,7 +32,7 @@ pub fn main() -> ExitCode {
             return;
         }
         output::file::remove_partial_files();
-        eprintln!("interrupted");
+        crate::text::warn("interrupted");
         std::process::exit(130);
     });
     match parse() {
@@ -47,7 +47,7 @@ fn parse() -> Result<Cli, ExitCode> {
         if e.use_stderr() {
             let args: Vec<String> = std::env::args().collect();
             if let Some(hint) = hints::quoting_hint(&args) {
-                eprintln!("\n{hint}");
+                crate::text::warn(format_args!("\n{hint}"));
             }
             ExitCode::FAILURE
         } else {
@@ -115,7 +115,7 @@ fn run(cli: Cli) -> ExitCode {
             threads,
         } => match bench::probe::group_visits(groups, &backend, size, threads) {
             Ok(text) => {
-                print!("{text}");
+                crate::text::say(text.trim_end_matches('\n'));
                 ExitCode::SUCCESS
             }
             Err(e) => report(Err(crate::Error::flag("probe-group-visits", e.to_string()))),
@@ -129,7 +129,7 @@ fn report(r: crate::Result<()>) -> ExitCode {
         Err(e) => {
             // A message may quote a file's text: each line cut and its control characters
             // escaped, whatever the file held.
-            eprintln!("{}", crate::text::terminal_safe(&format!("error: {e}")));
+            crate::text::warn(crate::text::terminal_safe(&format!("error: {e}")));
             ExitCode::FAILURE
         }
     }

@@ -131,10 +131,10 @@ fn render_pixels(
             .map_or("not estimated (one round)".to_string(), |r| {
                 format!("{r:.3e}")
             });
-        eprintln!(
+        crate::text::warn(format_args!(
             "{} spp in {} rounds, stopped by {}: estimated RMS noise {rms}",
             done.samples, done.rounds, done.stopped_by
-        );
+        ));
     }
     Ok(stats)
 }
@@ -234,11 +234,11 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     fits_in_memory(&scene, format, args)?;
     // Said once per command (a film's frames share it), and not under --quiet.
     if let Some(w) = render::extrapolation_warning(&scene).filter(|_| !args.quiet) {
-        eprintln!("{w}");
+        crate::text::warn(format_args!("{w}"));
     }
     if !args.quiet {
         for w in &scene.warnings {
-            eprintln!("warning: {}", crate::text::shown(w));
+            crate::text::warn(format_args!("warning: {}", crate::text::shown(w)));
         }
     }
     // One frame of a film to a plain name (no run of #): a still of that frame.
@@ -290,17 +290,17 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
         match output::finished(&args.output, format, size, &id) {
             Ok(()) => {
                 if !args.quiet {
-                    eprintln!(
+                    crate::text::warn(format_args!(
                         "{}: a finished image of this render already (--resume): kept",
                         args.output.display()
-                    );
+                    ));
                 }
                 return Ok(());
             }
-            Err(why) if !args.quiet => eprintln!(
+            Err(why) if !args.quiet => crate::text::warn(format_args!(
                 "{} is not a finished image of this render ({why}): rendering it again",
                 args.output.display()
-            ),
+            )),
             Err(_) => {}
         }
     }
@@ -338,7 +338,7 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     warn_nonfinite(&stats, args.quiet);
     if !args.quiet {
         let secs = stats.trace_time.as_secs_f64();
-        eprintln!(
+        crate::text::warn(format_args!(
             "{}: {}x{}, {} spp, {} primitive{} in {} group{}, backend {backend_name}: build {:.3} s, render {:.3} s ({:.2} M primary rays/s)",
             args.output.display(),
             scene.image.frame_size().0,
@@ -351,7 +351,7 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
             stats.build_time.as_secs_f64(),
             secs,
             stats.primary_rays as f64 / secs.max(1e-9) / 1e6
-        );
+        ));
     }
     // The command ends here and its process with it: the world and the scene are left to the
     // operating system, which takes their memory back at once, instead of being freed piece by
@@ -379,9 +379,9 @@ pub(super) fn run_assemble(output: &Path, tiles: &[PathBuf]) -> crate::Result<()
 
 pub(super) fn warn_nonfinite(stats: &render::RenderStats, quiet: bool) {
     if stats.nonfinite_pixels > 0 && !quiet {
-        eprintln!(
+        crate::text::warn(format_args!(
             "warning: {} pixels came out NaN or infinite and were set to black; please report this scene",
             stats.nonfinite_pixels
-        );
+        ));
     }
 }

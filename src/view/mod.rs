@@ -209,7 +209,9 @@ fn open_browser(url: &str) {
         .stderr(std::process::Stdio::null())
         .spawn();
     if spawned.is_err() {
-        eprintln!("(could not start {opener}: open the URL above in a browser)");
+        crate::text::warn(format_args!(
+            "(could not start {opener}: open the URL above in a browser)"
+        ));
     }
 }
 

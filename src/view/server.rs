@@ -73,7 +73,7 @@ pub(super) async fn serve(listener: TcpListener, viewer: Arc<Viewer>, stop: Arc<
                 Ok((s, _)) => s,
                 Err(e) => {
                     // Out of file descriptors, say: wait a moment rather than spin.
-                    eprintln!("rest-embree view: {e}");
+                    crate::text::warn(format_args!("rest-embree view: {e}"));
                     tokio::time::sleep(Duration::from_millis(10)).await;
                     continue;
                 }

@@ -495,3 +495,41 @@ fn output_to_a_closed_pipe_is_dropped_quietly() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(err.trim().is_empty(), "nothing on standard error: {err}");
 }
+
+/// Messages that cannot be written (standard error on a full device, or a closed pipe) are
+/// lost, not turned into a panic: a refused scene still exits 1, a good render 0, and a
+/// command whose standard output and error are both full still ends with its own status.
+#[test]
+fn messages_that_cannot_be_written_leave_the_exit_status() {
+    let d = Dir::new("unwritable-stderr");
+    let bad = d.0.join("bad.toml");
+    std::fs::write(&bad, with("fov_y = 30", "fov_y = -30")).unwrap();
+    let good = d.0.join("good.toml");
+    std::fs::write(&good, GOOD).unwrap();
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap()
+    };
+    let run = |args: &[&str], stdout_full: bool| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_rest-embree"));
+        c.args(args).stderr(full());
+        if stdout_full {
+            c.stdout(full());
+        }
+        c.status().unwrap().code()
+    };
+    let png = d.0.join("x.png");
+    let (bad, good, png) = (
+        bad.to_str().unwrap(),
+        good.to_str().unwrap(),
+        png.to_str().unwrap(),
+    );
+    assert_eq!(run(&["render", bad, "-o", png], false), Some(1));
+    assert!(!Path::new(png).exists(), "no file from a refused scene");
+    assert_eq!(run(&["render", good, "-o", png], false), Some(0));
+    assert!(Path::new(png).exists());
+    assert_eq!(run(&["backends"], true), Some(0));
+    assert_eq!(run(&["no-such-command"], true), Some(1));
+}
