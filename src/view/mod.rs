@@ -264,7 +264,15 @@ impl Viewer {
     ) -> crate::Result<Viewer> {
         // The scene as the viewer will render it: loaded now so that a bad file is said at once.
         let base = edits::saved_text(&text, &source, &[]).map_err(|e| e.on_flag("view"))?;
-        let mut scene = crate::scene::load_str(&source, &base, &[])?;
+        // A bad file is said as the file has it: the text the viewer renders has two lines
+        // of its own at the top, and no film.
+        let mut scene = match crate::scene::load_str(&source, &base, &[]) {
+            Ok(scene) => scene,
+            Err(e) => match crate::scene::load_str(&source, &text, &[]) {
+                Err(in_file) => return Err(in_file.into()),
+                Ok(_) => return Err(e.into()),
+            },
+        };
         scene.film = None;
         let backend =
             crate::accel::backend_by_name(backend_name).map_err(|e| e.on_flag("--backend"))?;

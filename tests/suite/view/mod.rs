@@ -452,3 +452,39 @@ fn ctrl_c_stops_it_cleanly() {
         "no longer listening"
     );
 }
+
+/// A bad scene is refused by `view` as by `render`: the same message, naming the line of the
+/// file (the text the viewer renders has lines of its own at the top), exit status 1.
+#[test]
+fn a_bad_scene_is_said_at_its_own_line() {
+    let dir = std::env::temp_dir().join(format!("rest-embree-view-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("typo.toml");
+    let text = "[camera]\nposition = [0, 0, 0]\nlookat = [0, 0, 0]\n";
+    std::fs::write(&scene, text).unwrap();
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let path = scene.to_str().unwrap();
+    let png = dir.join("x.png");
+    let (code, viewed) = run(&["view", path, "--no-browser", "--port", "0"]);
+    let (rendered_code, rendered) = run(&["render", path, "-o", png.to_str().unwrap()]);
+    assert_eq!(
+        (code, rendered_code),
+        (Some(1), Some(1)),
+        "{viewed}\n{rendered}"
+    );
+    assert!(
+        viewed.contains("typo.toml:3: key `camera.lookat`"),
+        "{viewed}"
+    );
+    assert_eq!(viewed, rendered);
+    let _ = std::fs::remove_dir_all(&dir);
+}
