@@ -166,8 +166,9 @@ impl Doc {
 }
 
 /// A `--set` value is TOML; a bare word that is not valid TOML is taken as a string, so
-/// `--set camera.projection=orthographic` works without shell-quoted quotes. `at`: the flag
-/// and key an error names.
+/// `--set camera.projection=orthographic` and `--set texture.t.image=maps/wood.png` work
+/// without shell-quoted quotes (a word: letters, digits and `_ - . / ~ +`, not starting with a
+/// digit or `-`, which a number would). `at`: the flag and key an error names.
 fn parse_set_value(text: &str, origin: Origin, at: &SceneError) -> Result<Node, SceneError> {
     let bad = |message: String| SceneError {
         message,
@@ -181,7 +182,7 @@ fn parse_set_value(text: &str, origin: Origin, at: &SceneError) -> Result<Node, 
         Err(e) => {
             let word = text
                 .chars()
-                .all(|c| c.is_alphanumeric() || "_-".contains(c));
+                .all(|c| c.is_alphanumeric() || "_-./~+".contains(c));
             if word
                 && !text
                     .chars()

@@ -340,6 +340,47 @@ fn set_addresses_entries_by_name_and_overrides_any_value() {
     assert!(ch["A"].iter().all(|&a| a == 1.0), "opaque: alpha 1");
 }
 
+/// A bare file name or path given with `--set` is a string, as a bare word is: the scene then
+/// fails at the file it names (which is missing), not at the value.
+#[test]
+fn set_takes_a_bare_file_name_as_a_string() {
+    let d = Dir::new("set-file");
+    let text = format!("{GOOD}\n[[texture]]\nname = \"map\"\nimage = \"here.png\"\n");
+    let scene = d.file("scene.toml", &text);
+    let out = d.0.join("o.png");
+    for name in [
+        "nothere.png",
+        "infile.png",
+        "x.png",
+        "maps/x.png",
+        "./x.png",
+    ] {
+        let set = format!("texture.map.image={name}");
+        let (ok, err) = run(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--set",
+            &set,
+        ]);
+        assert!(!ok);
+        assert!(
+            err.contains(name.trim_start_matches("./")) && !err.contains("TOML value"),
+            "{name}: {err}"
+        );
+    }
+    let (ok, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "camera.fov_y=1.5.2",
+    ]);
+    assert!(!ok && err.contains("not a TOML value"), "{err}");
+}
+
 #[cfg(not(feature = "embree"))]
 #[test]
 fn asking_a_build_without_embree_for_embree_is_a_clear_error() {
