@@ -78,22 +78,25 @@ impl<'a> Table<'a> {
         Some(&self.entries()[i].1)
     }
 
-    /// An error about this table as a whole (a missing key, a conflict).
+    /// An error about key `key` of this table: at the key's line where the table has it (a
+    /// conflict, a value that does not fit the others), else at the table's (a missing key).
     pub fn error(&self, key: &str, msg: impl Into<String>) -> SceneError {
+        if let Some(n) = self.get(key) {
+            return self.error_at(n, key, msg);
+        }
         // A key said missing that is written nearly so (`colour1` for `color1` in an inline
         // table, which is read before its unknown keys are looked for): that key is blamed,
         // with the name meant, as `finish` blames an unknown key.
-        if self.get(key).is_none() {
-            let near = self.entries().iter().find(|(k, _)| {
-                !self.used.borrow()[self.index_of(k)] && closest(k, &[key]).is_some()
-            });
-            if let Some((k, n)) = near {
-                return self.error_at(
-                    n,
-                    k,
-                    format!("unknown key\n  did you mean `{key}`?{}", case_note(k, key)),
-                );
-            }
+        let near = self
+            .entries()
+            .iter()
+            .find(|(k, _)| !self.used.borrow()[self.index_of(k)] && closest(k, &[key]).is_some());
+        if let Some((k, n)) = near {
+            return self.error_at(
+                n,
+                k,
+                format!("unknown key\n  did you mean `{key}`?{}", case_note(k, key)),
+            );
         }
         SceneError::new(self.doc.locate(&self.node.origin), self.key_path(key), msg)
     }

@@ -57,7 +57,11 @@ pub(super) fn velocity(t: &Table, dir_key: &str) -> SceneResult<Option<Velocity>
         "rapidity" => Velocity::from_rapidity(dir, s),
         _ => Velocity::from_one_minus_beta(dir, s),
     };
-    let v = v.map_err(|e| t.error_at(n, form, e.to_string()))?;
+    // A zero direction is the direction's fault; the rest, the speed's.
+    let v = v.map_err(|e| match e {
+        crate::spacetime::VelocityError::ZeroDirection => t.error(dir_key, e.to_string()),
+        _ => t.error_at(n, form, e.to_string()),
+    })?;
     if let Some(why) = super::envelope::too_fast(v.rapidity()) {
         return Err(t.error_at(n, form, why));
     }

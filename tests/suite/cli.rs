@@ -180,6 +180,31 @@ fn bad_values_name_line_and_key() {
         &[],
         &["scene.toml:3", "camera.look_at", "expected 3 numbers"],
     );
+    // Values that do not fit the others are named at their own line, not the table's.
+    fails(
+        "same",
+        &with("look_at = [0, 10, 0]", "look_at = [0, 0, 0]"),
+        &[],
+        &["scene.toml:3", "camera.look_at", "zero length"],
+    );
+    fails(
+        "up",
+        &with(
+            "look_at = [0, 10, 0]",
+            "look_at = [0, 10, 0]\nup = [0, 1, 0]",
+        ),
+        &[],
+        &["scene.toml:4", "camera.up", "parallel"],
+    );
+    fails(
+        "direction",
+        &with(
+            "velocity = [0.5, 0, 0]",
+            "direction = [0, 0, 0]\nbeta = 0.5",
+        ),
+        &[],
+        &["scene.toml:21", "group.cube.direction", "zero vector"],
+    );
 }
 
 #[test]
