@@ -64,5 +64,23 @@ pub(super) fn material(
     {
         return Err(format!("material `{}` has a number that is not finite", out.name).into());
     }
+    // glTF 2.0 keeps these factors in [0, 1]; a file beyond is refused, not clamped into
+    // another picture (a scene's own colours beyond are refused too).
+    let factors = [
+        ("baseColorFactor", f.to_vec()),
+        ("metallicFactor", vec![out.metallic]),
+        ("roughnessFactor", vec![out.roughness]),
+        ("transmissionFactor", vec![out.transmission]),
+        ("emissiveFactor", e.to_vec()),
+    ];
+    for (key, values) in factors {
+        if let Some(v) = values.iter().find(|v| !(0.0..=1.0).contains(*v)) {
+            return Err(format!(
+                "material `{}`'s {key} holds {v}, outside [0, 1] (glTF 2.0's range)",
+                out.name
+            )
+            .into());
+        }
+    }
     Ok(out)
 }

@@ -342,17 +342,37 @@ fn checked_beyond_validation(root: &gltf::json::Root) -> Result<(), GltfError> {
             }
             for (semantic, a) in &prim.attributes {
                 let (c, t, n) = kind(a.value());
-                let fine = match semantic {
-                    Valid(Semantic::Positions | Semantic::Normals) => {
-                        c == Some(C::F32) && t == Some(T::Vec3)
-                    }
-                    Valid(Semantic::TexCoords(0)) => {
-                        matches!(c, Some(C::F32 | C::U8 | C::U16)) && t == Some(T::Vec2)
-                    }
-                    _ => true,
+                // What the file calls it, and the kind this reader takes.
+                let (name, fine, wanted) = match semantic {
+                    Valid(Semantic::Positions) => (
+                        "POSITION",
+                        c == Some(C::F32) && t == Some(T::Vec3),
+                        "VEC3 of FLOAT",
+                    ),
+                    Valid(Semantic::Normals) => (
+                        "NORMAL",
+                        c == Some(C::F32) && t == Some(T::Vec3),
+                        "VEC3 of FLOAT",
+                    ),
+                    Valid(Semantic::TexCoords(0)) => (
+                        "TEXCOORD_0",
+                        matches!(c, Some(C::F32 | C::U8 | C::U16)) && t == Some(T::Vec2),
+                        "VEC2 of FLOAT, UNSIGNED_BYTE or UNSIGNED_SHORT",
+                    ),
+                    _ => ("", true, ""),
                 };
-                if !fine || n == 0 {
-                    return Err(bad(&format!("{semantic:?}")));
+                if !fine {
+                    return Err(format!(
+                        "mesh {m} primitive {p}: its {name} accessor is not {wanted}, as glTF 2.0 requires"
+                    )
+                    .into());
+                }
+                if n == 0 {
+                    return Err(format!(
+                        "mesh {m} primitive {p}: its {} accessor has no elements (count 0)",
+                        semantic.to_string()
+                    )
+                    .into());
                 }
             }
         }

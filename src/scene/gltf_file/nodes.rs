@@ -187,7 +187,12 @@ impl Reading<'_> {
             let reader = prim.reader(|b| self.buffers.get(b.index()).map(Vec::as_slice));
             let positions: Vec<DVec3> = reader
                 .read_positions()
-                .ok_or_else(|| format!("{} has no positions", what()))?
+                .ok_or_else(|| {
+                    format!(
+                        "{}: its POSITION accessor is missing or lies outside its buffer",
+                        what()
+                    )
+                })?
                 .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))))
                 .collect();
             let n = positions.len();

@@ -95,6 +95,49 @@ fn bad_gltf_files_are_clear_errors() {
     fov.json["nodes"][0]["camera"] = json!(0);
     let err = refused(&d, "fov.glb", &fov.glb());
     assert!(err.contains("yfov"), "{err}");
+    // A POSITION accessor of the wrong type, and one running past its buffer.
+    let positions = |doc: &Doc| {
+        doc.json["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+            .as_u64()
+            .unwrap() as usize
+    };
+    let mut flat = Doc::unit_box(nested_nodes());
+    let pos = positions(&flat);
+    flat.json["accessors"][pos]["type"] = json!("VEC2");
+    let err = refused(&d, "flat.glb", &flat.glb());
+    assert!(
+        err.contains("POSITION") && err.contains("VEC3") && !err.contains("Valid("),
+        "{err}"
+    );
+    let mut long = Doc::unit_box(nested_nodes());
+    let pos = positions(&long);
+    long.json["accessors"][pos]["count"] = json!(800);
+    let err = refused(&d, "long.glb", &long.glb());
+    assert!(err.contains("POSITION") && err.contains("outside"), "{err}");
+    // Factors glTF keeps in [0, 1] given beyond: refused naming the material and the key,
+    // not clamped into another colour.
+    for (key, value) in [
+        ("baseColorFactor", json!([2.0, -1.0, 0.5, 1.0])),
+        ("metallicFactor", json!(1.5)),
+        ("roughnessFactor", json!(-0.25)),
+    ] {
+        let mut paint = Doc::unit_box(nested_nodes());
+        paint.json["meshes"][0]["primitives"][0]["material"] = json!(0);
+        paint.json["materials"] = json!([{"name": "paint", "pbrMetallicRoughness": {key: value}}]);
+        let err = refused(&d, "paint.glb", &paint.glb());
+        assert!(
+            err.contains("`paint`") && err.contains(key) && err.contains("[0, 1]"),
+            "{key}: {err}"
+        );
+    }
+    let mut glow = Doc::unit_box(nested_nodes());
+    glow.json["meshes"][0]["primitives"][0]["material"] = json!(0);
+    glow.json["materials"] = json!([{"name": "glow", "emissiveFactor": [1.0, 3.0, 0.0]}]);
+    let err = refused(&d, "glow.glb", &glow.glb());
+    assert!(
+        err.contains("`glow`") && err.contains("emissiveFactor"),
+        "{err}"
+    );
     // Two top-level nodes of one name, each a group of its own: refused, naming it.
     let mut twins = Doc::unit_box(json!([
         {"name": "Ship", "translation": [0, 10.5, 0], "mesh": 0},
