@@ -52,8 +52,18 @@ impl Scene {
 /// them.
 #[pyfunction]
 fn load(path: std::path::PathBuf, overrides: Vec<(String, String)>) -> PyResult<Scene> {
-    let scene = rest_embree::scene::load_file(&path, &overrides)
-        .map_err(|e| py_err(rest_embree::Error::from(e)))?;
+    let scene = rest_embree::scene::load_file(&path, &overrides).map_err(|e| {
+        let e = rest_embree::Error::from(e);
+        // A file that cannot be opened (missing, a folder, no permission) is an `OSError`, as
+        // for every other file; what it holds, a `ValueError`.
+        let opens =
+            std::fs::File::open(&path).is_ok_and(|f| f.metadata().is_ok_and(|m| !m.is_dir()));
+        if opens {
+            py_err(e)
+        } else {
+            PyOSError::new_err(e.to_string())
+        }
+    })?;
     Ok(Scene::new(scene, path.display().to_string(), &overrides))
 }
 

@@ -112,6 +112,10 @@ def test_errors_are_the_command_lines(tmp_path):
         re.Scene.from_toml("[camera]\nposition = [0, 0, nan]\nlook_at = [0, 1, 0]\n")
     with pytest.raises(OSError):
         re.read_exr(tmp_path / "none.exr")
+    with pytest.raises(OSError, match="none.toml"):
+        re.Scene.load(tmp_path / "none.toml")
+    with pytest.raises(OSError):
+        re.Scene.load(tmp_path)
     with pytest.raises(ValueError, match="backend"):
         re.render(re.Scene.from_dict(CUBE), backend="nope")
     with pytest.raises(TypeError):
@@ -259,3 +263,19 @@ def test_the_notebook_runs(tmp_path):
     client.execute()
     text = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.outputs)
     assert "closed form" in text, text
+
+
+def test_the_readmes_example_runs(tmp_path):
+    """The README's "From Python" snippet as written, in a folder with the project's scenes."""
+    text = (ROOT / "README.md").read_text()
+    part = text[text.index("## From Python"):]
+    code = part[part.index("```python") + len("```python"):]
+    code = code[:code.index("```")]
+    (tmp_path / "scenes").symlink_to(ROOT / "scenes")
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        exec(compile(code, "README.md", "exec"), {})
+    finally:
+        os.chdir(cwd)
+    assert (tmp_path / "lattice.exr").stat().st_size > 0
