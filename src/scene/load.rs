@@ -439,14 +439,16 @@ pub(super) fn group(
             let (geo, chosen) = (&mut geometry, chosen.clone());
             add_mesh_data(o, id, mat, place, geo, total, g.mesh, chosen, material_ids)?;
             check_object(o, "gltf", &geometry, materials, (0, 0, 0))?;
+            // The object is named as its group, `<group>/<node>`: nodes of one name in two
+            // entries' groups stay apart in the mattes and the probe.
+            let named = format!("{name}/{}", g.node);
             objects.push(ObjectInfo {
-                name: Some(g.node.clone()),
+                name: Some(named.clone()),
                 kind: "gltf".into(),
                 group: index + out.len(),
             });
             // A node of a moving group that is not keyframed moves with the group.
             let line = g.segments.or_else(|| segments.clone());
-            let named = format!("{name}/{}", g.node);
             out.extend(groups_of(
                 o, &named, geometry, line, velocity, materials, total,
             )?);

@@ -588,3 +588,25 @@ fn close_but_edges(
     }
     differing(a, &b2)
 }
+
+/// With `groups = "nodes"` a top-level node's object is named as its group, `<group>/<node>`
+/// (docs/scene-format.md): one file placed by two entries in two groups gives objects of two
+/// names, which the mattes and the probe tell apart.
+#[test]
+fn a_node_of_its_own_is_named_group_slash_node() {
+    let d = Dir::new("gltf-node-names");
+    let mut doc = Doc::unit_box(json!([{"name": "CubeA", "translation": [0, 10.5, 0]}]));
+    doc.json["nodes"][0]["mesh"] = json!(0);
+    std::fs::write(d.0.join("cube.glb"), doc.glb()).unwrap();
+    let text = with_object("type = \"gltf\"\nfile = \"cube.glb\"\ngroups = \"nodes\"");
+    let text = format!(
+        "{text}\n[[group]]\nname = \"other\"\nvelocity = [-0.4, 0, 0]\n\
+         [[group.object]]\ntype = \"gltf\"\nfile = \"cube.glb\"\ngroups = \"nodes\"\n"
+    );
+    let s = load(&d, "two.toml", &text, &[]);
+    let names: Vec<&str> = s.objects.iter().filter_map(|o| o.name.as_deref()).collect();
+    assert_eq!(names, ["cube/CubeA", "other/CubeA"]);
+    for o in s.objects.iter().filter(|o| o.name.is_some()) {
+        assert_eq!(o.name.as_deref(), Some(s.groups[o.group].name.as_str()));
+    }
+}
