@@ -215,6 +215,44 @@ impl RenderArgs {
 }
 
 impl RenderArgs {
+    /// Flags that would otherwise be lost without a word: a dedicated flag and a `--set` of
+    /// the same key (the later `--set` won), and an EXR's options with `-o` naming a PNG.
+    pub(super) fn check_flags(&self, format: output::Format) -> crate::Result<()> {
+        let dedicated = [
+            ("--width", "image.width", self.width.is_some()),
+            ("--height", "image.height", self.height.is_some()),
+            ("--samples", "image.samples", self.samples.is_some()),
+            ("--time", "camera.time", self.time.is_some()),
+            ("--passes", "image.passes", self.passes.is_some()),
+        ];
+        for (flag, key, _) in dedicated.into_iter().filter(|d| d.2) {
+            let same = self
+                .set
+                .iter()
+                .find(|s| s.split_once('=').is_some_and(|(k, _)| k.trim() == key));
+            if let Some(s) = same {
+                return Err(crate::Error::flag(
+                    flag,
+                    format!("`--set {s}` sets the same value: give one of the two"),
+                ));
+            }
+        }
+        if format == output::Format::Png {
+            let exr_only = [
+                ("--half", self.half),
+                ("--compression", self.compression.is_some()),
+                ("--passes", self.passes.is_some()),
+            ];
+            if let Some((flag, _)) = exr_only.into_iter().find(|e| e.1) {
+                return Err(crate::Error::flag(
+                    flag,
+                    "applies to an EXR; `-o` names a PNG, which holds colour and alpha alone",
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// The overrides in the order they apply: the dedicated flags, then every --set.
     pub fn overrides(&self) -> Vec<(String, String)> {
         let mut v = Vec::new();

@@ -42,6 +42,12 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
             "sets values of a scene file: give one (rest-embree bench SCENE.toml --set ...); the suite's cases set their own",
         ));
     }
+    if args.scene.is_some() && !args.cases.is_empty() {
+        return Err(Error::flag(
+            "--case",
+            "picks cases of the fixed suite; a scene file is measured whole (choose its settings with --backend)",
+        ));
+    }
     if args.cases.iter().any(|c| c.trim().is_empty()) {
         return Err(Error::flag(
             "--case",

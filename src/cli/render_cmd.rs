@@ -198,6 +198,7 @@ fn same_file(a: &Path, b: &Path) -> bool {
 pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     // Check everything that can be checked before the (possibly long) render.
     let format = output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
+    args.check_flags(format)?;
     let backend_name = args
         .backend
         .clone()

@@ -271,6 +271,40 @@ fn empty_scenes_are_refused() {
 
 #[test]
 fn bad_flags_are_named() {
+    // A flag whose value would be lost: the same value set twice, an EXR's option on a PNG.
+    fails(
+        "set-twice",
+        GOOD,
+        &["--width", "20", "--set", "image.width=10"],
+        &["--width", "`--set image.width=10` sets the same value"],
+    );
+    for (flag, value) in [
+        ("--half", None),
+        ("--compression", Some("piz")),
+        ("--passes", Some("depth")),
+    ] {
+        let mut extra = vec![flag];
+        extra.extend(value);
+        fails(
+            &format!("png{flag}"),
+            GOOD,
+            &extra,
+            &[flag, "applies to an EXR", "PNG"],
+        );
+    }
+    let d = Dir::new("bench-case");
+    let scene = d.file("scene.toml", GOOD);
+    let out = d.0.join("bench");
+    let (code, err) = status(&[
+        "bench",
+        scene.to_str().unwrap(),
+        "--case",
+        "nothing",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("--case") && err.contains("suite"), "{err}");
     fails(
         "backend",
         GOOD,
