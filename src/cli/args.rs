@@ -218,22 +218,21 @@ impl RenderArgs {
     /// Flags that would otherwise be lost without a word: a dedicated flag and a `--set` of
     /// the same key (the later `--set` won), and an EXR's options with `-o` naming a PNG.
     pub(super) fn check_flags(&self, format: output::Format) -> crate::Result<()> {
-        let dedicated = [
-            ("--width", "image.width", self.width.is_some()),
-            ("--height", "image.height", self.height.is_some()),
-            ("--samples", "image.samples", self.samples.is_some()),
-            ("--time", "camera.time", self.time.is_some()),
-            ("--passes", "image.passes", self.passes.is_some()),
-        ];
-        for (flag, key, _) in dedicated.into_iter().filter(|d| d.2) {
-            let same = self
-                .set
-                .iter()
-                .find(|s| s.split_once('=').is_some_and(|(k, _)| k.trim() == key));
-            if let Some(s) = same {
+        // The keys `overrides` sets, each with the flag that set it (`--width 20`, `--set …`).
+        let all = self.overrides();
+        let keyed: Vec<(&str, &str)> = all
+            .iter()
+            .filter_map(|(shown, set)| Some((shown.as_str(), set.split_once('=')?.0.trim())))
+            .collect();
+        let (sets, dedicated): (Vec<_>, Vec<_>) = keyed
+            .iter()
+            .partition(|(shown, _)| shown.starts_with("--set "));
+        for &&(shown, key) in &dedicated {
+            if let Some(&&(again, _)) = sets.iter().find(|s| s.1 == key) {
+                let flag = shown.split(' ').next().unwrap_or(shown);
                 return Err(crate::Error::flag(
                     flag,
-                    format!("`--set {s}` sets the same value: give one of the two"),
+                    format!("`{again}` sets the same value: give one of the two"),
                 ));
             }
         }

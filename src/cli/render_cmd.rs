@@ -235,7 +235,7 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     fits_in_memory(&scene, format, args)?;
     // Said once per command (a film's frames share it), and not under --quiet.
     if let Some(w) = render::extrapolation_warning(&scene).filter(|_| !args.quiet) {
-        crate::text::warn(format_args!("{w}"));
+        crate::text::warn(w);
     }
     if !args.quiet {
         for w in &scene.warnings {

@@ -379,10 +379,10 @@ fn append(a: &mut MeshData, b: MeshData) {
 /// A glTF material as the scene's: base colour (and its texture, times the factor) as the
 /// diffuse `color`, metallic as the mirror share `reflect` with `roughness`, transmission of
 /// the dielectric share as `transmit` with `ior`, emissive factor times strength (and its
-/// texture) as `emission`.
+/// texture) as `emission`. The factors are glTF's ranges, as the reader checked them
+/// (`gltf_file::materials`).
 fn material(m: &GltfMaterial) -> Material {
     let d = Material::default_white();
-    let unit = |v: f64| v.clamp(0.0, 1.0);
     let texture = |img: &gltf_file::Image, factor: DVec3, role: Role| {
         let texels: super::texture::Texels = if factor == DVec3::ONE {
             img.texels.clone()
@@ -401,19 +401,19 @@ fn material(m: &GltfMaterial) -> Material {
             role,
         )))
     };
-    let base = m.base_color.clamp(DVec3::ZERO, DVec3::ONE);
+    let base = m.base_color;
     let color_texture = m
         .base_texture
         .as_ref()
         .map(|i| texture(i, base, Role::Reflectance));
-    let emissive = m.emissive.max(DVec3::ZERO);
+    let emissive = m.emissive;
     let emission_texture = m
         .emissive_texture
         .as_ref()
         .filter(|_| emissive != DVec3::ZERO)
         .map(|i| texture(i, emissive, Role::Emitter));
     let first = |t: &Arc<super::Texture>| t.colours().next().cloned();
-    let metallic = unit(m.metallic);
+    let metallic = m.metallic;
     Material {
         name: m.name.clone(),
         color: color_texture
@@ -421,9 +421,9 @@ fn material(m: &GltfMaterial) -> Material {
             .and_then(first)
             .unwrap_or_else(|| Colour::rgb(base, Role::Reflectance)),
         reflect: metallic,
-        transmit: unit(m.transmission) * (1.0 - metallic),
+        transmit: m.transmission * (1.0 - metallic),
         ior: m.ior.max(1.0),
-        roughness: unit(m.roughness),
+        roughness: m.roughness,
         emission: match &emission_texture {
             Some(t) => first(t),
             None => (emissive != DVec3::ZERO).then(|| Colour::rgb(emissive, Role::Emitter)),

@@ -64,14 +64,15 @@ pub(super) fn material(
     {
         return Err(format!("material `{}` has a number that is not finite", out.name).into());
     }
-    // glTF 2.0 keeps these factors in [0, 1]; a file beyond is refused, not clamped into
-    // another picture (a scene's own colours beyond are refused too).
-    let factors = [
-        ("baseColorFactor", f.to_vec()),
-        ("metallicFactor", vec![out.metallic]),
-        ("roughnessFactor", vec![out.roughness]),
-        ("transmissionFactor", vec![out.transmission]),
-        ("emissiveFactor", e.to_vec()),
+    // glTF 2.0 keeps these factors in [0, 1] and the emissive strength at 0 or more; a file
+    // beyond is refused, not clamped into another picture (a scene's own colours beyond are
+    // refused too). The scene's material takes them as they are (`gltf_object::material`).
+    let factors: [(&str, &[f64]); 5] = [
+        ("baseColorFactor", &f),
+        ("metallicFactor", &[out.metallic]),
+        ("roughnessFactor", &[out.roughness]),
+        ("transmissionFactor", &[out.transmission]),
+        ("emissiveFactor", &e),
     ];
     for (key, values) in factors {
         if let Some(v) = values.iter().find(|v| !(0.0..=1.0).contains(*v)) {
@@ -81,6 +82,13 @@ pub(super) fn material(
             )
             .into());
         }
+    }
+    if strength < 0.0 {
+        return Err(format!(
+            "material `{}`'s emissiveStrength is {strength}; it must be 0 or more",
+            out.name
+        )
+        .into());
     }
     Ok(out)
 }

@@ -342,35 +342,33 @@ fn checked_beyond_validation(root: &gltf::json::Root) -> Result<(), GltfError> {
             }
             for (semantic, a) in &prim.attributes {
                 let (c, t, n) = kind(a.value());
-                // What the file calls it, and the kind this reader takes.
-                let (name, fine, wanted) = match semantic {
-                    Valid(Semantic::Positions) => (
-                        "POSITION",
-                        c == Some(C::F32) && t == Some(T::Vec3),
-                        "VEC3 of FLOAT",
-                    ),
-                    Valid(Semantic::Normals) => (
-                        "NORMAL",
-                        c == Some(C::F32) && t == Some(T::Vec3),
-                        "VEC3 of FLOAT",
-                    ),
-                    Valid(Semantic::TexCoords(0)) => (
-                        "TEXCOORD_0",
-                        matches!(c, Some(C::F32 | C::U8 | C::U16)) && t == Some(T::Vec2),
-                        "VEC2 of FLOAT, UNSIGNED_BYTE or UNSIGNED_SHORT",
-                    ),
-                    _ => ("", true, ""),
+                // The kind this reader takes, where the file gives another.
+                let wanted = match semantic {
+                    Valid(Semantic::Positions | Semantic::Normals)
+                        if !(c == Some(C::F32) && t == Some(T::Vec3)) =>
+                    {
+                        Some("VEC3 of FLOAT")
+                    }
+                    Valid(Semantic::TexCoords(0))
+                        if !(matches!(c, Some(C::F32 | C::U8 | C::U16)) && t == Some(T::Vec2)) =>
+                    {
+                        Some("VEC2 of FLOAT, UNSIGNED_BYTE or UNSIGNED_SHORT")
+                    }
+                    _ => None,
                 };
-                if !fine {
+                // As the file names it: POSITION, NORMAL, TEXCOORD_0.
+                let name = || semantic.to_string();
+                if let Some(wanted) = wanted {
                     return Err(format!(
-                        "mesh {m} primitive {p}: its {name} accessor is not {wanted}, as glTF 2.0 requires"
+                        "mesh {m} primitive {p}: its {} accessor is not {wanted}, as glTF 2.0 requires",
+                        name()
                     )
                     .into());
                 }
                 if n == 0 {
                     return Err(format!(
                         "mesh {m} primitive {p}: its {} accessor has no elements (count 0)",
-                        semantic.to_string()
+                        name()
                     )
                     .into());
                 }

@@ -114,30 +114,43 @@ fn bad_gltf_files_are_clear_errors() {
     long.json["accessors"][pos]["count"] = json!(800);
     let err = refused(&d, "long.glb", &long.glb());
     assert!(err.contains("POSITION") && err.contains("outside"), "{err}");
-    // Factors glTF keeps in [0, 1] given beyond: refused naming the material and the key,
-    // not clamped into another colour.
-    for (key, value) in [
-        ("baseColorFactor", json!([2.0, -1.0, 0.5, 1.0])),
-        ("metallicFactor", json!(1.5)),
-        ("roughnessFactor", json!(-0.25)),
+    // Factors glTF keeps in [0, 1] given beyond, and a negative emissive strength: refused
+    // naming the material and the key, not clamped into another colour.
+    for (key, mut material) in [
+        (
+            "baseColorFactor",
+            json!({"pbrMetallicRoughness": {"baseColorFactor": [2.0, -1.0, 0.5, 1.0]}}),
+        ),
+        (
+            "metallicFactor",
+            json!({"pbrMetallicRoughness": {"metallicFactor": 1.5}}),
+        ),
+        (
+            "roughnessFactor",
+            json!({"pbrMetallicRoughness": {"roughnessFactor": -0.25}}),
+        ),
+        ("emissiveFactor", json!({"emissiveFactor": [1.0, 3.0, 0.0]})),
+        (
+            "emissiveStrength",
+            json!({"emissiveFactor": [1.0, 1.0, 1.0],
+            "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": -2.0}}}),
+        ),
     ] {
+        material["name"] = json!("paint");
         let mut paint = Doc::unit_box(nested_nodes());
         paint.json["meshes"][0]["primitives"][0]["material"] = json!(0);
-        paint.json["materials"] = json!([{"name": "paint", "pbrMetallicRoughness": {key: value}}]);
+        paint.json["materials"] = json!([material]);
         let err = refused(&d, "paint.glb", &paint.glb());
+        let range = if key == "emissiveStrength" {
+            "0 or more"
+        } else {
+            "[0, 1]"
+        };
         assert!(
-            err.contains("`paint`") && err.contains(key) && err.contains("[0, 1]"),
+            err.contains("`paint`") && err.contains(key) && err.contains(range),
             "{key}: {err}"
         );
     }
-    let mut glow = Doc::unit_box(nested_nodes());
-    glow.json["meshes"][0]["primitives"][0]["material"] = json!(0);
-    glow.json["materials"] = json!([{"name": "glow", "emissiveFactor": [1.0, 3.0, 0.0]}]);
-    let err = refused(&d, "glow.glb", &glow.glb());
-    assert!(
-        err.contains("`glow`") && err.contains("emissiveFactor"),
-        "{err}"
-    );
     // Two top-level nodes of one name, each a group of its own: refused, naming it.
     let mut twins = Doc::unit_box(json!([
         {"name": "Ship", "translation": [0, 10.5, 0], "mesh": 0},

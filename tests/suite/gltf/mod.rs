@@ -595,8 +595,7 @@ fn close_but_edges(
 #[test]
 fn a_node_of_its_own_is_named_group_slash_node() {
     let d = Dir::new("gltf-node-names");
-    let mut doc = Doc::unit_box(json!([{"name": "CubeA", "translation": [0, 10.5, 0]}]));
-    doc.json["nodes"][0]["mesh"] = json!(0);
+    let doc = Doc::unit_box(json!([{"name": "CubeA", "translation": [0, 10.5, 0], "mesh": 0}]));
     std::fs::write(d.0.join("cube.glb"), doc.glb()).unwrap();
     let text = with_object("type = \"gltf\"\nfile = \"cube.glb\"\ngroups = \"nodes\"");
     let text = format!(
