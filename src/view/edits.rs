@@ -178,7 +178,8 @@ fn number(v: &Value, shown: &str) -> crate::Result<f64> {
         .ok_or_else(|| refuse!("{shown} must be a number"))?;
     if !x.is_finite() || x.abs() > MAX_MAGNITUDE {
         return Err(refuse!(
-            "{shown} = {x}: must be finite and at most {MAX_MAGNITUDE:e} in size"
+            // Rust's shortest form (`1e300`), not every digit of the number.
+            "{shown} = {x:?}: must be finite and at most {MAX_MAGNITUDE:e} in size"
         ));
     }
     Ok(x)
@@ -555,5 +556,9 @@ mod tests {
             let e = edits(&view, &editable()).unwrap_err();
             assert!(e.to_string().contains(needle), "{view}: {e}");
         }
+        // A huge number is said in its short form, not in its 301 digits.
+        let huge = json!({ "camera": { "position": [1e300, 0.0, 0.0] } });
+        let e = edits(&huge, &editable()).unwrap_err().to_string();
+        assert!(e.contains("= 1e300:") && e.len() < 120, "{e}");
     }
 }
