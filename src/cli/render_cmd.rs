@@ -339,16 +339,28 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     warn_nonfinite(&stats, args.quiet);
     if !args.quiet {
         let secs = stats.trace_time.as_secs_f64();
+        // As the file has them: a worldline's pieces are groups of their own to the renderer,
+        // one rest frame each, said beside.
+        let named = scene.named_groups().count();
+        let primitives: usize = scene
+            .named_groups()
+            .map(|g| g.geometry.len() as usize)
+            .sum();
         crate::text::warn(format_args!(
-            "{}: {}x{}, {} spp, {} primitive{} in {} group{}, backend {backend_name}: build {:.3} s, render {:.3} s ({:.2} M primary rays/s)",
+            "{}: {}x{}, {} spp, {} primitive{} in {} group{}{}, backend {backend_name}: build {:.3} s, render {:.3} s ({:.2} M primary rays/s)",
             args.output.display(),
             scene.image.frame_size().0,
             scene.image.frame_size().1,
             stats.samples.unwrap_or(scene.image.samples),
-            scene.primitive_count(),
-            if scene.primitive_count() == 1 { "" } else { "s" },
-            scene.groups.len(),
-            if scene.groups.len() == 1 { "" } else { "s" },
+            primitives,
+            if primitives == 1 { "" } else { "s" },
+            named,
+            if named == 1 { "" } else { "s" },
+            if named == scene.groups.len() {
+                String::new()
+            } else {
+                format!(" ({} rest frames)", scene.groups.len())
+            },
             stats.build_time.as_secs_f64(),
             secs,
             stats.primary_rays as f64 / secs.max(1e-9) / 1e6

@@ -116,14 +116,21 @@ pub fn attributes(
         .groups
         .iter()
         .take(SHOWN_GROUPS)
-        .map(|g| {
+        .enumerate()
+        .map(|(i, g)| {
             // β to 13 significant digits: the rapidity it is kept as rounds 0.5 to 0.49999….
             let b = g
                 .velocity
                 .beta_vec()
                 .to_array()
                 .map(|x| format!("{x:.12e}").parse::<f64>().unwrap_or(x));
-            format!("{}: beta = {b:?}", g.name)
+            match scene.worldline_piece(i) {
+                Some((k, n)) => format!(
+                    "{}: beta = {b:?} (piece {k} of {n} of its worldline)",
+                    g.name
+                ),
+                None => format!("{}: beta = {b:?}", g.name),
+            }
         })
         .collect();
     if scene.groups.len() > SHOWN_GROUPS {

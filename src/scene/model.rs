@@ -367,6 +367,12 @@ pub struct Group {
     pub turn: Option<glam::DMat3>,
 }
 
+/// Whether `b` is the piece after `a` of one worldline (the loader puts a worldline's pieces
+/// side by side, and group names are unique).
+fn same_worldline(a: &Group, b: &Group) -> bool {
+    a.window.is_some() && b.window.is_some() && a.name == b.name
+}
+
 impl Group {
     /// The transformation from the world frame into its rest frame, in its own axes.
     pub fn to_rest(&self) -> Boost {
@@ -562,6 +568,30 @@ impl Scene {
                 })
                 .fold(0, u64::saturating_add),
         )
+    }
+
+    /// The groups as the scene file names them: of a worldline's pieces (groups of one name,
+    /// each seen in its own window of emission times) the first alone.
+    pub fn named_groups(&self) -> impl Iterator<Item = &Group> {
+        let g = &self.groups;
+        (0..g.len())
+            .filter(move |&i| i == 0 || !same_worldline(&g[i - 1], &g[i]))
+            .map(move |i| &g[i])
+    }
+
+    /// For a group that is a piece of a worldline: which piece it is, from 1, and how many
+    /// the worldline has.
+    pub fn worldline_piece(&self, i: usize) -> Option<(usize, usize)> {
+        let g = &self.groups;
+        g[i].window.as_ref()?;
+        let first = (1..=i)
+            .rev()
+            .take_while(|&j| same_worldline(&g[j - 1], &g[j]))
+            .count();
+        let after = (i + 1..g.len())
+            .take_while(|&j| same_worldline(&g[j - 1], &g[j]))
+            .count();
+        Some((first + 1, first + 1 + after))
     }
 
     /// How many primitives all groups hold.

@@ -126,6 +126,49 @@ fn a_ball_that_stops_is_seen_in_each_segment_at_its_times() {
     }
 }
 
+/// The render's line counts the groups the file names, a worldline's pieces as the rest frames
+/// they are; the EXR's `groupVelocities` says which piece each entry is.
+#[test]
+fn a_worldline_is_one_group_of_several_rest_frames() {
+    use crate::common::cli::{oiiotool, status, Dir};
+    let d = Dir::new("worldline-pieces");
+    let three = "worldline = [{ until = -1, velocity = [0.8, 0, 0] }, { until = 3, velocity = [0, 0, 0] }, { velocity = [-0.5, 0, 0] }]";
+    let text = sphere_scene(three, 10.0)
+        + "[[group]]\nname = \"still\"\n[[group.object]]\ntype = \"sphere\"\ncenter = [3, 0, 0]\nradius = 1\n";
+    let file = d.file("pieces.toml", &text);
+    let out = d.0.join("pieces.exr");
+    let (code, err) = status(&[
+        "render",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains("2 primitives in 2 groups (4 rest frames)"),
+        "{err}"
+    );
+    let info = oiiotool(&["--info", "-v", out.to_str().unwrap()]);
+    for needle in [
+        "\"ball: beta = [0.8, 0.0, 0.0] (piece 1 of 3 of its worldline)\"",
+        "\"ball: beta = [0.0, 0.0, 0.0] (piece 2 of 3 of its worldline)\"",
+        "\"ball: beta = [-0.5, 0.0, 0.0] (piece 3 of 3 of its worldline)\"",
+        "\"still: beta = [0.0, 0.0, 0.0]\"",
+    ] {
+        assert!(info.contains(needle), "`{needle}` in:\n{info}");
+    }
+    // A scene without worldlines says its groups as before.
+    let plain = d.file("plain.toml", &sphere_scene("velocity = [0.5, 0, 0]", 10.0));
+    let (code, err) = status(&[
+        "render",
+        plain.to_str().unwrap(),
+        "-o",
+        d.0.join("p.png").to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("1 primitive in 1 group, backend"), "{err}");
+}
+
 #[test]
 fn bad_worldlines_name_the_key() {
     let cases = [
