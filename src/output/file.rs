@@ -3,7 +3,7 @@
 //! over the target only when complete, with the target's permissions. A symbolic link is
 //! written through (the link stays, its target is replaced); a read-only target or a directory
 //! is refused, and so is a device, FIFO or socket. Partial files of this machine's runs that
-//! died (killed, or the machine stopped) are removed by the next write to the same name; another
+//! died (killed, or the machine stopped) are removed by the next write into the same folder; another
 //! node's on a shared file system, or another container's, are left to their writers
 //! ([`partial_path`]); the command line removes its own on Ctrl-C and SIGTERM
 //! ([`remove_partial_files`]).
@@ -204,11 +204,13 @@ fn machine() -> String {
         .clone()
 }
 
-/// Remove the partial files of `target` left by processes of this machine that no longer run
-/// (Linux: no /proc/PID). Another machine's, another container's, or where it cannot tell, it
-/// leaves.
+/// Remove the partial files in `target`'s folder, of any name, left by processes of this
+/// machine that no longer run (Linux: no /proc/PID): a render killed outright leaves its file
+/// to the next render into the folder, not only to the next of the same name (a film's
+/// frames each have their own). Another machine's, another container's, or where it cannot
+/// tell, it leaves.
 fn remove_stale_partials(target: &Path) {
-    let (Some(dir), Some(name)) = (target.parent(), target.file_name()) else {
+    let Some(dir) = target.parent() else {
         return;
     };
     let dir = if dir.as_os_str().is_empty() {
@@ -219,15 +221,17 @@ fn remove_stale_partials(target: &Path) {
     if !Path::new("/proc/self").exists() {
         return;
     }
-    let prefix = format!(".{}.partial-{}-", name.to_string_lossy(), machine());
+    let marker = format!(".partial-{}-", machine());
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };
     for e in entries.flatten() {
         let file = e.file_name().to_string_lossy().into_owned();
         let Some(pid) = file
-            .strip_prefix(&prefix)
-            .and_then(|p| p.parse::<u32>().ok())
+            .strip_prefix('.')
+            .and_then(|f| f.rsplit_once(&marker))
+            .filter(|(name, _)| !name.is_empty())
+            .and_then(|(_, pid)| pid.parse::<u32>().ok())
         else {
             continue;
         };
@@ -320,18 +324,24 @@ mod tests {
         let dead = partial_name(&target, 4_194_305);
         // Process 1 always runs: its partial file may be in the middle of being written.
         let live = partial_name(&target, 1);
+        // Another file's, a frame of a film say, left by a run killed outright.
         let other = partial_name(&d.join("other.exr"), 4_194_305);
+        let other_live = partial_name(&d.join("other.exr"), 1);
         // Another node's (or container's), or one of a version that did not name the
         // machine: its process cannot be seen from here.
         let elsewhere = d.join(".out.exr.partial-node7.0123abcd.4026531836-4194305");
         let unnamed = d.join(".out.exr.partial-4194305");
-        for f in [&dead, &live, &other, &elsewhere, &unnamed] {
+        for f in [&dead, &live, &other, &other_live, &elsewhere, &unnamed] {
             std::fs::write(f, "half").unwrap();
         }
         write_whole(&target, bytes("whole")).unwrap();
         assert!(!dead.exists(), "a dead run's partial file is removed");
         assert!(live.exists(), "a running process's partial file is left");
-        assert!(other.exists(), "another file's partials are not touched");
+        assert!(
+            !other.exists(),
+            "another file's dead partial is removed too"
+        );
+        assert!(other_live.exists(), "another file's live partial is left");
         assert!(
             elsewhere.exists() && unnamed.exists(),
             "other machines' are left"
