@@ -269,13 +269,35 @@ fn reference(scene: &Scene, spp: u32) -> crate::Result<Frame> {
     Ok(render_world(&s, &World::build(&s, bvh.as_ref())?).0)
 }
 
-/// The fastest of at least `repeat` runs of `f`, and of as many more as fit in a quarter of a
-/// second: a pass of a few milliseconds is easily slowed by anything else on the machine.
-fn fastest(repeat: usize, mut f: impl FnMut()) -> f64 {
+/// How long a timing runs: at least `repeat` runs, and more (at most 100) until `floor_s`
+/// seconds have passed, since a pass of a few milliseconds is easily slowed by anything else on
+/// the machine. `--quick` keeps the floor short: its figures are a look, not a record.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Timing {
+    pub repeat: usize,
+    pub floor_s: f64,
+}
+
+impl Timing {
+    pub(crate) fn new(repeat: usize, quick: bool) -> Timing {
+        Timing {
+            repeat,
+            floor_s: if quick { 0.03 } else { 0.25 },
+        }
+    }
+
+    /// The same floor, with at least `repeat` runs.
+    fn runs(self, repeat: usize) -> Timing {
+        Timing { repeat, ..self }
+    }
+}
+
+/// The fastest run of `f` under `t`.
+fn fastest(t: Timing, mut f: impl FnMut()) -> f64 {
     let start = Instant::now();
     let mut best = f64::INFINITY;
     let mut runs = 0;
-    while runs < repeat.max(1) || (start.elapsed().as_secs_f64() < 0.25 && runs < 100) {
+    while runs < t.repeat.max(1) || (start.elapsed().as_secs_f64() < t.floor_s && runs < 100) {
         let t = Instant::now();
         f();
         best = best.min(t.elapsed().as_secs_f64());
@@ -310,7 +332,7 @@ fn write_like_the_command(
     written.map(|()| secs)
 }
 
-fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result<(Row, Frame)> {
+fn measure(case: &Case, setting: &str, spp: u32, t: Timing) -> crate::Result<(Row, Frame)> {
     let (backend_name, options, written) = parse_setting(setting)?;
     let passes = written.passes();
     let backend = backend_by_name(backend_name)?;
@@ -323,7 +345,7 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result
     // fresh worlds, one at a time, keep the fastest build and the fastest first render.
     let (mut build_s, mut first_render_s) = (f64::INFINITY, f64::INFINITY);
     let mut kept = None;
-    for i in 0..repeat.max(1) {
+    for i in 0..t.repeat.max(1) {
         if i > 0 && build_s + first_render_s > 0.1 {
             break;
         }
@@ -341,8 +363,8 @@ fn measure(case: &Case, setting: &str, spp: u32, repeat: usize) -> crate::Result
     // Then the fastest primary pass and render: passes of a few milliseconds vary by tens of
     // percent.
     let mut primary_rays = 0;
-    let primary_s = fastest(repeat, || primary_rays = trace_primary(&scene, &world).0);
-    let render_s = first_render_s.min(fastest(repeat.saturating_sub(1), || {
+    let primary_s = fastest(t, || primary_rays = trace_primary(&scene, &world).0);
+    let render_s = first_render_s.min(fastest(t.runs(t.repeat.saturating_sub(1)), || {
         render_world_passes(&scene, &world, passes);
     }));
     // No figure of a render the backend recorded a fault in.
@@ -384,11 +406,11 @@ fn beside(
     case: &Case,
     (what, one): (&str, &Scene),
     setting: &str,
-    repeat: usize,
+    t: Timing,
     row: &mut Row,
 ) -> crate::Result<Beside> {
     let alone = Case::new(&case.name, one.clone(), &[setting]).without_hi_reference();
-    let (one_row, _) = measure(&alone, setting, 1, repeat)?;
+    let (one_row, _) = measure(&alone, setting, 1, t)?;
     let (backend_name, options, written) = parse_setting(setting)?;
     let passes = written.passes();
     let backend = backend_by_name(backend_name)?;
@@ -402,8 +424,8 @@ fn beside(
     render(&one, &one_world);
     let (mut many_s, mut one_s) = (row.render_s, one_row.render_s);
     for _ in 0..PAIRED_BLOCKS {
-        many_s = many_s.min(fastest(repeat, || render(&many, &many_world)));
-        one_s = one_s.min(fastest(repeat, || render(&one, &one_world)));
+        many_s = many_s.min(fastest(t, || render(&many, &many_world)));
+        one_s = one_s.min(fastest(t, || render(&one, &one_world)));
     }
     row.render_s = many_s;
     many_world.check()?;
@@ -498,7 +520,7 @@ const PAIRED_BLOCKS: usize = 3;
 /// from run to run than bare Embree's). Passes alternated one by one instead would start each
 /// with the other's data in the caches.
 #[cfg(feature = "embree")]
-fn bare_embree(case: &Case, repeat: usize) -> crate::Result<Option<(u64, f64, f64)>> {
+fn bare_embree(case: &Case, t: Timing) -> crate::Result<Option<(u64, f64, f64)>> {
     use rayon::prelude::*;
     let (world, accel) = world_and_accel(&case.scene, "embree", WorldOptions::default())?;
     let Some(accel) = accel else {
@@ -516,22 +538,22 @@ fn bare_embree(case: &Case, repeat: usize) -> crate::Result<Option<(u64, f64, f6
     };
     let (mut bare_s, mut layer_s) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..PAIRED_BLOCKS {
-        layer_s = layer_s.min(fastest(repeat, layer));
-        bare_s = bare_s.min(fastest(repeat, bare));
+        layer_s = layer_s.min(fastest(t, layer));
+        bare_s = bare_s.min(fastest(t, bare));
     }
     world.check()?;
     Ok(Some((n, bare_s, layer_s)))
 }
 
 #[cfg(not(feature = "embree"))]
-fn bare_embree(_: &Case, _: usize) -> crate::Result<Option<(u64, f64, f64)>> {
+fn bare_embree(_: &Case, _: Timing) -> crate::Result<Option<(u64, f64, f64)>> {
     Ok(None)
 }
 
 /// Run the cases; settings whose backend is not in this build are left out.
 pub(crate) fn run(
     cases: &[LazyCase],
-    repeat: usize,
+    timing: Timing,
     mut progress: impl FnMut(&str),
 ) -> crate::Result<Vec<Row>> {
     let mut rows = Vec::new();
@@ -562,11 +584,11 @@ pub(crate) fn run(
                 .chain(case.extra_spp.iter().copied().filter(|_| plain))
                 .collect();
             for spp in spps {
-                let (mut row, frame) = measure(case, setting, spp, repeat)?;
+                let (mut row, frame) = measure(case, setting, spp, timing)?;
                 if let (Some((what, other)), 1, "embree" | "bvh") =
                     (&case.beside, spp, setting.as_str())
                 {
-                    let b = beside(case, (what, other), setting, repeat, &mut row)?;
+                    let b = beside(case, (what, other), setting, timing, &mut row)?;
                     row.beside = Some(b);
                 }
                 if !refs.iter().any(|(s, _)| *s == spp) {
@@ -579,7 +601,7 @@ pub(crate) fn run(
             }
         }
         if case.bare {
-            if let Some((n, secs, layer_s)) = bare_embree(case, repeat)? {
+            if let Some((n, secs, layer_s)) = bare_embree(case, timing)? {
                 // The layer's passes beside bare Embree's count among the "embree" setting's.
                 if let Some(e) = rows
                     .iter_mut()
@@ -649,7 +671,7 @@ mod tests {
                     small()
                 })
         });
-        let rows = run(&[lazy], 1, |_| {}).unwrap();
+        let rows = run(&[lazy], Timing::new(1, true), |_| {}).unwrap();
         assert_eq!(rows.len(), 1);
         let load = rows[0].load_s;
         assert!(

@@ -59,7 +59,7 @@ pub(crate) fn summary(quick: bool, backends: &[&str]) -> crate::Result<String> {
         for spp in [16, 64, 256] {
             let sc = scene(width, spp)?;
             let mut out = None;
-            let secs = super::fastest(if quick { 1 } else { 2 }, || {
+            let secs = super::fastest(super::Timing::new(if quick { 1 } else { 2 }, quick), || {
                 out = Some(render_progressive(
                     &sc,
                     &world,

@@ -45,11 +45,11 @@ fn rms(a: &Frame, b: &Frame) -> f64 {
 
 /// Seconds per sample per pixel of `scene` over the image: the fastest render at `hi` samples
 /// less the fastest at `lo`, over `hi − lo`.
-fn per_sample(scene: &Scene, world: &World, (lo, hi): (u32, u32), repeat: usize) -> f64 {
+fn per_sample(scene: &Scene, world: &World, (lo, hi): (u32, u32), t: super::Timing) -> f64 {
     let at = |spp: u32| {
         let mut sc = scene.clone();
         sc.image.samples = spp;
-        super::fastest(repeat, || {
+        super::fastest(t, || {
             render_world_passes(&sc, world, Passes::Colour);
         })
     };
@@ -79,7 +79,10 @@ pub(crate) fn summary(quick: bool, backend: &str) -> crate::Result<String> {
             ..WorldOptions::default()
         };
         let world = World::build_with(&scene, b.as_ref(), options)?;
-        cost.push((what, per_sample(&scene, &world, (lo, hi), repeat)));
+        cost.push((
+            what,
+            per_sample(&scene, &world, (lo, hi), super::Timing::new(repeat, quick)),
+        ));
     }
     let world = World::build(&scene, b.as_ref())?;
     let truth = render_world_passes(&room(size, reference_spp, 7)?, &world, Passes::Colour).0;
@@ -114,7 +117,12 @@ pub(crate) fn summary(quick: bool, backend: &str) -> crate::Result<String> {
     for v in ["0.7", "0"] {
         let sc = glow(v)?;
         let world = World::build(&sc, b.as_ref())?;
-        glow_cost.push(per_sample(&sc, &world, (lo / 2, hi / 2), repeat));
+        glow_cost.push(per_sample(
+            &sc,
+            &world,
+            (lo / 2, hi / 2),
+            super::Timing::new(repeat, quick),
+        ));
     }
     let _ = writeln!(
         lines,

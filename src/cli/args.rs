@@ -103,7 +103,8 @@ pub(crate) struct BenchArgs {
     /// switched off, e.g. 'embree no-cull' (default: every backend of this build).
     #[arg(long = "backend")]
     pub backends: Vec<String>,
-    /// Smaller images and scenes: the whole suite in well under a minute.
+    /// Smaller images and scenes, and shorter timings: the whole suite in under a minute on two
+    /// cores, for a look (its figures vary more than the full suite's).
     #[arg(long)]
     pub quick: bool,
     /// Only this case of the suite, or where no case has this name, every case whose name

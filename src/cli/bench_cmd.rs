@@ -112,14 +112,18 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         String::new()
     };
     let mut started = 0;
-    let rows = bench::run(&cases, args.repeat, |name| match &bar {
-        Some(bar) => {
-            bar.set_position(started);
-            bar.set_message(name.to_string());
-            started += 1;
-        }
-        None => crate::text::warn(format_args!("bench: {name}")),
-    });
+    let rows = bench::run(
+        &cases,
+        bench::Timing::new(args.repeat, args.quick),
+        |name| match &bar {
+            Some(bar) => {
+                bar.set_position(started);
+                bar.set_message(name.to_string());
+                started += 1;
+            }
+            None => crate::text::warn(format_args!("bench: {name}")),
+        },
+    );
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
@@ -128,22 +132,31 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
     let mut summary = bench::summary(&rows);
     summary.push_str(&files);
     if args.scene.is_none() && args.cases.is_empty() {
+        // The measures beside the table, each said as it starts: some take tens of seconds.
+        let step = |what: &str| crate::text::warn(format_args!("bench: {what}"));
         for b in accel::backend_names() {
+            step(&format!("a film's cost ({b})"));
             summary.push_str(&bench::film_cost(args.quick, b)?);
         }
         for b in accel::backend_names() {
+            step(&format!("the viewer's latency ({b})"));
             summary.push_str(&crate::view::latency(args.quick, b)?);
         }
+        step("the 1000^3 lattice");
         summary.push_str(&bench_lattice::summary(args.quick, &accel::backend_names()));
+        step("the path integrator's noise against time");
         summary.push_str(&bench::path_noise(args.quick, &accel::backend_names())?);
+        step("the path integrator's cost per sample");
         summary.push_str(&bench::path_room(
             args.quick,
             accel::default_backend_name(),
         )?);
+        step("EXR writing");
         summary.push_str(&bench::exr_writing(
             args.quick,
             accel::default_backend_name(),
         )?);
+        step("threads");
         summary.push_str(&bench::thread_scaling(
             args.quick,
             accel::default_backend_name(),
