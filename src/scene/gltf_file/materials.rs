@@ -90,5 +90,21 @@ pub(super) fn material(
         )
         .into());
     }
+    // The limits a scene's own material has (`ior` 1 or more, numbers within the envelope).
+    let limit = crate::scene::envelope::MAX_MAGNITUDE;
+    if strength > limit {
+        return Err(format!(
+            "material `{}`'s emissiveStrength is {strength:e}; at most {limit:e} is taken",
+            out.name
+        )
+        .into());
+    }
+    if !(1.0..=limit).contains(&out.ior) {
+        return Err(format!(
+            "material `{}`'s KHR_materials_ior ior is {}; it must be 1 or more (and at most {limit:e})",
+            out.name, out.ior
+        )
+        .into());
+    }
     Ok(out)
 }

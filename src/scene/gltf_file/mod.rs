@@ -223,6 +223,19 @@ pub(crate) fn read(path: &Path, split_all: bool, share_every: bool) -> Result<Gl
             keys,
         });
     }
+    // The walk has refused cycles: each keyed node's subtree is a tree.
+    fn holds_camera(n: &gltf::Node) -> bool {
+        n.camera().is_some() || n.children().any(|c| holds_camera(&c))
+    }
+    if let Some(n) = gltf
+        .nodes()
+        .find(|n| keys.contains_key(&n.index()) && holds_camera(n))
+    {
+        reading.warnings.push(format!(
+            "node {}'s translation is animated and it holds a camera: the camera stands where it is at time 0 (give [camera] a velocity or worldline to move it)",
+            n.index()
+        ));
+    }
     let untaken = gltf.animations().count() > 0
         && keys
             .keys()
@@ -315,6 +328,35 @@ fn checked_beyond_validation(root: &gltf::json::Root) -> Result<(), GltfError> {
         };
         if !whole {
             return Err(format!("camera {i} lacks the projection its type names").into());
+        }
+    }
+    // The crate's readers assert that an element fits its stride (a panic otherwise), and
+    // glTF 2.0 asks an accessor's offsets to be multiples of its component's size.
+    for (i, acc) in root.accessors.iter().enumerate() {
+        let (Valid(c), Valid(t), Some(view)) = (acc.component_type, acc.type_, acc.buffer_view)
+        else {
+            continue;
+        };
+        let Some(view) = root.buffer_views.get(view.value()) else {
+            continue;
+        };
+        let (size, element) = (c.0.size(), c.0.size() * t.multiplicity());
+        if let Some(stride) = view.byte_stride {
+            if stride.0 < element || stride.0 % size != 0 {
+                return Err(format!(
+                    "accessor {i}: its buffer view's byteStride {} does not hold its {element}-byte elements in steps of {size} bytes, as glTF 2.0 requires",
+                    stride.0
+                )
+                .into());
+            }
+        }
+        let offset = (acc.byte_offset.map_or(0, |o| o.0))
+            .saturating_add(view.byte_offset.map_or(0, |o| o.0));
+        if offset % size as u64 != 0 {
+            return Err(format!(
+                "accessor {i}: its data starts at byte {offset} of its buffer, not a multiple of its {size}-byte components, as glTF 2.0 requires"
+            )
+            .into());
         }
     }
     let kind = |a: usize| {

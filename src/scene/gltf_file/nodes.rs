@@ -118,14 +118,17 @@ impl Reading<'_> {
         }
         if let Some(cam) = node.camera() {
             match cam.projection() {
+                // The scene's own least field of view (`fov_y`, in degrees) holds here too.
                 gltf::camera::Projection::Perspective(p)
-                    if !(f64::from(p.yfov()) > 0.0
+                    if !(f64::from(p.yfov()).to_degrees() >= crate::scene::envelope::MIN_FOV_DEG
                         && f64::from(p.yfov()) < std::f64::consts::PI) =>
                 {
                     return Err(format!(
-                        "camera {}'s yfov {} is not between 0 and π",
+                        "camera {}'s yfov {} is not between {:e} rad ({:e}°) and π",
                         cam.index(),
-                        p.yfov()
+                        p.yfov(),
+                        crate::scene::envelope::MIN_FOV_DEG.to_radians(),
+                        crate::scene::envelope::MIN_FOV_DEG
                     )
                     .into())
                 }
@@ -176,13 +179,24 @@ impl Reading<'_> {
         let mirrored = linear.determinant() < 0.0;
         for prim in m.primitives() {
             let what = || format!("mesh {} primitive {}", m.index(), prim.index());
-            if prim.mode() != gltf::mesh::Mode::Triangles {
+            use gltf::mesh::Mode;
+            let mode = prim.mode();
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
                 self.warnings.push(format!(
                     "{} is not triangles ({:?}): it is ignored",
                     what(),
-                    prim.mode()
+                    mode
                 ));
                 continue;
+            }
+            if prim.morph_targets().next().is_some() {
+                self.warnings.push(format!(
+                    "{}'s morph targets are ignored (it is taken in its base shape)",
+                    what()
+                ));
             }
             let reader = prim.reader(|b| self.buffers.get(b.index()).map(Vec::as_slice));
             let positions: Vec<DVec3> = reader
@@ -203,6 +217,14 @@ impl Reading<'_> {
                     return Err(format!("{}: its indices lie outside their buffer", what()).into())
                 }
             };
+            let indices = match mode {
+                Mode::TriangleStrip => strip_triangles(&indices),
+                Mode::TriangleFan => fan_triangles(&indices),
+                _ => indices,
+            };
+            if indices.is_empty() {
+                return Err(format!("{}: it makes no triangle ({} vertices)", what(), n).into());
+            }
             if !indices.len().is_multiple_of(3) {
                 return Err(format!(
                     "{}: {} indices, not a whole number of triangles",
@@ -319,4 +341,65 @@ pub(super) fn face_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[
             [(v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero(); 3]
         })
         .collect()
+}
+
+/// The triangles of a TRIANGLE_STRIP, as glTF 2.0 lists them (§3.7.2.1): triangle i is
+/// (v[i], v[i+1+i%2], v[i+2-i%2]), every other one turned so that all face one way.
+fn strip_triangles(v: &[u32]) -> Vec<u32> {
+    (0..v.len().saturating_sub(2))
+        .flat_map(|i| [v[i], v[i + 1 + i % 2], v[i + 2 - i % 2]])
+        .collect()
+}
+
+/// The triangles of a TRIANGLE_FAN, as glTF 2.0 lists them: triangle i is
+/// (v[i+1], v[i+2], v[0]).
+fn fan_triangles(v: &[u32]) -> Vec<u32> {
+    (0..v.len().saturating_sub(2))
+        .flat_map(|i| [v[i + 1], v[i + 2], v[0]])
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A strip's and a fan's triangles all face the way their first does (glTF's order), and
+    /// cover what the equivalent list covers.
+    #[test]
+    fn strips_and_fans_are_the_triangles_gltf_lists() {
+        // A row of five points on a zig-zag in the plane z = 0, and a fan around the origin.
+        let strip_points = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(2.0, 0.0, 0.0),
+        ];
+        let fan_points = [
+            DVec3::ZERO,
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(-1.0, 1.0, 0.0),
+        ];
+        let v = [0, 1, 2, 3, 4];
+        let strip = strip_triangles(&v);
+        assert_eq!(strip, vec![0, 1, 2, 1, 3, 2, 2, 3, 4]);
+        let fan = fan_triangles(&v);
+        assert_eq!(fan, vec![1, 2, 0, 2, 3, 0, 3, 4, 0]);
+        for (tris, points) in [(strip, strip_points), (fan, fan_points)] {
+            let facing: Vec<f64> = tris
+                .chunks(3)
+                .map(|t| {
+                    let [a, b, c] = [0, 1, 2].map(|k| points[t[k] as usize]);
+                    (b - a).cross(c - a).z
+                })
+                .collect();
+            assert!(
+                facing.iter().all(|&z| z * facing[0] > 0.0),
+                "{tris:?}: {facing:?}"
+            );
+        }
+        assert!(strip_triangles(&[0, 1]).is_empty() && fan_triangles(&[]).is_empty());
+    }
 }

@@ -151,6 +151,46 @@ fn bad_gltf_files_are_clear_errors() {
             "{key}: {err}"
         );
     }
+    // Beyond a scene's own material's limits: an index of refraction below 1, an emission
+    // beyond the envelope's 1e15.
+    for (key, material) in [
+        (
+            "ior",
+            json!({"name": "paint", "extensions": {"KHR_materials_ior": {"ior": 0.5}}}),
+        ),
+        (
+            "emissiveStrength",
+            json!({"name": "paint", "emissiveFactor": [1.0, 1.0, 1.0],
+            "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e30}}}),
+        ),
+    ] {
+        let mut paint = Doc::unit_box(nested_nodes());
+        paint.json["meshes"][0]["primitives"][0]["material"] = json!(0);
+        paint.json["materials"] = json!([material]);
+        let err = refused(&d, "limits.glb", &paint.glb());
+        assert!(err.contains("`paint`") && err.contains(key), "{key}: {err}");
+    }
+    // A field of view below the scene's least (1e-6°).
+    let mut narrow = Doc::unit_box(nested_nodes());
+    narrow.json["cameras"] =
+        json!([{"type": "perspective", "perspective": {"yfov": 1e-12, "znear": 0.1}}]);
+    narrow.json["nodes"][0]["camera"] = json!(0);
+    let err = refused(&d, "narrow.glb", &narrow.glb());
+    assert!(err.contains("yfov") && err.contains("1e-6"), "{err}");
+    // A stride smaller than a VEC3 (the crate's reader asserted: a panic), and data that does
+    // not start on a whole component.
+    let pos = positions(&Doc::unit_box(nested_nodes()));
+    let mut stride = Doc::unit_box(nested_nodes());
+    stride.json["bufferViews"][0]["byteStride"] = json!(4);
+    let err = refused(&d, "stride.glb", &stride.glb());
+    assert!(
+        err.contains(&format!("accessor {pos}")) && err.contains("byteStride 4"),
+        "{err}"
+    );
+    let mut skew = Doc::unit_box(nested_nodes());
+    skew.json["accessors"][pos]["byteOffset"] = json!(1);
+    let err = refused(&d, "skew.glb", &skew.glb());
+    assert!(err.contains("not a multiple"), "{err}");
     // Two top-level nodes of one name, each a group of its own: refused, naming it.
     let mut twins = Doc::unit_box(json!([
         {"name": "Ship", "translation": [0, 10.5, 0], "mesh": 0},

@@ -180,6 +180,112 @@ fn a_box_from_gltf_renders_as_the_box_in_every_container() {
     }
 }
 
+/// The unit box as six primitives, one a face, each a TRIANGLE_STRIP or a TRIANGLE_FAN of the
+/// face's four corners, renders as the box of triangle lists; a primitive's morph targets are
+/// said to be ignored.
+#[test]
+fn strips_and_fans_render_as_the_triangles_they_list() {
+    let d = Dir::new("gltf-strips");
+    let sets = ["image.width=96", "image.height=64"];
+    let reference = load(&d, "box.toml", GOOD, &sets);
+    for (mode, order) in [(5, [1, 2, 0, 3]), (6, [0, 1, 2, 3])] {
+        // Strip (f1, f2, f0, f3): triangles (f1, f2, f0) and (f2, f3, f0); fan (f0, f1, f2,
+        // f3): the same two; the list's are (f0, f1, f2) and (f0, f2, f3), turned the same way.
+        let mut doc = Doc::unit_box(nested_nodes());
+        let mut primitives = Vec::new();
+        for f in BOX_FACES {
+            let offset = doc.bin.len();
+            for k in order {
+                doc.bin.extend_from_slice(&(f[k] - 1).to_le_bytes());
+            }
+            let views = doc.json["bufferViews"].as_array_mut().unwrap();
+            views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 16}));
+            let view = views.len() - 1;
+            let accessors = doc.json["accessors"].as_array_mut().unwrap();
+            accessors.push(
+                json!({"bufferView": view, "componentType": 5125, "count": 4, "type": "SCALAR"}),
+            );
+            let ix = accessors.len() - 1;
+            primitives.push(json!({"attributes": {"POSITION": 0}, "indices": ix, "mode": mode}));
+        }
+        doc.json["buffers"][0]["byteLength"] = json!(doc.bin.len());
+        primitives[0]["targets"] = json!([{"POSITION": 0}]);
+        doc.json["meshes"][0]["primitives"] = json!(primitives);
+        std::fs::write(d.0.join("faces.glb"), doc.glb()).unwrap();
+        let scene = load(
+            &d,
+            "faces.toml",
+            &with_object("type = \"gltf\"\nfile = \"faces.glb\""),
+            &sets,
+        );
+        assert!(
+            !scene.warnings.iter().any(|w| w.contains("not triangles")),
+            "{:?}",
+            scene.warnings
+        );
+        assert!(
+            scene
+                .warnings
+                .iter()
+                .any(|w| w.contains("morph targets are ignored")),
+            "{:?}",
+            scene.warnings
+        );
+        for b in backends() {
+            let (a, m) = (render_with(&reference, b), render_with(&scene, b));
+            let hit = a.pixels.iter().filter(|p| p.object_id == 1).count();
+            assert!(hit > 100, "the box is in view ({hit} pixels)");
+            let (all, inside) = differing(&a, &m);
+            assert_eq!(
+                inside, 0,
+                "mode {mode} on {b}: {all} differ, {inside} inside"
+            );
+            assert!(
+                all * 50 < a.pixels.len(),
+                "mode {mode} on {b}: {all} differ"
+            );
+        }
+    }
+}
+
+/// A keyframed node that holds the camera: the camera stands as at time 0, and says so.
+#[test]
+fn a_keyframed_camera_is_said_to_stand() {
+    let d = Dir::new("gltf-keyed-camera");
+    let mut doc = keyed_box(
+        &[(0.0, [0.0, 10.5, 0.0]), (1.0, [0.1, 10.5, 0.0])],
+        "LINEAR",
+    );
+    doc.json["cameras"] =
+        json!([{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}]);
+    doc.json["nodes"][0]["camera"] = json!(0);
+    std::fs::write(d.0.join("cam.glb"), doc.glb()).unwrap();
+    let scene = load(
+        &d,
+        "cam.toml",
+        &at_time("type = \"gltf\"\nfile = \"cam.glb\"", "", 10.0),
+        &[],
+    );
+    assert!(
+        scene.warnings.iter().any(|w| w.contains("holds a camera")),
+        "{:?}",
+        scene.warnings
+    );
+    // Keyed without a camera: no such word.
+    let plain = keyed_box(
+        &[(0.0, [0.0, 10.5, 0.0]), (1.0, [0.1, 10.5, 0.0])],
+        "LINEAR",
+    );
+    std::fs::write(d.0.join("plain.glb"), plain.glb()).unwrap();
+    let scene = load(
+        &d,
+        "plain.toml",
+        &at_time("type = \"gltf\"\nfile = \"plain.glb\"", "", 10.0),
+        &[],
+    );
+    assert!(!scene.warnings.iter().any(|w| w.contains("holds a camera")));
+}
+
 /// GOOD's box (or `object` in its place) at rest in the world (its light too), seen at camera
 /// time `time`.
 fn at_time(object: &str, velocity: &str, time: f64) -> String {
