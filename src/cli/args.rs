@@ -207,6 +207,20 @@ pub(crate) struct RenderArgs {
 
 impl RenderArgs {
     /// When a progressive render stops (None: not progressive, every sample at once).
+    /// What a still's file records of the command line (`renderOverrides`, and the render id
+    /// `--resume` compares): the overrides as given, then the rule that stopped its rounds
+    /// (--max-time, --target-rms), which decides how many samples it took.
+    pub(super) fn recorded(&self) -> Vec<String> {
+        let mut v: Vec<String> = self.overrides().into_iter().map(|(s, _)| s).collect();
+        if let Some(t) = self.max_time {
+            v.push(format!("--max-time {t:?}"));
+        }
+        if let Some(r) = self.target_rms {
+            v.push(format!("--target-rms {r:?}"));
+        }
+        v
+    }
+
     pub(super) fn stop_at(&self) -> Option<render::StopAt> {
         (self.max_time.is_some() || self.target_rms.is_some()).then(|| render::StopAt {
             max_time: self.max_time.map(std::time::Duration::from_secs_f64),

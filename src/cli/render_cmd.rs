@@ -23,11 +23,7 @@ pub(super) fn exr_options(
             scene,
             backend_name,
             &args.scene.display().to_string(),
-            &args
-                .overrides()
-                .into_iter()
-                .map(|(shown, _)| shown)
-                .collect::<Vec<_>>(),
+            &args.recorded(),
         )
     }
 }
@@ -60,18 +56,39 @@ pub(super) fn render_to_file(
     let mut stats = render::RenderStats::default();
     let written = match format {
         output::Format::Exr => {
-            let exr = match made {
+            let mut exr = match made {
                 Some(exr) => exr,
                 None => exr_options(scene, backend_name, args),
             };
+            // Colour and alpha alone need no centre ray per pixel.
+            let passes = match scene.image.passes.is_empty() {
+                true => Passes::Colour,
+                false => Passes::All,
+            };
+            // A still rendered in rounds (--max-time, --target-rms) is whole before its file is
+            // begun: its header says the samples it took, not the most it could.
+            let rounds = args
+                .stop_at()
+                .map(|stop| render_rounds(scene, world, passes, stop, progress, args));
+            if let Some(Ok((_, s))) = &rounds {
+                exr = exr.with_samples(s.samples.unwrap_or(scene.image.samples));
+            }
             let written = output::write_exr_in_strips(path, (w, h), true, &exr, |put| {
-                let strip = memory::STRIP_PIXELS;
-                // Colour and alpha alone need no centre ray per pixel.
-                let passes = match scene.image.passes.is_empty() {
-                    true => Passes::Colour,
-                    false => Passes::All,
+                stats = match rounds {
+                    Some(done) => {
+                        let (frame, s) = done?;
+                        put(&frame)?;
+                        s
+                    }
+                    None => render::render_world_in_strips(
+                        scene,
+                        world,
+                        passes,
+                        memory::STRIP_PIXELS,
+                        progress,
+                        put,
+                    )?,
                 };
-                stats = render_pixels(scene, world, passes, strip, progress, args, put)?;
                 Ok(())
             });
             progress.inspect(|p| p.finish());
@@ -81,7 +98,7 @@ pub(super) fn render_to_file(
         }
         output::Format::Png => {
             let alpha = scene.image.is_transparent();
-            let shown: Vec<String> = args.overrides().into_iter().map(|(s, _)| s).collect();
+            let shown = args.recorded();
             let id = output::header::render_id(scene, backend_name, &shown);
             let written = output::write_png_in_strips(path, (w, h), alpha, Some(&id), |put| {
                 let strip = memory::STRIP_PIXELS;
@@ -122,9 +139,23 @@ fn render_pixels(
     let Some(stop) = args.stop_at() else {
         return render::render_world_in_strips(scene, world, passes, strip, progress, put);
     };
+    let (frame, stats) = render_rounds(scene, world, passes, stop, progress, args)?;
+    put(&frame)?;
+    Ok(stats)
+}
+
+/// The frame rendered in rounds until `stop` (--max-time, --target-rms), and what the rounds
+/// did said.
+fn render_rounds(
+    scene: &scene::Scene,
+    world: &render::World,
+    passes: Passes,
+    stop: render::StopAt,
+    progress: Option<&render::Progress>,
+    args: &RenderArgs,
+) -> std::result::Result<(render::Frame, render::RenderStats), crate::Cause> {
     let (frame, stats, done) = render::render_progressive(scene, world, passes, stop, progress)?;
     progress.inspect(|p| p.finish());
-    put(&frame)?;
     if !args.quiet {
         let rms = done
             .rms
@@ -136,7 +167,7 @@ fn render_pixels(
             done.samples, done.rounds, done.stopped_by
         ));
     }
-    Ok(stats)
+    Ok((frame, stats))
 }
 
 /// Refuse a render whose frame and geometry would not fit in memory, blaming the image size.
@@ -227,6 +258,20 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
         scene.image.transparent.get_or_insert(false);
     }
     if let (Some(grid), Some(index)) = (args.tiles, args.tile) {
+        // Each tile would stop at its own noise or time: the tiles would not join into the
+        // one render `assemble` makes of them.
+        if let Some(flag) = [
+            ("--max-time", args.max_time),
+            ("--target-rms", args.target_rms),
+        ]
+        .iter()
+        .find_map(|(f, v)| v.map(|_| *f))
+        {
+            return Err(Error::flag(
+                flag,
+                "applies to a whole still; a tile of --tiles renders its `samples`, so that the tiles join into one render",
+            ));
+        }
         let what = format!("tile {index}");
         output::file::refuse_link(&args.output, &what).map_err(|e| e.on_flag("-o"))?;
         let shown = format!("--tiles {}x{} --tile {index}", grid.0, grid.1);
@@ -285,7 +330,7 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     }
     // A still (or a farm's tile) already written whole by this very render is kept.
     if args.resume && std::fs::symlink_metadata(&args.output).is_ok() {
-        let shown: Vec<String> = args.overrides().into_iter().map(|(s, _)| s).collect();
+        let shown = args.recorded();
         let id = output::header::render_id(&scene, &backend_name, &shown);
         let size = scene.image.frame_size();
         match output::finished(&args.output, format, size, &id) {

@@ -230,6 +230,18 @@ pub(crate) fn write_png_in_strips(
 /// Write an EXR of `width` × `height` whose rows `fill` hands on in strips, top to bottom (each
 /// but the last a whole number of 32-row blocks), as it renders them: the image is never held
 /// whole. `mattes`: whether the strips carry Cryptomatte mattes.
+impl ExrOptions {
+    /// The same, its header saying `samples` were taken per pixel (`renderSamples`).
+    pub(crate) fn with_samples(mut self, samples: u32) -> ExrOptions {
+        for (name, value) in &mut self.attributes {
+            if name == "renderSamples" {
+                *value = Attribute::Int(samples as i32);
+            }
+        }
+        self
+    }
+}
+
 pub(crate) fn write_exr_in_strips(
     path: &Path,
     size: (u32, u32),

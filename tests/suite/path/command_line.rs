@@ -62,6 +62,38 @@ fn time_and_noise_budgets_on_the_command_line() {
     ]);
     assert!(ok && err.contains("stopped by target"), "{err}");
     assert!(out.exists());
+    // The header says the samples the rounds took, and the rule that stopped them (so that
+    // `--resume` with another rule renders again); a tile cannot stop on its own.
+    let taken: u32 = err
+        .split(" spp in ")
+        .next()
+        .and_then(|a| a.rsplit(|c: char| !c.is_ascii_digit()).next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("the samples taken in: {err}"));
+    assert!(taken < 64, "{err}");
+    let info = crate::common::cli::oiiotool(&["--info", "-v", o]);
+    assert!(
+        info.contains(&format!("renderSamples: {taken}\n"))
+            && info.contains("--max-time 60.0")
+            && info.contains("--target-rms 3.0"),
+        "{taken} spp: {info}"
+    );
+    let (code, err) = crate::common::cli::status(&[
+        "render",
+        s,
+        "-o",
+        o,
+        "--target-rms",
+        "3",
+        "--tiles",
+        "2x1",
+        "--tile",
+        "0",
+    ]);
+    assert!(
+        code == Some(1) && err.contains("--target-rms") && err.contains("tiles"),
+        "{err}"
+    );
     for (flag, value, needles) in [
         ("--target-rms", "0", vec!["--target-rms", "must be above 0"]),
         ("--max-time", "-1", vec!["--max-time", "must be above 0"]),
