@@ -281,6 +281,12 @@ fn render(
     progress: Option<PyObject>,
 ) -> PyResult<Image> {
     let name = backend.unwrap_or_else(|| rest_embree::accel::default_backend_name().to_string());
+    // The command line's limit (0 here means every core): a million threads would take the
+    // machine's memory and minutes to start.
+    if threads > 0 {
+        rest_embree::render::thread_count_ok(threads)
+            .map_err(|e| PyValueError::new_err(format!("threads={threads}: {e}")))?;
+    }
     // Checked here, so that a bad name is a ValueError before any thread starts.
     rest_embree::accel::backend_by_name(&name).map_err(py_err)?;
     let scene_arc = scene.inner.clone();

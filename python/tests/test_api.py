@@ -153,6 +153,9 @@ def test_threads_progress_and_seeds():
         raise RuntimeError("stop here")
     with pytest.raises(RuntimeError, match="stop here"):
         re.render(scene, width=256, height=192, progress=boom)
+    # The command line's limit on threads, at once (a million took minutes to start).
+    with pytest.raises(ValueError, match="threads=1000000: .* per core"):
+        re.render(scene, width=8, height=8, threads=10**6)
 
 
 def test_ctrl_c_stops_a_render():

@@ -135,24 +135,9 @@ fn report(r: crate::Result<()>) -> ExitCode {
     }
 }
 
-/// More threads than this per core only costs memory (each has a stack) and switching.
-const THREADS_PER_CORE: usize = 8;
-
 fn set_threads(threads: Option<usize>) -> crate::Result<()> {
     if let Some(n) = threads {
-        if n == 0 {
-            return Err(Error::flag("--threads", "must be at least 1"));
-        }
-        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
-        if n > THREADS_PER_CORE * cores {
-            return Err(Error::flag(
-                "--threads",
-                format!(
-                    "{n} is more than {THREADS_PER_CORE} per core ({} on this machine's {cores} cores)",
-                    THREADS_PER_CORE * cores
-                ),
-            ));
-        }
+        crate::render::thread_count_ok(n).map_err(|e| Error::flag("--threads", e))?;
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()

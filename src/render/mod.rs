@@ -24,6 +24,24 @@ pub(crate) use frame::{CHANNELS, MATTE_RANKS};
 pub use progressive::{Converged, StopAt};
 pub use world::WorldOptions;
 
+/// More worker threads than this per core only cost memory (each has a stack) and switching:
+/// the command line's `--threads` and Python's `threads=` take at most this many a core.
+pub const THREADS_PER_CORE: usize = 8;
+
+/// Whether a render may run on `n` worker threads here: an error saying the limit where `n` is
+/// 0 or more than [`THREADS_PER_CORE`] per core of this machine.
+pub fn thread_count_ok(n: usize) -> Result<(), String> {
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    match n {
+        0 => Err("must be at least 1".into()),
+        n if n > THREADS_PER_CORE * cores => Err(format!(
+            "{n} is more than {THREADS_PER_CORE} per core ({} on this machine's {cores} cores)",
+            THREADS_PER_CORE * cores
+        )),
+        _ => Ok(()),
+    }
+}
+
 pub(crate) use band::Seen;
 pub(crate) use camera::CameraRays;
 pub(crate) use progress::Progress;
