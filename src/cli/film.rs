@@ -137,7 +137,8 @@ pub(super) fn run(
                     let frame_scene = scene.film_frame(k).expect("a film");
                     let id = crate::output::header::render_id(&frame_scene, backend_name, &shown);
                     let size = frame_scene.image.frame_size();
-                    Some(crate::output::finished(&path, format, size, &id))
+                    let storage = (args.compression.unwrap_or_default(), args.half);
+                    Some(crate::output::finished(&path, format, size, &id, storage))
                 })
                 .collect()
         }

@@ -333,7 +333,8 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
         let shown = args.recorded();
         let id = output::header::render_id(&scene, &backend_name, &shown);
         let size = scene.image.frame_size();
-        match output::finished(&args.output, format, size, &id) {
+        let storage = (args.compression.unwrap_or_default(), args.half);
+        match output::finished(&args.output, format, size, &id, storage) {
             Ok(()) => {
                 if !args.quiet {
                     crate::text::warn(format_args!(

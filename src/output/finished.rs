@@ -11,7 +11,16 @@ use std::path::Path;
 
 /// Ok if `path` is a finished `format` image of `size` (the frame's) from render `id`; else
 /// an error that says why not.
-pub fn finished(path: &Path, format: Format, size: (u32, u32), id: &str) -> crate::Result<()> {
+/// `storage`: for an EXR, the compression and whether colour is in half floats, as this
+/// render would write them (a film resumed with `--half` or another `--compression` renders
+/// its frames again rather than mix two kinds of file).
+pub fn finished(
+    path: &Path,
+    format: Format,
+    size: (u32, u32),
+    id: &str,
+    storage: (super::Compression, bool),
+) -> crate::Result<()> {
     let meta = std::fs::metadata(path).map_err(|e| not(path, e))?;
     if !meta.is_file() {
         return Err(not(path, "not a regular file"));
@@ -21,7 +30,7 @@ pub fn finished(path: &Path, format: Format, size: (u32, u32), id: &str) -> crat
     }
     match format {
         Format::Png => png(path, size, id),
-        Format::Exr => exr(path, size, id),
+        Format::Exr => exr(path, size, id, storage),
     }
 }
 
@@ -66,7 +75,12 @@ fn png(path: &Path, size: (u32, u32), id: &str) -> crate::Result<()> {
     Ok(())
 }
 
-fn exr(path: &Path, size: (u32, u32), id: &str) -> crate::Result<()> {
+fn exr(
+    path: &Path,
+    size: (u32, u32),
+    id: &str,
+    (compression, half): (super::Compression, bool),
+) -> crate::Result<()> {
     use exr::meta::attribute::AttributeValue;
     let file = std::fs::File::open(path).map_err(|e| not(path, e))?;
     let reader = exr::block::read(BufReader::new(file), false)
@@ -84,6 +98,31 @@ fn exr(path: &Path, size: (u32, u32), id: &str) -> crate::Result<()> {
                 "{}x{}, not the frame's {}x{}",
                 window.0, window.1, size.0, size.1
             ),
+        ));
+    }
+    if header.compression != compression.exr() {
+        return Err(not(
+            path,
+            format!(
+                "compressed as {}, not {}",
+                header.compression,
+                compression.exr()
+            ),
+        ));
+    }
+    let red = header
+        .channels
+        .list
+        .iter()
+        .find(|c| c.name.to_string() == "R");
+    let in_half = red.is_some_and(|c| c.sample_type == exr::meta::attribute::SampleType::F16);
+    if red.is_some() && in_half != half {
+        return Err(not(
+            path,
+            match half {
+                true => "colour in full floats, not half (--half)",
+                false => "colour in half floats (--half), not full",
+            },
         ));
     }
     let said = header

@@ -183,7 +183,7 @@ impl Compression {
         Self::NAMES.iter().position(|n| *n == name).map(|i| all[i])
     }
 
-    fn exr(self) -> exr::prelude::Compression {
+    pub(crate) fn exr(self) -> exr::prelude::Compression {
         use exr::prelude::Compression as C;
         match self {
             Self::Zip => C::ZIP16,

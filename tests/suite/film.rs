@@ -399,3 +399,44 @@ fn a_damaged_exr_frame_is_rendered_again() {
         );
     }
 }
+
+/// --resume keeps an EXR frame only if it is stored as this run would store it: resumed with
+/// `--half` or another `--compression`, every frame is rendered again (not a film of two kinds
+/// of file); resumed as it was, none is.
+#[test]
+fn a_frame_stored_otherwise_is_rendered_again() {
+    let d = Dir::new("film-exr-storage");
+    let scene = d.file("film.toml", &film(0.3, ""));
+    let pattern = d.0.join("f-#.exr").to_str().unwrap().to_string();
+    let s = scene.to_str().unwrap();
+    render(&["render", s, "-o", &pattern, "-q"]);
+    let frames = std::fs::read_dir(&d.0)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .ends_with(".exr")
+        })
+        .count();
+    assert!(frames > 1);
+    for (extra, rendered) in [
+        (&["--half"][..], frames),
+        (&["--half"][..], 0),
+        (&["--compression", "rle", "--half"][..], frames),
+        (&["--compression", "rle", "--half"][..], 0),
+    ] {
+        let mut args = vec!["render", s, "-o", &pattern, "--resume"];
+        args.extend_from_slice(extra);
+        let (ok, err) = run(&args);
+        assert!(ok, "{err}");
+        assert!(
+            err.contains(&format!(
+                "{rendered} frames rendered, {} already there",
+                frames - rendered
+            )),
+            "{extra:?}: {err}"
+        );
+    }
+}
