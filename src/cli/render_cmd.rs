@@ -295,6 +295,12 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
         .is_some_and(|n| n.contains('#'));
     let single = args.frames.filter(|(a, b)| a == b).map(|(a, _)| a);
     if plain && (single.is_some() || args.still) {
+        if args.frames.is_some() && single.is_none() {
+            return Err(Error::flag(
+                "--frames",
+                "--still renders one picture: give one frame (--frames K), not a range",
+            ));
+        }
         match (&scene.film, single) {
             (Some(film), Some(k)) => {
                 film::frame_range(film, Some((k, k)))?;

@@ -440,3 +440,22 @@ fn a_frame_stored_otherwise_is_rendered_again() {
         );
     }
 }
+
+/// `--still` renders one picture of a film's scene: with one frame that frame, with a range of
+/// frames it is refused naming `--frames` (it rendered one picture and said nothing).
+#[test]
+fn still_takes_one_frame_not_a_range() {
+    let d = Dir::new("film-still-flag");
+    let scene = d.file("film.toml", &film(0.3, ""));
+    let s = scene.to_str().unwrap();
+    let out = d.0.join("plain.png");
+    let o = out.to_str().unwrap();
+    let (code, err) = status(&["render", s, "-o", o, "--still", "--frames", "0..2"]);
+    assert!(
+        code == Some(1) && err.contains("--frames") && err.contains("not a range"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let (code, err) = status(&["render", s, "-o", o, "--still", "--frames", "1", "-q"]);
+    assert!(code == Some(0) && out.exists(), "{err}");
+}
