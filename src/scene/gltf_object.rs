@@ -442,6 +442,19 @@ pub(super) fn segments(
     transform: Option<Transform>,
 ) -> Result<Vec<Segment>, gltf_file::GltfError> {
     let turn = |d: DVec3| transform.map_or(d, |x| x.rotation * (d * x.scale));
+    // Scene times within the envelope, as a TOML worldline's `until` must be.
+    let limit = super::envelope::MAX_MAGNITUDE;
+    if let Some((k, t)) = keys
+        .iter()
+        .map(|&(t, _)| t)
+        .enumerate()
+        .find(|&(_, t)| (t * time_scale).abs() > limit)
+    {
+        return Err(gltf_file::GltfError(format!(
+            "key {k} is at scene time {:e} (file time {t} × time_scale); at most {limit:e} is taken",
+            t * time_scale
+        )));
+    }
     let rest = Motion::Uniform(Velocity::ZERO);
     let mut out = vec![Segment {
         until: Some(keys[0].0 * time_scale),

@@ -330,6 +330,41 @@ fn checked_beyond_validation(root: &gltf::json::Root) -> Result<(), GltfError> {
             return Err(format!("camera {i} lacks the projection its type names").into());
         }
     }
+    // A node's transform as glTF 2.0 allows it: a matrix or TRS, not both (the crate takes
+    // the matrix and drops the rest), a matrix that is an affine TRS (last row 0, 0, 0, 1),
+    // a rotation of unit length (a zero one read as no rotation).
+    for (i, node) in root.nodes.iter().enumerate() {
+        let trs = node.translation.is_some() || node.rotation.is_some() || node.scale.is_some();
+        if let Some(m) = node.matrix {
+            if trs {
+                return Err(format!(
+                    "node {i} gives both a matrix and translation, rotation or scale; glTF 2.0 takes one or the other"
+                )
+                .into());
+            }
+            if [m[3], m[7], m[11], m[15]] != [0.0, 0.0, 0.0, 1.0] {
+                return Err(format!(
+                    "node {i}'s matrix is not a placement (its last row is {:?}, not [0, 0, 0, 1])",
+                    [m[3], m[7], m[11], m[15]]
+                )
+                .into());
+            }
+        }
+        if let Some(q) = node.rotation {
+            let len =
+                q.0.iter()
+                    .map(|x| f64::from(*x).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+            if len.is_nan() || (len - 1.0).abs() > 1e-3 {
+                return Err(format!(
+                    "node {i}'s rotation {:?} is not a unit quaternion (its length is {len})",
+                    q.0
+                )
+                .into());
+            }
+        }
+    }
     // The crate's readers assert that an element fits its stride (a panic otherwise), and
     // glTF 2.0 asks an accessor's offsets to be multiples of its component's size.
     for (i, acc) in root.accessors.iter().enumerate() {

@@ -170,6 +170,45 @@ fn bad_gltf_files_are_clear_errors() {
         let err = refused(&d, "limits.glb", &paint.glb());
         assert!(err.contains("`paint`") && err.contains(key), "{key}: {err}");
     }
+    // Transforms glTF 2.0 does not allow, each read as another placement before: a matrix
+    // beside a translation (the translation dropped), a projective matrix, a zero rotation
+    // (read as none).
+    for (node, needle) in [
+        (
+            json!({"mesh": 0, "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 10.5, 0, 1], "translation": [1, 0, 0]}),
+            "both a matrix",
+        ),
+        (
+            json!({"mesh": 0, "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.5, 0, 10.5, 0, 1]}),
+            "last row",
+        ),
+        (
+            json!({"mesh": 0, "translation": [0, 10.5, 0], "rotation": [0, 0, 0, 0]}),
+            "unit quaternion",
+        ),
+    ] {
+        let mut odd = Doc::unit_box(nested_nodes());
+        odd.json["nodes"][1] = node;
+        let err = refused(&d, "transform.glb", &odd.glb());
+        assert!(err.contains("node 1") && err.contains(needle), "{err}");
+    }
+    // A key beyond the envelope's times, as a TOML worldline's `until` would be.
+    let late = keyed_box(
+        &[(0.0, [0.0, 10.5, 0.0]), (1e30, [0.1, 10.5, 0.0])],
+        "LINEAR",
+    );
+    std::fs::write(d.0.join("late.glb"), late.glb()).unwrap();
+    let scene = d.file(
+        "late.toml",
+        &super::at_time("type = \"gltf\"\nfile = \"late.glb\"", "", 10.0),
+    );
+    let err = rest_embree::scene::load_file(&scene, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("late.toml") && err.contains("key 1") && err.contains("1e15"),
+        "{err}"
+    );
     // A field of view below the scene's least (1e-6°).
     let mut narrow = Doc::unit_box(nested_nodes());
     narrow.json["cameras"] =
