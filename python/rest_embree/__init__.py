@@ -248,6 +248,8 @@ class Image:
         return np.frombuffer(self._native.rgba(), dtype="<f4").reshape(self.height, self.width, 4)
 
     def __getitem__(self, name: str) -> np.ndarray:
+        if not self.passes and name != "rgba":
+            raise KeyError(f"{name!r}: the image was rendered with passes=False (colour and alpha alone; see .rgba)")
         if name in _IDS:
             data = self._native.ids(name)
             return np.frombuffer(data, dtype="<u4").reshape(self.height, self.width)
@@ -268,7 +270,12 @@ class Image:
         """Write it as ``rest-embree render`` writes its file, byte for byte for the same scene
         and overrides: ``.exr`` with every pass, ``.png`` colour (alpha only for a transparent
         scene)."""
-        self._native.save(os.fspath(path))
+        path = os.fspath(path)
+        # Into a folder that does not exist yet, as the command line's `-o` does.
+        folder = os.path.dirname(path)
+        if folder:
+            os.makedirs(folder, exist_ok=True)
+        self._native.save(path)
 
     def _repr_png_(self) -> bytes:
         with tempfile.TemporaryDirectory() as d:
@@ -289,6 +296,8 @@ def _progress_callback(progress) -> Optional[Callable]:
         return None
     if callable(progress):
         return progress
+    if progress is not True:
+        raise TypeError(f"progress must be a callable f(done, total), True or None, not {type(progress).__name__}")
     try:
         from tqdm.auto import tqdm
     except ImportError:
@@ -321,6 +330,15 @@ def _with(scene: Scene, **values) -> Scene:
     return s
 
 
+def _check_flags(passes: Any, threads: Any) -> None:
+    if not isinstance(passes, bool):
+        raise TypeError(
+            f"passes must be True (every pass) or False (colour and alpha), not {passes!r}; "
+            "a list of passes is the scene's [image] passes: scene.set(\"image.passes\", [...])")
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 0:
+        raise ValueError(f"threads must be a whole number, 0 (every core) or more, not {threads!r}")
+
+
 def render(
     scene: Scene,
     width: Optional[int] = None,
@@ -346,6 +364,7 @@ def render(
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"render takes a Scene, not {type(scene).__name__}")
+    _check_flags(passes, threads)
     s = _with(scene, **{"image.width": width, "image.height": height,
                          "image.samples": samples, "render.seed": seed,
                          "image.transparent": transparent})
@@ -370,6 +389,7 @@ def film(scene: Scene, **kwargs) -> Iterator[tuple]:
     passes = kwargs.pop("passes", True)
     if kwargs:
         raise TypeError(f"film() got unexpected keywords {sorted(kwargs)}")
+    _check_flags(passes, threads)
     for k in range(n):
         frame = s._native.film_frame(k)
         native = _native.render(frame, backend, threads, passes, _progress_callback(progress))
@@ -381,6 +401,11 @@ def probe(scene: Scene, x: int, y: int, image: Optional[Image] = None, **kwargs)
     and its group, the emission event (world time and place), lookback, Doppler factor, depth
     and the point on the object in its rest frame. Renders the scene (with :func:`render`'s
     keywords) unless ``image`` is given."""
+    for name, v in (("x", x), ("y", y)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+            raise TypeError(f"{name} must be a whole pixel number, not {v!r}")
+    if image is not None and not isinstance(image, Image):
+        raise TypeError(f"image must be an Image from render(), not {type(image).__name__}")
     img = image if image is not None else render(scene, **kwargs)
     if not img.passes:
         raise ValueError("the image was rendered with passes=False: it has no ids or lookback to probe")
@@ -435,6 +460,8 @@ def view(scene: Scene, port: int = 0, backend: Optional[str] = None) -> Viewer:
     returned object shows the page. Its saved views and renders go to the current folder."""
     if not isinstance(scene, Scene):
         raise TypeError(f"view takes a Scene, not {type(scene).__name__}")
+    if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
+        raise ValueError(f"port must be 0 (a free one) to 65535, not {port!r}")
     return Viewer(_native.view_start(scene._path, scene._text, scene._sets, port, backend))
 
 

@@ -120,6 +120,26 @@ def test_errors_are_the_command_lines(tmp_path):
         re.render(re.Scene.from_dict(CUBE), backend="nope")
     with pytest.raises(TypeError):
         re.Scene.from_dict({"camera": {"position": object()}})
+    # Arguments of the wrong kind say which, before any render.
+    cube = re.Scene.from_dict(CUBE)
+    with pytest.raises(TypeError, match="passes must be True"):
+        re.render(cube, width=8, height=8, passes="depth")
+    with pytest.raises(TypeError, match="progress"):
+        re.render(cube, width=8, height=8, progress=5)
+    with pytest.raises(ValueError, match="threads"):
+        re.render(cube, width=8, height=8, threads=-1)
+    with pytest.raises(ValueError, match="port"):
+        re.view(cube, port=-1)
+    plain = re.render(cube, width=8, height=8, passes=False)
+    with pytest.raises(KeyError, match="passes=False"):
+        plain["depth"]
+    with pytest.raises(TypeError, match="x must be a whole pixel"):
+        re.probe(cube, 3.7, 5, image=plain)
+    with pytest.raises(TypeError, match="image must be an Image"):
+        re.probe(cube, 3, 5, image=5)
+    # save makes the folders of its path, as the command line's -o does.
+    plain.save(tmp_path / "new" / "dir" / "x.png")
+    assert (tmp_path / "new" / "dir" / "x.png").stat().st_size > 0
 
 
 def test_scenes_from_dicts_and_text_are_the_files():
