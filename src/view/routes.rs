@@ -162,6 +162,21 @@ fn view_text(v: &Viewer, body: &Value) -> Result<String, (u16, String)> {
 }
 
 fn frame(v: &Viewer, body: &Value) -> Answer {
+    // A mistyped key (`levle`) would otherwise be dropped without a word.
+    const KEYS: [&str; 5] = ["client", "seq", "level", "pass", "view"];
+    if let Some(k) = body
+        .as_object()
+        .and_then(|o| o.keys().find(|k| !KEYS.contains(&k.as_str())))
+    {
+        return Err((
+            400,
+            format!(
+                "unknown key `{}` (a frame request takes {})",
+                k.chars().take(40).collect::<String>(),
+                KEYS.join(", ")
+            ),
+        ));
+    }
     let client = client_id(body.get("client"))?;
     let n = v.levels.len();
     let level = body
@@ -180,12 +195,14 @@ fn frame(v: &Viewer, body: &Value) -> Answer {
         ));
     }
     // The page numbers its requests; one without a number counts as the newest.
+    // At most 2^53, the page's whole numbers: a client that jumped to u64's last would have
+    // every later request refused as older.
     let seq = match body.get("seq") {
         None => None,
-        Some(x) => Some(
-            x.as_u64()
-                .ok_or((400, "`seq` must be a whole number".to_string()))?,
-        ),
+        Some(x) => Some(x.as_u64().filter(|&n| n <= MAX_SEQ).ok_or((
+            400,
+            format!("`seq` must be a whole number from 0 to {MAX_SEQ}"),
+        ))?),
     };
     let view = body.get("view").ok_or((400, "no `view`".to_string()))?;
     // The view's values checked before it supersedes anything (the scene is read later).
@@ -261,6 +278,10 @@ impl Drop for Count<'_> {
         self.0.fetch_sub(1, Ordering::AcqRel);
     }
 }
+
+/// The largest request number a client may give: 2^53, the largest whole number JavaScript
+/// counts exactly.
+const MAX_SEQ: u64 = 1 << 53;
 
 /// Make request `seq` the client's newest (None: one past its newest): stop the render of the
 /// one before, and forget the client seen longest ago when there are too many. A request older

@@ -362,6 +362,25 @@ fn an_older_request_never_supersedes_a_newer_one() {
         &serde_json::json!({ "client": "p", "seq": -1, "level": 0, "view": {} }),
     );
     assert_eq!(bad.status, 400, "{}", bad.text());
+    // u64's last number would leave every later request older: refused, and the client's
+    // next request without a number is served.
+    let last = ask(u64::MAX, -0.2);
+    assert_eq!(last.status, 400, "{}", last.text());
+    let next = v.post(
+        "/api/frame",
+        &serde_json::json!({ "client": "p", "level": 0, "view": {} }),
+    );
+    assert_eq!(next.status, 200, "{}", next.text());
+    // A mistyped key is named, not dropped.
+    let typo = v.post(
+        "/api/frame",
+        &serde_json::json!({ "client": "p", "levle": 0, "level": 0, "view": {} }),
+    );
+    assert!(
+        typo.status == 400 && typo.text().contains("`levle`"),
+        "{}",
+        typo.text()
+    );
 }
 
 /// A hundred changes as fast as a slider sends them: every superseded view's work stops, at no
