@@ -36,7 +36,7 @@ impl Transform {
                         n,
                         "scale",
                         format!(
-                            "every factor must be greater than 0 (got {s}); mirror with rotate"
+                            "every factor must be greater than 0 (got {s}): a mirrored placement is not taken"
                         ),
                     ));
                 }

@@ -286,7 +286,7 @@ fn bad_meshes_and_transforms_are_clear_errors() {
         "two.obj",
         "v 0 10 0\nv 1 10 0\nv 0 11 0\nusemtl hull\nf 1 2 3\n",
     );
-    let cases: [(&str, &[&str]); 17] = [
+    let cases: [(&str, &[&str]); 18] = [
         ("type = \"mesh\"\nfile = \"missing.obj\"", &["missing.obj", "cannot read it"]),
         ("type = \"mesh\"\nfile = \"bad-v.obj\"", &["bad-v.obj:2", "position parse error"]),
         ("type = \"mesh\"\nfile = \"bad-f.obj\"", &["bad-f.obj:4", "names vertex 9"]),
@@ -315,7 +315,11 @@ fn bad_meshes_and_transforms_are_clear_errors() {
         ),
         (
             "type = \"mesh\"\nfile = \"two.obj\"\nmaterials = { wing = \"white\" }",
-            &["materials.wing", "no material `wing`", "hull"],
+            &["materials.wing", "the file has no material `wing`", "hull"],
+        ),
+        (
+            "type = \"mesh\"\nfile = \"two.obj\"\nscale = [-1, 1, 1]",
+            &["scale", "a mirrored placement is not taken"],
         ),
         (
             "type = \"mesh\"\nfile = \"two.obj\"\nmaterials = { hull = \"paint\" }",

@@ -414,6 +414,12 @@ fn checked_beyond_validation(root: &gltf::json::Root) -> Result<(), GltfError> {
             if let Some(ix) = &prim.indices {
                 match kind(ix.value()) {
                     (Some(C::U8 | C::U16 | C::U32), Some(T::Scalar), n) if n > 0 => {}
+                    (Some(C::U8 | C::U16 | C::U32), Some(T::Scalar), _) => {
+                        return Err(format!(
+                            "mesh {m} primitive {p}: its indices accessor has no elements (count 0)"
+                        )
+                        .into())
+                    }
                     _ => return Err(bad("indices")),
                 }
             }

@@ -210,6 +210,17 @@ impl Reading<'_> {
                 .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))))
                 .collect();
             let n = positions.len();
+            // A count past what the buffer can hold (2^63, say) reads as no vertices.
+            let claimed = prim
+                .get(&gltf::Semantic::Positions)
+                .map_or(n, |a| a.count());
+            if claimed != n {
+                return Err(format!(
+                    "{}: its POSITION accessor claims {claimed} vertices; its buffer holds {n}",
+                    what()
+                )
+                .into());
+            }
             let indices: Vec<u32> = match (reader.read_indices(), prim.indices()) {
                 (Some(i), _) => i.into_u32().collect(),
                 (None, None) => (0..n as u32).collect(),
@@ -226,8 +237,12 @@ impl Reading<'_> {
                 return Err(format!("{}: it makes no triangle ({} vertices)", what(), n).into());
             }
             if !indices.len().is_multiple_of(3) {
+                let given = match prim.indices() {
+                    Some(_) => "indices",
+                    None => "vertices and no indices",
+                };
                 return Err(format!(
-                    "{}: {} indices, not a whole number of triangles",
+                    "{}: {} {given}, not a whole number of triangles",
                     what(),
                     indices.len()
                 )

@@ -48,14 +48,14 @@ pub(in crate::scene) fn file_materials(
         for k in keys {
             let Some(i) = in_file.iter().position(|n| n == k) else {
                 let named = if in_file.is_empty() {
-                    "the file names no materials (usemtl)".to_string()
+                    "the file names no materials".to_string()
                 } else {
                     format!("the file's materials: {}", in_file.join(", "))
                 };
                 return Err(map.error_at(
                     map.get(k).expect("a key of the table"),
                     k,
-                    format!("the mesh file has no material `{k}` ({named})"),
+                    format!("the file has no material `{k}` ({named})"),
                 ));
             };
             chosen[i] = material_ref(&map, k, mats, default)?;

@@ -192,6 +192,23 @@ fn bad_gltf_files_are_clear_errors() {
         let err = refused(&d, "transform.glb", &odd.glb());
         assert!(err.contains("node 1") && err.contains(needle), "{err}");
     }
+    // Counts that say what is wrong: past the buffer (it read as no vertices), no indices at
+    // all, and eight vertices without indices (it said "8 indices").
+    let mut huge = Doc::unit_box(nested_nodes());
+    huge.json["accessors"][pos]["count"] = json!(1u64 << 63);
+    let err = refused(&d, "huge.glb", &huge.glb());
+    assert!(err.contains("claims 9223372036854775808 vertices"), "{err}");
+    let mut none = Doc::unit_box(nested_nodes());
+    none.json["accessors"][1]["count"] = json!(0);
+    let err = refused(&d, "none.glb", &none.glb());
+    assert!(err.contains("indices accessor has no elements"), "{err}");
+    let mut bare = Doc::unit_box(nested_nodes());
+    bare.json["meshes"][0]["primitives"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("indices");
+    let err = refused(&d, "bare.glb", &bare.glb());
+    assert!(err.contains("8 vertices and no indices"), "{err}");
     // A key beyond the envelope's times, as a TOML worldline's `until` would be.
     let late = keyed_box(
         &[(0.0, [0.0, 10.5, 0.0]), (1e30, [0.1, 10.5, 0.0])],
