@@ -209,6 +209,23 @@ fn bad_gltf_files_are_clear_errors() {
         .remove("indices");
     let err = refused(&d, "bare.glb", &bare.glb());
     assert!(err.contains("8 vertices and no indices"), "{err}");
+    // A sparse index past its accessor's elements (the reader skipped it without a word).
+    let mut sparse = Doc::unit_box(nested_nodes());
+    let offset = sparse.bin.len();
+    sparse.bin.extend_from_slice(&60u32.to_le_bytes());
+    for x in [0.0f32, 5.0, 0.0] {
+        sparse.bin.extend_from_slice(&x.to_le_bytes());
+    }
+    sparse.json["buffers"][0]["byteLength"] = json!(sparse.bin.len());
+    let views = sparse.json["bufferViews"].as_array_mut().unwrap();
+    views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 4}));
+    views.push(json!({"buffer": 0, "byteOffset": offset + 4, "byteLength": 12}));
+    let n = views.len();
+    sparse.json["accessors"][pos]["sparse"] = json!({"count": 1,
+        "indices": {"bufferView": n - 2, "componentType": 5125},
+        "values": {"bufferView": n - 1}});
+    let err = refused(&d, "sparse.glb", &sparse.glb());
+    assert!(err.contains("sparse index 60 is past its 8"), "{err}");
     // A key beyond the envelope's times, as a TOML worldline's `until` would be.
     let late = keyed_box(
         &[(0.0, [0.0, 10.5, 0.0]), (1e30, [0.1, 10.5, 0.0])],
