@@ -135,6 +135,14 @@ impl Reading<'_> {
                 gltf::camera::Projection::Perspective(p) => {
                     let forward = world.transform_vector3(-DVec3::Z).normalize_or_zero();
                     let up = world.transform_vector3(DVec3::Y).normalize_or_zero();
+                    if forward == DVec3::ZERO || up == DVec3::ZERO || forward.cross(up) == DVec3::ZERO {
+                        return Err(format!(
+                            "camera {} is placed by node {}, whose transform leaves it no view direction or up (a scale of 0?)",
+                            cam.index(),
+                            node.index()
+                        )
+                        .into());
+                    }
                     self.cameras.push(CameraView {
                         name: cam
                             .name()

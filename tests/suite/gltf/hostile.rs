@@ -243,6 +243,14 @@ fn bad_gltf_files_are_clear_errors() {
         err.contains("late.toml") && err.contains("key 1") && err.contains("1e15"),
         "{err}"
     );
+    // A camera whose node flattens it (it said the file held no camera).
+    let mut flat_cam = Doc::unit_box(nested_nodes());
+    flat_cam.json["cameras"] =
+        json!([{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}]);
+    flat_cam.json["nodes"][0]["camera"] = json!(0);
+    flat_cam.json["nodes"][0]["scale"] = json!([0, 0, 0]);
+    let err = refused(&d, "flatcam.glb", &flat_cam.glb());
+    assert!(err.contains("camera 0") && err.contains("node 0"), "{err}");
     // A field of view below the scene's least (1e-6°).
     let mut narrow = Doc::unit_box(nested_nodes());
     narrow.json["cameras"] =
