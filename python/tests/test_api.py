@@ -240,7 +240,7 @@ def test_a_film_yields_its_frames_and_probe_tells_a_pixel():
         re.probe(scene, 999, 0, image=img)
 
 
-def test_the_viewer_serves_the_scene_with_its_overrides():
+def test_the_viewer_serves_the_scene_with_its_overrides(capfd):
     import json
     import urllib.error
     import urllib.request
@@ -263,6 +263,10 @@ def test_the_viewer_serves_the_scene_with_its_overrides():
             re.view(scene)
     finally:
         viewer.stop()
+    # It said where it served (before serving the requests above), but not "Ctrl-C stops
+    # it": here .stop() does.
+    said = capfd.readouterr()
+    assert viewer.url in said.out and "Ctrl-C" not in said.out + said.err, said
     # Stopped, another starts: a scene given as a dict (its text served, named scene.toml).
     again = re.view(re.Scene.from_dict(CUBE))
     try:

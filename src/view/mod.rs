@@ -157,7 +157,10 @@ pub(crate) fn run(config: &Config) -> crate::Result<()> {
             viewer.access.token()
         ));
     }
-    crate::text::say("Ctrl-C stops it.");
+    // A program that started it (Python's `view`) stops it its own way (`.stop()`).
+    if config.tell_url.is_none() {
+        crate::text::say("Ctrl-C stops it.");
+    }
     if config.open_browser {
         open_browser(&url);
     }
