@@ -154,6 +154,13 @@ const MAPPED: [&str; 4] = [
 /// a file that several entries of the scene place.
 pub(crate) fn read(path: &Path, split_all: bool, share_every: bool) -> Result<GltfData, GltfError> {
     let bytes = read_file(path)?;
+    // A `.glb` without its magic would be read as JSON, and said to be bad JSON.
+    let glb = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if glb && !bytes.starts_with(b"glTF") {
+        return Err("not a readable glTF: a .glb must begin with the bytes `glTF` (a binary glTF's magic), and this one does not".into());
+    }
     let gltf = parse(&bytes)?;
     drop(bytes);
     let base = path.parent().unwrap_or(Path::new("")).to_path_buf();

@@ -293,6 +293,9 @@ fn bad_gltf_files_are_clear_errors() {
     // Not glTF at all, and a data URI over the memory limit.
     let err = refused(&d, "junk.glb", b"glTF\x02\0\0\0junk");
     assert!(err.contains("not a readable glTF"), "{err}");
+    // A .glb without its magic was read as JSON: "expected value at line 1 column 1".
+    let err = refused(&d, "magic.glb", b"GLTF\x02\0\0\0junk");
+    assert!(err.contains("must begin with the bytes `glTF`"), "{err}");
     let big = format!(
         "data:application/octet-stream;base64,{}",
         "A".repeat(4 << 20)
