@@ -221,6 +221,17 @@ impl RenderArgs {
         v
     }
 
+    /// The first of --max-time and --target-rms given: a still's rounds, which a film's frames
+    /// and the tiles of --tiles do not take.
+    pub(super) fn stop_flag(&self) -> Option<&'static str> {
+        [
+            ("--max-time", self.max_time),
+            ("--target-rms", self.target_rms),
+        ]
+        .into_iter()
+        .find_map(|(f, v)| v.map(|_| f))
+    }
+
     pub(super) fn stop_at(&self) -> Option<render::StopAt> {
         (self.max_time.is_some() || self.target_rms.is_some()).then(|| render::StopAt {
             max_time: self.max_time.map(std::time::Duration::from_secs_f64),

@@ -260,13 +260,7 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     if let (Some(grid), Some(index)) = (args.tiles, args.tile) {
         // Each tile would stop at its own noise or time: the tiles would not join into the
         // one render `assemble` makes of them.
-        if let Some(flag) = [
-            ("--max-time", args.max_time),
-            ("--target-rms", args.target_rms),
-        ]
-        .iter()
-        .find_map(|(f, v)| v.map(|_| *f))
-        {
+        if let Some(flag) = args.stop_flag() {
             return Err(Error::flag(
                 flag,
                 "applies to a whole still; a tile of --tiles renders its `samples`, so that the tiles join into one render",
@@ -320,13 +314,7 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
             "renders one picture: give a plain file name (no run of #), and at most one frame",
         ));
     } else if scene.film.is_some() || args.frames.is_some() {
-        if let Some(flag) = [
-            ("--max-time", args.max_time),
-            ("--target-rms", args.target_rms),
-        ]
-        .iter()
-        .find_map(|(f, v)| v.map(|_| *f))
-        {
+        if let Some(flag) = args.stop_flag() {
             return Err(Error::flag(
                 flag,
                 "applies to a still image; a film's frames render their `samples` each",

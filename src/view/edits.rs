@@ -208,7 +208,7 @@ fn literal3(v: [f64; 3]) -> String {
 }
 
 /// At most 40 characters of a name the request gave, for an error.
-fn clip(s: &str) -> String {
+pub(super) fn clip(s: &str) -> String {
     s.chars().take(40).collect()
 }
 

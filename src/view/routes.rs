@@ -172,7 +172,7 @@ fn frame(v: &Viewer, body: &Value) -> Answer {
             400,
             format!(
                 "unknown key `{}` (a frame request takes {})",
-                k.chars().take(40).collect::<String>(),
+                edits::clip(k),
                 KEYS.join(", ")
             ),
         ));
