@@ -4,7 +4,7 @@
 CARGO ?= cargo
 OUT ?= out
 
-.PHONY: setup demo test bench images docs film python
+.PHONY: setup demo test lint bench images docs film python
 
 setup:
 	@scripts/setup.sh
@@ -19,36 +19,34 @@ demo: setup
 	./target/release/rest-embree render scenes/passing_spheres.toml -o $(OUT)/passing-spheres.png
 	@echo "demo: wrote $(OUT)/lattice-0.9.png, $(OUT)/lattice-0.9.exr and $(OUT)/passing-spheres.png"
 
-# The formatting and the lints (the library alone and the whole program), then every test,
-# optimised, without the Embree backend and with it; then a real one-node SLURM
+# The formatting and the lints alone, as `make test` runs them (in target/lint).
+lint:
+	@CARGO=$(CARGO) scripts/lint.sh
+
+# Every test, optimised, once, in the build with Embree, and beside it the formatting and the
+# lints (the library alone and the whole program: scripts/lint.sh); then a real one-node SLURM
 # cluster runs a film and a tiled still through `rest-embree farm slurm` (scripts/slurm-test.sh;
 # it needs root, and says so when skipped). The Python package's tests follow (pytest, and the
 # example notebook; its virtual environment is filled in the background meanwhile).
-# `--release` builds the tests in target/release
-# beside `make demo`'s binary, on the same optimised dependencies: one optimised build of
-# everything, not a second one in target/debug with full debug info. The build without Embree
-# goes first, so the binary left in target/release is the one with it. Blender 5 (bpy, from
-# PyPI) downloads in the background meanwhile, for the last check: every documented pass as
-# Blender's compositor takes it (scripts/blender-test.sh). Before it, headless Chromium drives
-# the viewer's page: a slider moved, a frame awaited, a pixel clicked (scripts/browser-test.sh).
+# `--release` builds the tests in target/release beside `make demo`'s binary, on the same
+# optimised dependencies: one optimised build of everything, not a second one in target/debug
+# with full debug info. Blender 5 (bpy, from PyPI) downloads in the background meanwhile, for
+# the last check: every documented pass as Blender's compositor takes it
+# (scripts/blender-test.sh). Before it, headless Chromium drives the viewer's page: a slider
+# moved, a frame awaited, a pixel clicked (scripts/browser-test.sh).
 test: setup
 	@mkdir -p target && (scripts/blender-test.sh --install >target/bpy-install.log 2>&1 &)
 	@(scripts/python-test.sh --prepare >target/pyenv-install.log 2>&1 &)
 	@# The code as the house keeps it: formatted, and no lint in the library alone (no Embree,
-	@# no command line: what a program that links it builds) or in the whole program.
-	$(CARGO) fmt --all --check
-	$(CARGO) clippy --release --no-default-features --all-targets -- -D warnings
-	$(CARGO) clippy --release --all-targets -- -D warnings
-	$(CARGO) clippy --release -p rest-embree-python -- -D warnings
-	@# Without Embree, the library's own tests (internals, and the build's one backend, the
-	@# BVH); the integration suite runs once, below, on every backend of the full build. This
-	@# build is one crate alone, which in one codegen unit (Cargo.toml) keeps one of the two
-	@# cores idle: it is built in 16 (docs/testing.md has the times). The machine code differs,
-	@# the results do not: Rust neither reorders nor fuses floating-point operations. The build
-	@# with Embree compiles the library and its tests side by side, one unit on each core,
-	@# which 16 units do not speed up. This build's binary is run once and never profiled: it
-	@# keeps no line tables, which cost its compile about a tenth of its time.
-	$(CARGO) test --release --no-default-features --features cli --lib --config 'profile.release.package.rest-embree.codegen-units=16' --config 'profile.release.package.rest-embree.debug=false'
+	@# no command line: what a program that links it builds), in the whole program or in the
+	@# Python crate (scripts/lint.sh). They run beside the builds, in a target directory of
+	@# their own at the lowest priority, on the cores the build leaves idle; their output and
+	@# their verdict come at the end. The build without Embree is checked there, every target
+	@# of it, and its tests are not run again: they are the same tests over the same code but
+	@# for a few lines chosen by the feature (the backends' names and the error naming the
+	@# feature, which the tests check in every build: src/tests/backend_names.rs). Running
+	@# them cost a second optimised build of the library (docs/testing.md has the times).
+	@CARGO=$(CARGO) scripts/lint.sh --start
 	@# Every package's tests, and the one build of the library the steps below share: the ISA
 	@# loop names the workspace too, and the Python package's build finds the library built
 	@# with the same features (naming the root package alone, the Python crate's dependencies
@@ -78,6 +76,7 @@ test: setup
 	  wait $$slurm; cluster=$$?; cat target/slurm-test.log; \
 	  [ $$cluster -eq 0 ] || echo "make test: FAILED: scripts/slurm-test.sh (above)" >&2; \
 	  [ $$rest -eq 0 ] && [ $$cluster -eq 0 ]
+	@scripts/lint.sh --wait
 
 # The Python package (python/): `import rest_embree` in the virtual environment VENV (default
 # .venv here); see docs/python.md.

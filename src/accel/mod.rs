@@ -334,6 +334,15 @@ pub(crate) fn embree_backend(name: &str) -> Option<EmbreeBackend> {
 #[cfg(feature = "embree")]
 pub(crate) const EMBREE_WIDTHS: [&str; 4] = ["embree-16", "embree-8", "embree-4", "embree-single"];
 
+/// What asking a build without Embree for an Embree backend says: how to get one. Built in
+/// every build, so the tests of the build with Embree check the message too.
+#[cfg_attr(all(feature = "embree", not(test)), expect(dead_code))]
+pub(crate) fn embree_not_in_this_build() -> crate::Error {
+    crate::Error::backend(
+        "backend 'embree' is not in this build: rebuild with `--features embree` (needs libembree-dev and libclang-dev)",
+    )
+}
+
 /// The backend of that name, or an error that lists the choices.
 pub fn backend_by_name(name: &str) -> crate::Result<Box<dyn Backend>> {
     match name {
@@ -349,9 +358,9 @@ pub fn backend_by_name(name: &str) -> crate::Result<Box<dyn Backend>> {
             }
         }
         #[cfg(not(feature = "embree"))]
-        "embree" | "embree-16" | "embree-8" | "embree-4" | "embree-single" => Err(crate::Error::backend(
-            "backend 'embree' is not in this build: rebuild with `--features embree` (needs libembree-dev and libclang-dev)",
-        )),
+        "embree" | "embree-16" | "embree-8" | "embree-4" | "embree-single" => {
+            Err(embree_not_in_this_build())
+        }
         other => Err(crate::Error::backend(format!(
             "unknown backend '{other}' (choose one of: {})",
             all_backend_names().join(", ")
