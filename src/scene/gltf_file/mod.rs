@@ -161,6 +161,9 @@ pub(crate) fn read(path: &Path, split_all: bool, share_every: bool) -> Result<Gl
     if glb && !bytes.starts_with(b"glTF") {
         return Err("not a readable glTF: a .glb must begin with the bytes `glTF` (a binary glTF's magic), and this one does not".into());
     }
+    if glb {
+        glb_length_checked(&bytes)?;
+    }
     let gltf = parse(&bytes)?;
     drop(bytes);
     let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
@@ -308,6 +311,27 @@ fn parse(bytes: &[u8]) -> Result<gltf::Gltf, GltfError> {
     })
 }
 
+/// A binary glTF's header gives the file's whole length (bytes 8 to 12, little-endian): a
+/// file cut short or with bytes after it says otherwise.
+fn glb_length_checked(bytes: &[u8]) -> Result<(), GltfError> {
+    let Some(said) = bytes.get(8..12) else {
+        return Err(format!(
+            "not a readable glTF: a .glb's header is 12 bytes, and this file has {}",
+            bytes.len()
+        )
+        .into());
+    };
+    let said = u32::from_le_bytes([said[0], said[1], said[2], said[3]]);
+    if u64::from(said) != bytes.len() as u64 {
+        return Err(format!(
+            "not a readable glTF: its .glb header says the file is {said} bytes long, and it is {} (cut short, or joined to other bytes)",
+            bytes.len()
+        )
+        .into());
+    }
+    Ok(())
+}
+
 /// What the crate's readers unwrap or call unreachable on and its validation lets through:
 /// an image without its MIME type or URI, a camera without the projection its type names, and
 /// accessors of a kind a primitive's indices, positions, normals or texture coordinates cannot
@@ -371,6 +395,49 @@ fn checked_beyond_validation(root: &gltf::json::Root) -> Result<(), GltfError> {
                 )
                 .into());
             }
+        }
+    }
+    // glTF 2.0 only (a 1.0 file's keys mean other things), as `asset` says.
+    let major = |v: &str| v.split('.').next().map(str::to_string);
+    if major(&root.asset.version).as_deref() != Some("2")
+        || root
+            .asset
+            .min_version
+            .as_deref()
+            .and_then(major)
+            .as_deref()
+            .is_some_and(|m| m != "2")
+    {
+        return Err(format!(
+            "its asset.version is \"{}\"{}: this reader reads glTF 2.0",
+            crate::text::shown(&root.asset.version),
+            root.asset
+                .min_version
+                .as_deref()
+                .map(|m| format!(" (minVersion \"{}\")", crate::text::shown(m)))
+                .unwrap_or_default()
+        )
+        .into());
+    }
+    // Every buffer holds at least a byte, and every view lies within the bytes its buffer
+    // declares (the reader checks the buffer's bytes reach that far: `files::buffers`).
+    for (b, buffer) in root.buffers.iter().enumerate() {
+        if buffer.byte_length.0 == 0 {
+            return Err(format!("buffer {b}'s byteLength is 0; glTF 2.0 asks at least 1").into());
+        }
+    }
+    for (v, view) in root.buffer_views.iter().enumerate() {
+        let Some(buffer) = root.buffers.get(view.buffer.value()) else {
+            continue;
+        };
+        let end = (view.byte_offset.map_or(0, |o| o.0)).saturating_add(view.byte_length.0);
+        if end > buffer.byte_length.0 {
+            return Err(format!(
+                "buffer view {v} reaches byte {end} of buffer {}, past the {} bytes its byteLength declares",
+                view.buffer.value(),
+                buffer.byte_length.0
+            )
+            .into());
         }
     }
     // The crate's readers assert that an element fits its stride (a panic otherwise), and

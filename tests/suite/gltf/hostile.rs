@@ -296,6 +296,54 @@ fn bad_gltf_files_are_clear_errors() {
     // A .glb without its magic was read as JSON: "expected value at line 1 column 1".
     let err = refused(&d, "magic.glb", b"GLTF\x02\0\0\0junk");
     assert!(err.contains("must begin with the bytes `glTF`"), "{err}");
+    // A .glb whose header's length is not the file's (bytes after it, or a length of 20) was
+    // read as if it were.
+    let mut joined = good.glb();
+    let whole = joined.len();
+    joined.extend_from_slice(b"more");
+    let err = refused(&d, "joined.glb", &joined);
+    assert!(
+        err.contains(&format!(
+            "says the file is {whole} bytes long, and it is {}",
+            whole + 4
+        )),
+        "{err}"
+    );
+    let mut twenty = good.glb();
+    twenty[8..12].copy_from_slice(&20u32.to_le_bytes());
+    let err = refused(&d, "twenty.glb", &twenty);
+    assert!(err.contains("says the file is 20 bytes long"), "{err}");
+    // glTF 1.0 (or 3.0) by its asset's word, and a minVersion past 2.
+    for (asset, said) in [
+        (json!({"version": "1.0"}), "asset.version is \"1.0\""),
+        (json!({"version": "3.0"}), "asset.version is \"3.0\""),
+        (
+            json!({"version": "2.0", "minVersion": "3.0"}),
+            "(minVersion \"3.0\")",
+        ),
+    ] {
+        let mut old = Doc::unit_box(nested_nodes());
+        old.json["asset"] = asset;
+        let err = refused(&d, "version.glb", &old.glb());
+        assert!(err.contains(said) && err.contains("glTF 2.0"), "{err}");
+    }
+    // A buffer of byteLength 0, and a view past the bytes its buffer declares (the bytes
+    // were there, so it was read).
+    let mut empty = Doc::unit_box(nested_nodes());
+    empty.json["buffers"][0]["byteLength"] = json!(0);
+    let err = refused(&d, "empty.glb", &empty.glb());
+    assert!(err.contains("buffer 0's byteLength is 0"), "{err}");
+    let mut short = Doc::unit_box(nested_nodes());
+    let declared = short.bin.len() - 4;
+    short.json["buffers"][0]["byteLength"] = json!(declared);
+    let err = refused(&d, "short.glb", &short.glb());
+    assert!(
+        err.contains("buffer view")
+            && err.contains(&format!(
+                "past the {declared} bytes its byteLength declares"
+            )),
+        "{err}"
+    );
     let big = format!(
         "data:application/octet-stream;base64,{}",
         "A".repeat(4 << 20)
