@@ -681,7 +681,7 @@ impl EventReceiver for Builder<'_, '_> {
                 Ok(i) => Val::Int(i),
                 Err(_) => {
                     error.report_error(err(
-                        "the integer does not fit 64 bits (write it as a float, e.g. 1e20)",
+                        "the integer does not fit 64 bits (-2^63 to 2^63 - 1; a key that takes any number takes it as a float, e.g. 1e20)",
                         span.start(),
                     ));
                     Val::Int(0)

@@ -249,6 +249,20 @@ fn slips_say_what_would_be_accepted() {
         &[],
         &["image.samples", "whole number", "4 or 5 would do"],
     );
+    // An integer past 64 bits: its range said, and a float offered only where any number is
+    // taken (a seed of 1e20 is no whole number the seed takes).
+    fails(
+        "seed-2-64",
+        &with(
+            "height = 32",
+            "height = 32\n[render]\nseed = 18446744073709551616",
+        ),
+        &[],
+        &[
+            "does not fit 64 bits (-2^63 to 2^63 - 1",
+            "a key that takes any number takes it as a float",
+        ],
+    );
     let d = Dir::new("set-split");
     let scene = d.file("scene.toml", GOOD);
     let (code, err) = status(&[
