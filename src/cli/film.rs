@@ -115,6 +115,7 @@ pub(super) fn run(
         let what = format!("frame {k}");
         crate::output::file::refuse_link(&pattern.path(k), &what)
             .map_err(|m| Error::flag("-o", m))?;
+        super::render_cmd::not_an_input(scene, &pattern.path(k), &what)?;
     }
     let t0 = std::time::Instant::now();
     let rest = render::RestGroups::build(scene, backend, render::WorldOptions::default())?;

@@ -226,6 +226,23 @@ fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
+/// An output that would replace a file the scene reads (a texture, a sky map, a mesh, a glTF
+/// file or one of its buffers or images) refused: the render would overwrite its own input.
+/// `what` says which output (`-o`, or a film's frame).
+pub(super) fn not_an_input(scene: &scene::Scene, out: &Path, what: &str) -> crate::Result<()> {
+    match scene.inputs.iter().find(|input| same_file(input, out)) {
+        Some(input) => Err(Error::flag(
+            "-o",
+            format!(
+                "{what} `{}` is {}, which the scene reads; it was left as it is",
+                out.display(),
+                input.display()
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
 pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     // Check everything that can be checked before the (possibly long) render.
     let format = output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
@@ -288,6 +305,9 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
         .and_then(|n| n.to_str())
         .is_some_and(|n| n.contains('#'));
     let single = args.frames.filter(|(a, b)| a == b).map(|(a, _)| a);
+    if plain && (single.is_some() || args.still) || scene.film.is_none() && args.frames.is_none() {
+        not_an_input(&scene, &args.output, "the output")?;
+    }
     if plain && (single.is_some() || args.still) {
         if args.frames.is_some() && single.is_none() {
             return Err(Error::flag(

@@ -196,6 +196,7 @@ pub(crate) fn render_id(scene: &Scene, backend: &str, overrides: &[String]) -> S
         fog,
         image: _,
         warnings: _,
+        inputs: _,
     } = scene;
     // The renderer's version too: another version may draw the same settings otherwise, and
     // `--resume` must not keep its frames.

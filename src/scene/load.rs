@@ -138,7 +138,10 @@ fn load_str_as(
     for (shown, set) in overrides {
         doc.apply_set(shown, set, superseded)?;
     }
-    build(&doc, frame)
+    let (scene, inputs) = super::inputs::recorded(|| build(&doc, frame));
+    let mut scene = scene?;
+    scene.inputs = inputs;
+    Ok(scene)
 }
 
 /// The keys an override replaces in its table: the other ways of giving the same setting, so
@@ -302,6 +305,7 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         sky,
         fog,
         warnings: imports.warnings,
+        inputs: Vec::new(),
     })
 }
 

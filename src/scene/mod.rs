@@ -7,6 +7,7 @@ pub(crate) mod doc;
 mod envelope;
 mod gltf_file;
 mod gltf_object;
+mod inputs;
 mod lights;
 mod load;
 mod many_groups;

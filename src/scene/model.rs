@@ -438,6 +438,10 @@ pub struct Scene {
     /// What the scene's files hold that it does not take (a glTF file's unmapped extensions,
     /// say), one sentence each, for the user to be told.
     pub warnings: Vec<String>,
+    /// The files its load read beside the scene file (textures, sky maps, meshes, glTF files
+    /// and theirs), as given or found: a render's output must not be one of them.
+    #[serde(skip)]
+    pub inputs: Vec<std::path::PathBuf>,
 }
 
 /// A homogeneous medium everywhere outside objects, at rest in a group's frame. Its medium is

@@ -298,6 +298,7 @@ fn fits(path: &std::path::Path, w: usize, h: usize, per_texel: u64) -> crate::Re
 /// not, in words.
 pub(crate) fn read_image(path: &std::path::Path) -> crate::Result<(usize, usize, Texels)> {
     let bad = |m: String| crate::Error::image(path, m, None);
+    super::inputs::note(path);
     let ext = path
         .extension()
         .and_then(|e| e.to_str())

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// A file's bytes, if it is a regular file within the memory limit.
 pub(super) fn read_file(path: &Path) -> Result<Vec<u8>, GltfError> {
+    crate::scene::inputs::note(path);
     let meta = std::fs::metadata(path).map_err(|e| format!("cannot read it: {e}"))?;
     if !meta.is_file() {
         return Err("it is not a regular file".into());

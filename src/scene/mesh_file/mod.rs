@@ -59,6 +59,7 @@ pub(crate) const BYTES_PER_FILE_BYTE: u64 = 24;
 
 /// Read the mesh at `path`, by its extension.
 pub fn read(path: &Path) -> Result<MeshData, MeshError> {
+    super::inputs::note(path);
     let ext = path
         .extension()
         .and_then(|e| e.to_str())

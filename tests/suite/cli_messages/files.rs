@@ -200,3 +200,82 @@ fn special_files_are_neither_replaced_nor_read_forever() {
         assert!(!out.exists());
     }
 }
+
+/// A render never writes over a file its scene reads: a texture, a sky map, named as `-o`
+/// however spelt, or met by one of a film's frames, is refused and left as it is (it was
+/// replaced by the render, from a fifth newcomer's trial).
+#[test]
+fn a_render_never_writes_over_a_file_its_scene_reads() {
+    let d = Dir::new("inputs");
+    let plain = d.file("plain.toml", GOOD);
+    let paint = d.0.join("paint.png");
+    let (code, err) = status(&[
+        "render",
+        plain.to_str().unwrap(),
+        "-o",
+        paint.to_str().unwrap(),
+        "-q",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let painted = GOOD.replace(
+        "color = [0.8, 0.8, 0.8]",
+        "color = \"paint\"\n[[texture]]\nname = \"paint\"\nimage = \"paint.png\"",
+    );
+    let scene = d.file("scene.toml", &painted);
+    let s = scene.to_str().unwrap();
+    let before = std::fs::read(&paint).unwrap();
+    let spelt = format!("{}/./paint.png", d.0.display());
+    for out in [paint.to_str().unwrap(), spelt.as_str()] {
+        let (code, err) = status(&["render", s, "-o", out]);
+        assert_eq!(code, Some(1), "{err}");
+        assert!(
+            err.contains("-o")
+                && err.contains("which the scene reads")
+                && err.contains("paint.png"),
+            "{err}"
+        );
+        assert_eq!(
+            std::fs::read(&paint).unwrap(),
+            before,
+            "the texture is intact"
+        );
+    }
+    // The same picture as a sky map.
+    let sky = d.file("sky.toml", &format!("{GOOD}\n[sky]\nmap = \"paint.png\"\n"));
+    let (code, err) = status(&[
+        "render",
+        sky.to_str().unwrap(),
+        "-o",
+        paint.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("which the scene reads"), "{err}");
+    assert_eq!(
+        std::fs::read(&paint).unwrap(),
+        before,
+        "the sky map is intact"
+    );
+    // A film whose second frame's file is the texture: refused before any frame is written.
+    std::fs::copy(&paint, d.0.join("f1.png")).unwrap();
+    let film = d.file(
+        "film.toml",
+        &format!(
+            "{}\n[film]\nstart = 10\nend = 11\nfps = 1\n",
+            painted.replace("image = \"paint.png\"", "image = \"f1.png\"")
+        ),
+    );
+    let pattern = d.0.join("f#.png");
+    let (code, err) = status(&[
+        "render",
+        film.to_str().unwrap(),
+        "-o",
+        pattern.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("frame 1") && err.contains("which the scene reads"),
+        "{err}"
+    );
+    assert!(!d.0.join("f0.png").exists(), "no frame was written");
+    assert_eq!(std::fs::read(d.0.join("f1.png")).unwrap(), before);
+}
