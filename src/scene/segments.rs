@@ -165,6 +165,43 @@ pub(crate) fn read(t: &Table, dir_key: &str, whose: Whose) -> SceneResult<Option
         ])?;
         segments.push(Segment { until, motion });
     }
+    // The last segment lasts for ever, unless it accelerates (then a coast follows it at the
+    // velocity reached): an `until` on a uniform last segment would say nothing.
+    if let (
+        Some(Segment {
+            until: Some(u),
+            motion: Motion::Uniform(_) | Motion::Coast,
+        }),
+        Some(s),
+    ) = (segments.last(), tables.last())
+    {
+        let n = s.get("until").expect("read above");
+        return Err(s.error_at(
+            n,
+            "until",
+            format!(
+                "the last segment lasts for ever, so it has no end at {u}: leave `until` out, or add the segment that follows it (a group at rest after it: {{ velocity = [0, 0, 0] }})"
+            ),
+        ));
+    }
+    // An acceleration ends at the velocity it reached, which must be one the renderer keeps
+    // exact, as a velocity given is.
+    let line = Worldline::new(Event::ORIGIN, &segments);
+    for (i, (segment, s)) in segments.iter().zip(&tables).enumerate() {
+        if let (Motion::Accelerated(_), Some(u)) = (segment.motion, segment.until) {
+            let rapidity = line.velocity(u).rapidity();
+            if !(rapidity <= super::envelope::MAX_RAPIDITY) {
+                return Err(s.error(
+                    "acceleration",
+                    format!(
+                        "segment {} reaches rapidity {rapidity:?} by its end (world time {u}), beyond the speeds rest-embree renders correctly: rapidity up to {:?} (1 - beta down to about 1e-17); accelerate less, or end it sooner",
+                        i + 1,
+                        super::envelope::MAX_RAPIDITY
+                    ),
+                ));
+            }
+        }
+    }
     Ok(Some(segments))
 }
 

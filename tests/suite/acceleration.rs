@@ -434,6 +434,28 @@ fn bad_accelerations_name_the_key() {
             format!("[render]\nintegrator = \"path\"\n{}", base("worldline = [{ until = 0, velocity = [0, 0, 0] }, { until = 3, acceleration = [0.1, 0, 0] }]", sphere)),
             "groups on accelerated segments are not built yet for integrator = \"path\"",
         ),
+        // An acceleration that ends past the speeds the renderer keeps exact (rapidity
+        // 0.4 × 1e13 by its end) was taken, its beta 1 in the header; so was a last uniform
+        // segment's `until`, which the motion ignores (both from the fifth trial).
+        (
+            base("worldline = [{ until = 5, velocity = [0.5, 0, 0] }, { until = 1e13, acceleration = [0.4, 0, 0] }]", sphere),
+            "worldline.1.acceleration`: segment 2 reaches rapidity",
+        ),
+        (
+            base("worldline = [{ until = 0, velocity = [0, 0, 0] }, { until = 1e9, acceleration = [0.4, 0, 0] }]", sphere),
+            "by its end (world time 1000000000), beyond the speeds rest-embree renders correctly: rapidity up to 20.0",
+        ),
+        (
+            base("worldline = [{ until = 5, velocity = [0.5, 0, 0] }, { until = 9, velocity = [0, 0, 0] }]", sphere),
+            "test.toml:6: key `group.ball.worldline.1.until`: the last segment lasts for ever, so it has no end at 9",
+        ),
+        (
+            base("velocity = [0, 0, 0]", sphere).replace(
+                "look_at = [0, 0, 0]",
+                "look_at = [0, 0, 0]\nworldline = [{ until = 0, velocity = [0, 0, 0] }, { until = 1e13, acceleration = [0.4, 0, 0] }]",
+            ).replace("position = [0, -10, 0]\n", "position = [0, -10, 0]\n"),
+            "camera.worldline.1.acceleration`: segment 2 reaches rapidity",
+        ),
     ];
     for (text, needle) in cases {
         let e = rest_embree::scene::load_str("test.toml", &text, &[])
