@@ -190,7 +190,7 @@ pub(crate) fn read(t: &Table, dir_key: &str, whose: Whose) -> SceneResult<Option
     for (i, (segment, s)) in segments.iter().zip(&tables).enumerate() {
         if let (Motion::Accelerated(_), Some(u)) = (segment.motion, segment.until) {
             let rapidity = line.velocity(u).rapidity();
-            if !(rapidity <= super::envelope::MAX_RAPIDITY) {
+            if rapidity.is_nan() || rapidity > super::envelope::MAX_RAPIDITY {
                 return Err(s.error(
                     "acceleration",
                     format!(
