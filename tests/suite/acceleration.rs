@@ -453,7 +453,7 @@ fn bad_accelerations_name_the_key() {
             base("velocity = [0, 0, 0]", sphere).replace(
                 "look_at = [0, 0, 0]",
                 "look_at = [0, 0, 0]\nworldline = [{ until = 0, velocity = [0, 0, 0] }, { until = 1e13, acceleration = [0.4, 0, 0] }]",
-            ).replace("position = [0, -10, 0]\n", "position = [0, -10, 0]\n"),
+            ),
             "camera.worldline.1.acceleration`: segment 2 reaches rapidity",
         ),
     ];
