@@ -274,7 +274,14 @@ fn build(doc: &Doc, frame: FrameSize) -> SceneResult<Scene> {
         ));
     }
     let mut lights = Vec::new();
+    let mut light_names = std::collections::HashSet::new();
     for t in root.tables("light")? {
+        // `--set light.<name>.…` reaches the first of a name: the others could not be.
+        if let Some(name) = t.string("name")? {
+            if !light_names.insert(name) {
+                return Err(t.error("name", format!("a light named `{name}` is defined twice")));
+            }
+        }
         lights.push(light(&t, &groups)?);
     }
     lights.extend(flash);
@@ -357,7 +364,20 @@ pub(super) fn group(
     let mut geometry = Geometry::default();
     let entries = t.tables("object")?;
     let mut own_groups = Vec::new();
+    let mut object_names = std::collections::HashSet::new();
     for (k, o) in entries.iter().enumerate() {
+        // `--set group.<group>.object.<name>.…` reaches the first of a name: the others could
+        // not be.
+        if let Some(object) = o.string("name")? {
+            if !object_names.insert(object) {
+                return Err(o.error(
+                    "name",
+                    format!(
+                        "group `{name}` holds two objects named `{object}`: give each its own name"
+                    ),
+                ));
+            }
+        }
         let id = (id_base + objects.len()) as u32;
         let (first, implicit, parts) = (
             geometry.prims.len(),

@@ -633,3 +633,35 @@ fn messages_that_cannot_be_written_leave_the_exit_status() {
     assert_eq!(run(&["backends"], true), Some(0));
     assert_eq!(run(&["no-such-command"], true), Some(1));
 }
+
+/// A name `--set` addresses is one entry's: two lights of a name, or two objects of a name in
+/// one group, are refused (the second could not be reached: the fifth trial's mesh and
+/// sphere both named `rock`); the same object name in two groups is two addresses.
+#[test]
+fn names_set_addresses_are_unique() {
+    let load = |text: &str| rest_embree::scene::load_str("test.toml", text, &[]).map(|_| ());
+    let twice = GOOD.replace(
+        "material = \"white\"\n",
+        "material = \"white\"\nname = \"rock\"\n[[group.object]]\ntype = \"sphere\"\ncenter = [0, 12, 0]\nradius = 0.5\nname = \"rock\"\n",
+    );
+    let e = load(&twice).unwrap_err().to_string();
+    assert!(
+        e.contains("group.cube.object.rock.name")
+            && e.contains("group `cube` holds two objects named `rock`"),
+        "{e}"
+    );
+    let apart = twice.replace(
+        "name = \"rock\"\n[[group.object]]",
+        "name = \"rock\"\n[[group]]\nname = \"other\"\n[[group.object]]",
+    );
+    load(&apart).unwrap();
+    let lights = GOOD.replace(
+        "[[light]]\n",
+        "[[light]]\nname = \"sun\"\nposition = [0, 0, 30]\n[[light]]\nname = \"sun\"\n",
+    );
+    let e = load(&lights).unwrap_err().to_string();
+    assert!(
+        e.contains("light.sun.name") && e.contains("a light named `sun` is defined twice"),
+        "{e}"
+    );
+}
