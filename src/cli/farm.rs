@@ -253,6 +253,7 @@ impl Plan {
         };
         let scene = scene::load_file_as(&scene_path, &overrides, frame)?;
         let format = output::Format::for_path(&args.output).map_err(|e| e.on_flag("-o"))?;
+        task_flags_checked(&scene_path, &render_flags, args, format)?;
         if let Some(b) = &args.backend {
             crate::accel::backend_by_name(b).map_err(|e| e.on_flag("--backend"))?;
         }
@@ -448,6 +449,17 @@ fn directives(
                 format!("`{}` has a control character", crate::text::shown(a)),
             ));
         }
+        // sbatch's command line outranks the script's own --array: every task would render
+        // the same frame or tile.
+        if a.starts_with("--array") || a.starts_with("-a") {
+            return Err(Error::flag(
+                "--sbatch-arg",
+                format!(
+                    "`{}`: the farm makes the job array itself, one task per frame or tile (--frames and --tiles choose them)",
+                    crate::text::shown(a)
+                ),
+            ));
+        }
         // sbatch splits an #SBATCH line at spaces: an argument with one goes on sbatch's
         // command line alone, and the script says so.
         match a.chars().any(char::is_whitespace) {
@@ -458,18 +470,83 @@ fn directives(
             )),
         }
     }
-    for (flag, v) in [("--mem", &args.mem), ("--time", &args.time)] {
-        if let Some(v) = v
-            .as_ref()
-            .filter(|v| v.is_empty() || v.chars().any(|c| c.is_whitespace() || c.is_control()))
-        {
+    let forms = [
+        (
+            "--mem",
+            &args.mem,
+            slurm_size as fn(&str) -> bool,
+            "a whole number of megabytes, or one with K, M, G or T (8G; 0 is all of a node's)",
+        ),
+        (
+            "--time",
+            &args.time,
+            slurm_time,
+            "minutes, minutes:seconds, hours:minutes:seconds, days-hours, days-hours:minutes, days-hours:minutes:seconds or UNLIMITED",
+        ),
+    ];
+    for (flag, v, fits, accepted) in forms {
+        if let Some(v) = v.as_ref().filter(|v| !fits(v)) {
             return Err(Error::flag(
                 flag,
-                format!("`{}` is no value for sbatch", crate::text::shown(v)),
+                format!(
+                    "`{}` is no value sbatch takes: {accepted}",
+                    crate::text::shown(v)
+                ),
             ));
         }
     }
     Ok(out)
+}
+
+/// Whether sbatch's --mem takes `v`: digits, then at most one of its units.
+fn slurm_size(v: &str) -> bool {
+    let digits = v.trim_end_matches(['K', 'M', 'G', 'T', 'k', 'm', 'g', 't']);
+    v.len() - digits.len() <= 1 && !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
+}
+
+/// Whether sbatch's --time takes `v`: one of its six forms of whole numbers, or no limit.
+fn slurm_time(v: &str) -> bool {
+    if ["UNLIMITED", "INFINITE"]
+        .iter()
+        .any(|w| v.eq_ignore_ascii_case(w))
+    {
+        return true;
+    }
+    let number = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    let (days, rest) = match v.split_once('-') {
+        Some((d, rest)) => (Some(d), rest),
+        None => (None, v),
+    };
+    let parts: Vec<&str> = rest.split(':').collect();
+    days.is_none_or(number) && parts.len() <= 3 && parts.iter().all(|p| number(p))
+}
+
+/// A task's flags read as `render` reads them, and refused here as a task would refuse them
+/// (an EXR's flag on a PNG, a value given twice), before anything is submitted.
+fn task_flags_checked(
+    scene: &Path,
+    render_flags: &[(String, String)],
+    args: &SlurmArgs,
+    format: output::Format,
+) -> crate::Result<()> {
+    use clap::Parser;
+    let mut argv: Vec<String> = ["rest-embree", "render"].map(String::from).to_vec();
+    argv.push(scene.display().to_string());
+    argv.extend(["-o".to_string(), args.output.display().to_string()]);
+    for (shown, _) in render_flags {
+        let (flag, value) = shown.split_once(' ').expect("a flag and its value");
+        argv.extend([flag.to_string(), value.to_string()]);
+    }
+    for s in &args.set {
+        argv.extend(["--set".to_string(), s.clone()]);
+    }
+    match super::args::Cli::try_parse_from(&argv) {
+        Ok(super::args::Cli {
+            command: super::args::Command::Render(task),
+        }) => task.check_flags(format),
+        // The farm's own flags were read by the same parsers: a task reads them as they are.
+        _ => Ok(()),
+    }
 }
 
 /// A task's time limit estimated from a small render of the scene here (one tile's width, the

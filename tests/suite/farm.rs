@@ -180,6 +180,44 @@ fn bad_farms_are_clear_errors() {
         ),
         (vec![s(&film), "-o", "x.exr"], "frame pattern"),
         (vec![s(&still), "-o", "my renders/x.exr"], "has a space"),
+        // What every task's render would refuse, or sbatch would (the fifth trial's: each
+        // was written into the scripts and submitted).
+        (
+            vec![s(&still), "-o", "x.png", "--passes", "depth"],
+            "--passes: applies to an EXR",
+        ),
+        (
+            vec![
+                s(&still),
+                "-o",
+                "x.exr",
+                "--width",
+                "20",
+                "--set",
+                "image.width=10",
+            ],
+            "sets the same value",
+        ),
+        (
+            vec![s(&still), "-o", "x.exr", "--mem", "abc"],
+            "--mem: `abc` is no value sbatch takes",
+        ),
+        (
+            vec![s(&still), "-o", "x.exr", "--mem", "8GB"],
+            "K, M, G or T",
+        ),
+        (
+            vec![s(&still), "-o", "x.exr", "--time", "abc"],
+            "--time: `abc` is no value sbatch takes",
+        ),
+        (
+            vec![s(&still), "-o", "x.exr", "--time", "1:2:3:4"],
+            "UNLIMITED",
+        ),
+        (
+            vec![s(&still), "-o", "x.exr", "--sbatch-arg=--array=0-5"],
+            "the farm makes the job array itself",
+        ),
     ] {
         let mut all = vec!["farm", "slurm"];
         all.extend(args);
@@ -279,6 +317,39 @@ fn bad_farms_are_clear_errors() {
         text.contains("#SBATCH --mem=4G\n") && text.contains("#SBATCH --time=1:00:00\n"),
         "{text}"
     );
+    // Every form sbatch documents is taken as it is.
+    for (mem, time) in [
+        ("0", "90"),
+        ("512", "90:30"),
+        ("8g", "1-12"),
+        ("1T", "2-0:30"),
+        ("64M", "3-04:05:06"),
+        ("2K", "UNLIMITED"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
+            .args([
+                "farm",
+                "slurm",
+                s(&still),
+                "-o",
+                s(&d.0.join("x.exr")),
+                "--dry-run",
+                "--mem",
+                mem,
+                "--time",
+                time,
+            ])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success()
+                && text.contains(&format!("#SBATCH --mem={mem}\n"))
+                && text.contains(&format!("#SBATCH --time={time}\n")),
+            "{mem} {time}: {text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
 }
 
 fn out_pattern(dir: &Path) -> std::path::PathBuf {
