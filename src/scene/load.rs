@@ -557,6 +557,24 @@ fn holds_glass_or_media(geometry: &Geometry, materials: &[Material]) -> bool {
 /// ones from `implicit`, its parts from `parts`: an object's parts are the last added, so a
 /// group of many objects is checked in time linear in them) that an image texture cannot be
 /// mapped onto, or that reaches farther than coordinates may.
+/// The keys that say where an object's points are, besides its `type`.
+const PLACING_KEYS: [&str; 14] = [
+    "center",
+    "radius",
+    "min",
+    "max",
+    "from",
+    "to",
+    "origin",
+    "spacing",
+    "counts",
+    "length",
+    "bar_size",
+    "translate",
+    "scale",
+    "file",
+];
+
 fn check_object(
     o: &Table,
     kind: &str,
@@ -610,7 +628,15 @@ fn check_object(
         .map(|b| b.min.abs().max(b.max.abs()).max_element())
         .fold(0.0, f64::max);
     if reach > super::envelope::MAX_MAGNITUDE {
-        return Err(o.error("type", super::envelope::reaches_too_far(kind, reach)));
+        // The object as a whole (its `type`, or the mesh file whose points reach there),
+        // unless a flag placed it (`--set ...center=`): then that flag, which the file's
+        // lines do not show.
+        let whole = if o.has("file") { "file" } else { "type" };
+        let key = PLACING_KEYS
+            .into_iter()
+            .find(|k| o.from_flag(k))
+            .unwrap_or(whole);
+        return Err(o.error(key, super::envelope::reaches_too_far(kind, reach)));
     }
     Ok(())
 }

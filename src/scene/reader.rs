@@ -71,6 +71,13 @@ impl<'a> Table<'a> {
         self.entries().iter().any(|(k, _)| k == key)
     }
 
+    /// Whether key `key` is given by a command-line flag (`--set`), not the file.
+    pub fn from_flag(&self, key: &str) -> bool {
+        self.entries()
+            .iter()
+            .any(|(k, n)| k == key && n.origin.source().is_err())
+    }
+
     /// The node of a key, marking it understood.
     pub fn get(&self, key: &str) -> Option<&'a Node> {
         let i = self.entries().iter().position(|(k, _)| k == key)?;

@@ -73,9 +73,11 @@ fn values_beyond_the_envelope_name_their_key() {
         ("light.0.intensity=1e308", "light.0.intensity"),
         ("image.background=1e300", "image.background"),
         ("group.g.object.0.radius=1e308", "group.g.object.0.radius"),
+        // The object reaches too far: the flag that placed it is named (the object's `type`
+        // line in the file was, which the flag had not touched).
         (
             "group.g.object.0.center=[1e15, 0, 0]",
-            "group.g.object.0.type",
+            "group.g.object.0.center",
         ),
     ];
     for (set, key) in cases {
@@ -90,6 +92,28 @@ fn values_beyond_the_envelope_name_their_key() {
             "{set}: {e}"
         );
     }
+}
+
+/// A mesh whose vertices reach past 1e15 is blamed on its `file` (it was on its `type`).
+#[test]
+fn a_mesh_beyond_the_envelope_names_its_file() {
+    let d = crate::common::cli::Dir::new("envelope-mesh");
+    std::fs::write(
+        d.0.join("far.obj"),
+        "v 0 0 0\nv 1e300 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let scene = d.file(
+        "scene.toml",
+        "[camera]\nposition = [0, 0, 0]\nlook_at = [0, 10, 0]\n[[group]]\nname = \"g\"\n[[group.object]]\ntype = \"mesh\"\nfile = \"far.obj\"\n",
+    );
+    let e = rest_embree::scene::load_file(&scene, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("scene.toml:8: key `group.g.object.0.file`: the mesh reaches 1e300"),
+        "{e}"
+    );
 }
 
 /// The corners: objects near 1e15 from the origin, the fastest group and camera, the largest
