@@ -634,7 +634,7 @@ fn check_object(
         let whole = if o.has("file") { "file" } else { "type" };
         let key = PLACING_KEYS
             .into_iter()
-            .find(|k| o.from_flag(k))
+            .find(|k| o.set_by_flag(k))
             .unwrap_or(whole);
         return Err(o.error(key, super::envelope::reaches_too_far(kind, reach)));
     }

@@ -72,7 +72,7 @@ impl<'a> Table<'a> {
     }
 
     /// Whether key `key` is given by a command-line flag (`--set`), not the file.
-    pub fn from_flag(&self, key: &str) -> bool {
+    pub fn set_by_flag(&self, key: &str) -> bool {
         self.entries()
             .iter()
             .any(|(k, n)| k == key && n.origin.source().is_err())
