@@ -149,8 +149,11 @@ fn load_str_as(
 pub(crate) fn superseded(table: &[&str], key: &str) -> &'static [&'static str] {
     let in_group = table.first() == Some(&"group") && table.len() == 2;
     let in_camera = table == ["camera"];
+    let in_light = table.first() == Some(&"light") && table.len() == 2;
     match key {
-        // A group's velocity replaces its worldline too.
+        // A velocity replaces a worldline, and a worldline every way of giving a velocity
+        // (a group's speed has its `direction`, the camera's and a light's their
+        // `velocity_direction`; a light's `group` is its velocity too).
         "velocity" if in_group => &[
             "beta",
             "rapidity",
@@ -158,7 +161,47 @@ pub(crate) fn superseded(table: &[&str], key: &str) -> &'static [&'static str] {
             "direction",
             "worldline",
         ],
+        "worldline" if in_group => &[
+            "velocity",
+            "beta",
+            "rapidity",
+            "one_minus_beta",
+            "direction",
+        ],
+        "velocity" if in_light => &[
+            "beta",
+            "rapidity",
+            "one_minus_beta",
+            "velocity_direction",
+            "worldline",
+            "group",
+        ],
+        "worldline" if in_light => &[
+            "velocity",
+            "beta",
+            "rapidity",
+            "one_minus_beta",
+            "velocity_direction",
+            "group",
+        ],
+        "velocity" if in_camera => &[
+            "beta",
+            "rapidity",
+            "one_minus_beta",
+            "velocity_direction",
+            "worldline",
+        ],
+        "worldline" if in_camera => &[
+            "velocity",
+            "beta",
+            "rapidity",
+            "one_minus_beta",
+            "velocity_direction",
+        ],
         "velocity" => &["beta", "rapidity", "one_minus_beta", "velocity_direction"],
+        // A film's frame rate or its step: one of the two.
+        "fps" if table == ["film"] => &["step"],
+        "step" if table == ["film"] => &["fps"],
         "beta" => &["velocity", "rapidity", "one_minus_beta"],
         "rapidity" => &["velocity", "beta", "one_minus_beta"],
         "one_minus_beta" => &["velocity", "beta", "rapidity"],

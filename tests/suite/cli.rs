@@ -665,3 +665,54 @@ fn names_set_addresses_are_unique() {
         "{e}"
     );
 }
+
+/// `--set` of one way of giving a motion replaces the others, whichever the file gives: a
+/// worldline over a group's, the camera's or a light's velocity and back, a film's step over
+/// its frame rate (each was "give either ..., not both", from the fifth trial).
+#[test]
+fn set_replaces_the_other_forms_of_a_motion() {
+    use rest_embree::scene::FrameSpacing;
+    let film = format!(
+        "{}\n[film]\nend = 12\nfps = 1\n",
+        GOOD.replace(
+            "[[light]]\n",
+            "[[light]]\nname = \"lamp\"\nvelocity = [0.1, 0, 0]\n",
+        )
+        .replace("group = \"cube\"\n", "")
+    );
+    let line = "[{ until = 5, velocity = [0.5, 0, 0] }, { velocity = [0, 0, 0] }]";
+    let set = |pairs: &[(&str, String)]| {
+        let sets: Vec<(String, String)> = pairs
+            .iter()
+            .map(|(k, v)| (format!("--set {k}={v}"), format!("{k}={v}")))
+            .collect();
+        rest_embree::scene::load_str("test.toml", &film, &sets)
+    };
+    let s = set(&[
+        ("group.cube.worldline", line.to_string()),
+        ("camera.worldline", line.to_string()),
+        ("light.lamp.worldline", line.to_string()),
+        ("film.step", "0.5".to_string()),
+    ])
+    .unwrap();
+    assert_eq!(s.groups.len(), 2, "the group's worldline of two pieces");
+    assert!(s.camera.worldline.is_some());
+    let f = s.film.as_ref().unwrap();
+    assert_eq!(f.spacing, FrameSpacing::Step(0.5));
+    assert_eq!(
+        f.frame_count(),
+        5,
+        "frames every 0.5 from the camera's 10 to 12"
+    );
+    // And back: a velocity over the worldline the step gave.
+    let s = set(&[
+        ("camera.worldline", line.to_string()),
+        ("camera.velocity", "[0.2, 0, 0]".to_string()),
+        ("film.step", "0.5".to_string()),
+        ("film.fps", "2".to_string()),
+    ])
+    .unwrap();
+    assert!(s.camera.worldline.is_none());
+    assert!((s.camera.velocity.beta() - 0.2).abs() < 1e-12);
+    assert_eq!(s.film.unwrap().spacing, FrameSpacing::Fps(2.0));
+}
