@@ -20,7 +20,13 @@ pub(super) fn read_spin(
         return Err(t.error("axis", "must not be zero"));
     }
     let axis = axis.normalize();
-    let omega = t.f64_or("omega", 0.0)?;
+    // No default: a spin without its rate would be none, said nowhere.
+    let omega = t.f64("omega")?.ok_or_else(|| {
+        t.error(
+            "omega",
+            "missing: give the rate of turning (radians per unit of the group's time; 0 for none)",
+        )
+    })?;
     t.finish(&["axis", "omega"])?;
     let (centre, turning) = match (kind, prims) {
         ("sphere", [Primitive::Sphere { center, .. }]) => (*center, false),

@@ -133,6 +133,12 @@ fn bad_spins_are_refused() {
     );
     let e = load(&lattice);
     assert!(e.contains("a spinning lattice is not built yet"), "{e}");
+    // A spin without its rate was no spin, without a word (the fifth trial).
+    let e = load(&spinning(0.5, 0.0, "").replace(", omega = 0.25", ""));
+    assert!(
+        e.contains("key `group.ball.object.0.spin.omega`: missing: give the rate of turning"),
+        "{e}"
+    );
     let turned_box = spinning(0.5, 0.0, "").replace(
         "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 2",
         "type = \"box\"\nmin = [-1, -1, -1]\nmax = [1, 1, 1]\nrotate = { axis = [0, 0, 1], degrees = 30 }",
