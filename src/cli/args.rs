@@ -20,6 +20,9 @@ pub(crate) struct Cli {
 #[derive(Subcommand, Debug)]
 pub(crate) enum Command {
     /// Render a scene file to an EXR (linear, with passes) or PNG (sRGB) image.
+    // A negative number is a flag's value, so `--width -5` is said to be no width (clap
+    // otherwise takes it for an unknown flag).
+    #[command(allow_negative_numbers = true)]
     Render(RenderArgs),
     /// Explore a scene in the browser: velocities, camera and passes on controls, refined while
     /// nothing changes; save the view as a scene file or render it to an EXR.

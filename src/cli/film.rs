@@ -107,7 +107,7 @@ pub(super) fn run(
     let pattern = FramePattern::parse(&args.output)?;
     if let Some(dir) = pattern.dir.to_str().filter(|d| !d.is_empty()) {
         std::fs::create_dir_all(dir)
-            .map_err(|e| Error::flag("-o", format!("cannot make the folder {dir}: {e}")))?;
+            .map_err(|e| Error::flag("-o", super::render_cmd::folder_error(Path::new(dir), &e)))?;
     }
     // Every frame's file, before any is written: none may be a link (it could lead to another
     // frame, which would be lost).

@@ -218,6 +218,22 @@ pub(crate) fn memory_need(scene: &scene::Scene, format: output::Format, threads:
     held.saturating_add(scene.primitive_bytes())
 }
 
+/// Why the folder `dir` of an output could not be made: a file in the way named (`-o
+/// scene.toml/out.png` said "File exists"), else the system's reason.
+pub(super) fn folder_error(dir: &Path, e: &std::io::Error) -> String {
+    let in_the_way = dir
+        .ancestors()
+        .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir());
+    match in_the_way {
+        Some(file) => format!(
+            "cannot make the folder {}: {} is a file, not a folder",
+            dir.display(),
+            file.display()
+        ),
+        None => format!("cannot make the folder {}: {e}", dir.display()),
+    }
+}
+
 /// Whether two paths name one existing file (through links).
 fn same_file(a: &Path, b: &Path) -> bool {
     match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
@@ -253,6 +269,7 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
         .unwrap_or_else(|| accel::default_backend_name().to_string());
     let backend = accel::backend_by_name(&backend_name).map_err(|e| e.on_flag("--backend"))?;
     set_threads(args.threads)?;
+    crate::render::simd_env_checked()?;
     if same_file(&args.scene, &args.output) {
         return Err(Error::flag(
             "-o",
@@ -379,12 +396,7 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
     let (world, build_time) = world?;
     // Into a folder that does not exist yet, as a film's frames go.
     if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Error::flag(
-                "-o",
-                format!("cannot make the folder {}: {e}", dir.display()),
-            )
-        })?;
+        std::fs::create_dir_all(dir).map_err(|e| Error::flag("-o", folder_error(dir, &e)))?;
     }
     let mut stats = render_to_file(
         &scene,

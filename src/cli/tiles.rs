@@ -48,8 +48,13 @@ pub(super) fn parse_grid(text: &str) -> Result<(u32, u32), String> {
     let (a, b) = text
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("`{text}` is not a grid: give columns x rows, e.g. 2x2"))?;
-    let count = |t: &str| match t.trim().parse::<u32>() {
-        Ok(n) if n >= 1 => Ok(n),
+    let count = |t: &str| match t.trim().parse::<u64>() {
+        Ok(n) if n >= 1 => u32::try_from(n).map_err(|_| {
+            format!(
+                "`{t}` in `{text}` is more tiles than an image has pixels (at most {} a side)",
+                u32::MAX
+            )
+        }),
         _ => Err(format!(
             "`{t}` in `{text}` is not a count of tiles (1 or more)"
         )),

@@ -48,7 +48,7 @@ pub(crate) use progress::Progress;
 pub(crate) use progressive::render as render_progressive;
 pub(crate) use screen_cull::ScreenCull;
 pub(crate) use tile::TileScratch;
-pub(crate) use world::{RestGroups, World};
+pub(crate) use world::{simd_env_checked, RestGroups, World};
 // What the bench's passes of primary rays alone reach (src/bench/primary.rs).
 #[cfg(feature = "cli")]
 pub(crate) use tile::image_points;

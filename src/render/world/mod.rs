@@ -95,6 +95,21 @@ pub struct WorldOptions {
     pub simd: bool,
 }
 
+/// `REST_EMBREE_SIMD`, if set, as `off` or `on`: another value is an error naming it (it was
+/// taken as on).
+pub(crate) fn simd_env_checked() -> crate::Result<()> {
+    match std::env::var("REST_EMBREE_SIMD") {
+        Ok(v) if v != "off" && v != "on" => Err(crate::Error::flag(
+            "REST_EMBREE_SIMD",
+            format!(
+                "`{}` is neither `off` (the lanes one by one) nor `on` (in vector registers where the CPU has them; the default)",
+                crate::text::shown(&v)
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Whether the environment leaves SIMD on (`REST_EMBREE_SIMD=off` turns it off).
 fn simd_by_default() -> bool {
     static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();

@@ -434,3 +434,53 @@ fn round_three_inputs_are_clear_errors() {
     );
     assert!(!out.exists());
 }
+
+/// The fifth trial's unclear words, each now said: a file where `-o`'s folder would go, a grid
+/// of more tiles than a u32, an unknown `REST_EMBREE_SIMD`, and a negative number given to a
+/// flag (clap took it for an unknown flag).
+#[test]
+fn odd_outputs_grids_environments_and_negative_flags_are_said() {
+    let d = Dir::new("odd-words");
+    let scene = d.file("scene.toml", GOOD);
+    let s = scene.to_str().unwrap();
+    let under = format!("{s}/out.png");
+    let (code, err) = status(&["render", s, "-o", &under]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("-o: cannot make the folder")
+            && err.contains("scene.toml is a file, not a folder"),
+        "{err}"
+    );
+    let out = d.0.join("out.exr");
+    let o = out.to_str().unwrap();
+    let (code, err) = status(&[
+        "render",
+        s,
+        "-o",
+        o,
+        "--tiles",
+        "99999999999x1",
+        "--tile",
+        "0",
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("is more tiles than an image has pixels"),
+        "{err}"
+    );
+    let (code, err, _) = status_with_env(&["render", s, "-o", o], &[("REST_EMBREE_SIMD", "maybe")]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("REST_EMBREE_SIMD: `maybe` is neither `off`"),
+        "{err}"
+    );
+    let (code, err, _) =
+        status_with_env(&["render", s, "-o", o, "-q"], &[("REST_EMBREE_SIMD", "on")]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = status(&["render", s, "-o", o, "--width", "-5"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--width -5: key `image.width`: must be a whole number"),
+        "{err}"
+    );
+}
