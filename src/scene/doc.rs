@@ -76,16 +76,19 @@ impl Doc {
             .split_once('=')
             .ok_or_else(|| bad("", "expected KEY=VALUE, e.g. camera.time=5".into()))?;
         let key = key.trim();
-        if key.is_empty() || key.split('.').any(|s| s.is_empty()) {
+        // Dotted, as TOML's keys are: a part in quotes is a name as it is (`group."g.x".velocity`
+        // reaches the group named g.x; `group."1"` the one named 1, never the second entry).
+        let parts = key_parts(key).filter(|p| !p.is_empty() && p.iter().all(|s| !s.0.is_empty()));
+        let Some(parts) = parts else {
             return Err(bad(
                 key,
-                "the key must be a dotted path like group.cube.velocity".into(),
+                "the key must be a dotted path like group.cube.velocity (a name with dots in quotes: group.\"g.x\".velocity)".into(),
             ));
-        }
+        };
         let origin = Origin::flag(self.flags.len());
         let value = parse_set_value(text.trim(), origin, &bad(key, String::new()))?;
         self.flags.push(shown.clone());
-        let segs: Vec<&str> = key.split('.').collect();
+        let segs: Vec<&str> = parts.iter().map(|(s, _)| s.as_str()).collect();
         let mut cur = &mut self.root;
         for (i, seg) in segs.iter().enumerate() {
             let last = i + 1 == segs.len();
@@ -135,10 +138,15 @@ impl Doc {
                                 .unwrap_or_else(|| j.to_string())
                         })
                         .collect();
+                    let quoted = parts[i].1;
                     let p = items
                         .iter()
                         .position(|n| n.name_field() == Some(seg))
-                        .or_else(|| seg.parse::<usize>().ok().filter(|&j| j < items.len()));
+                        .or_else(|| {
+                            seg.parse::<usize>()
+                                .ok()
+                                .filter(|&j| j < items.len() && !quoted)
+                        });
                     let Some(p) = p else {
                         let parent = segs[..i].join(".");
                         return Err(bad(
@@ -163,6 +171,27 @@ impl Doc {
         }
         unreachable!("the loop returns at the last segment")
     }
+}
+
+/// A `--set` key's parts, split at the dots outside quotes, each with whether it was quoted
+/// (`"..."` or `'...'`, taken as written); None for an unclosed quote.
+fn key_parts(key: &str) -> Option<Vec<(String, bool)>> {
+    let mut parts = vec![(String::new(), false)];
+    let mut quote: Option<char> = None;
+    for c in key.chars() {
+        let part = parts.last_mut().expect("one at least");
+        match (quote, c) {
+            (Some(q), c) if c == q => quote = None,
+            (Some(_), c) => part.0.push(c),
+            (None, '"' | '\'') if part.0.is_empty() && !part.1 => {
+                quote = Some(c);
+                part.1 = true;
+            }
+            (None, '.') => parts.push((String::new(), false)),
+            (None, c) => part.0.push(c),
+        }
+    }
+    quote.is_none().then_some(parts)
 }
 
 /// A `--set` value is TOML; a bare word that is not valid TOML is taken as a string, so

@@ -716,3 +716,53 @@ fn set_replaces_the_other_forms_of_a_motion() {
     assert!((s.camera.velocity.beta() - 0.2).abs() < 1e-12);
     assert_eq!(s.film.unwrap().spacing, FrameSpacing::Fps(2.0));
 }
+
+/// A name with dots is reached in quotes, as in a TOML key (`group."g.x".velocity`; the
+/// fifth trial could not reach it), and a quoted number is a name, never an index.
+#[test]
+fn set_reaches_names_with_dots_in_quotes() {
+    let two = format!(
+        "{}\n[[group]]\nname = \"g.x\"\n[[group.object]]\ntype = \"sphere\"\ncenter = [3, 12, 0]\nradius = 0.5\n",
+        GOOD.replace("name = \"cube\"", "name = \"7\"")
+            .replace("group = \"cube\"", "group = \"7\"")
+    );
+    let set = |pairs: &[&str]| {
+        let sets: Vec<(String, String)> = pairs
+            .iter()
+            .map(|s| (format!("--set {s}"), s.to_string()))
+            .collect();
+        rest_embree::scene::load_str("test.toml", &two, &sets)
+    };
+    let s = set(&[
+        "group.\"g.x\".velocity=[0.3, 0, 0]",
+        "group.'7'.velocity=[0, 0.2, 0]",
+    ])
+    .unwrap();
+    let beta = |name: &str| {
+        s.groups
+            .iter()
+            .find(|g| g.name == name)
+            .unwrap()
+            .velocity
+            .beta_vec()
+    };
+    assert!((beta("g.x").x - 0.3).abs() < 1e-12 && (beta("7").y - 0.2).abs() < 1e-12);
+    // Unquoted, the dots split the name; a quote left open is said.
+    let e = set(&["group.g.x.velocity=[0.3, 0, 0]"])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("no [[group]] entry named `g`") && e.contains("g.x"),
+        "{e}"
+    );
+    let e = set(&["group.\"g.x.velocity=[0.3, 0, 0]"])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("a name with dots in quotes"), "{e}");
+    // A quoted number is a name: no group is named 1, though there is a second entry.
+    let e = set(&["group.\"1\".velocity=[0.3, 0, 0]"])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no [[group]] entry named `1`"), "{e}");
+    set(&["group.1.velocity=[0.3, 0, 0]"]).unwrap();
+}
