@@ -173,6 +173,17 @@ impl Doc {
     }
 }
 
+/// `name` as a part of a `--set` key: as it is, or in quotes where it holds a dot or a quote.
+pub(crate) fn key_part(name: &str) -> String {
+    if !name.contains(['.', '"', '\'']) {
+        name.to_string()
+    } else if name.contains('"') {
+        format!("'{name}'")
+    } else {
+        format!("\"{name}\"")
+    }
+}
+
 /// A `--set` key's parts, split at the dots outside quotes, each with whether it was quoted
 /// (`"..."` or `'...'`, taken as written); None for an unclosed quote.
 fn key_parts(key: &str) -> Option<Vec<(String, bool)>> {

@@ -41,7 +41,7 @@ impl Edit {
         let table = match &self.place {
             Place::Camera => "camera".to_string(),
             Place::Render => "render".to_string(),
-            Place::Group(name) => format!("group.{name}"),
+            Place::Group(name) => format!("group.{}", crate::scene::doc::key_part(name)),
         };
         format!("{table}.{}={}", self.key, self.value)
     }
@@ -394,6 +394,27 @@ mod tests {
             groups: vec!["lattice".into()],
             pinhole: true,
         }
+    }
+
+    /// A group whose name holds a dot is edited through a quoted key, which the scene's
+    /// reader takes as that name.
+    #[test]
+    fn a_name_with_dots_is_quoted_in_the_assignment() {
+        let edit = Edit {
+            place: Place::Group("Cube.001".into()),
+            key: "velocity",
+            value: "[0.5, 0, 0]".into(),
+        };
+        let set = edit.assignment();
+        assert_eq!(set, "group.\"Cube.001\".velocity=[0.5, 0, 0]");
+        let text = "[camera]\nposition = [0, 0, 0]\nlook_at = [1, 0, 0]\n[[group]]\nname = \"Cube.001\"\n[[group.object]]\ntype = \"sphere\"\ncenter = [5, 0, 0]\nradius = 1\n";
+        let scene = crate::scene::load_str("t.toml", text, &[(set.clone(), set)]).unwrap();
+        assert!((scene.groups[0].velocity.beta() - 0.5).abs() < 1e-12);
+        assert_eq!(
+            crate::scene::doc::key_part("it's \"x.y\""),
+            "'it's \"x.y\"'"
+        );
+        assert_eq!(crate::scene::doc::key_part("cube"), "cube");
     }
 
     const TEXT: &str = "# top\n[camera]\nposition = [0, 0, 0]\nlook_at = [1, 0, 0] # aim\nfov_y = 60\n\n[[group]]\nname = \"lattice\"\ndirection = [1, 0, 0]\nbeta = 0.5\n[[group.object]]\ntype = \"sphere\"\n\n[film]\nframes = 3\n";
