@@ -410,10 +410,7 @@ mod tests {
         let text = "[camera]\nposition = [0, 0, 0]\nlook_at = [1, 0, 0]\n[[group]]\nname = \"Cube.001\"\n[[group.object]]\ntype = \"sphere\"\ncenter = [5, 0, 0]\nradius = 1\n";
         let scene = crate::scene::load_str("t.toml", text, &[(set.clone(), set)]).unwrap();
         assert!((scene.groups[0].velocity.beta() - 0.5).abs() < 1e-12);
-        assert_eq!(
-            crate::scene::doc::key_part("it's \"x.y\""),
-            "'it's \"x.y\"'"
-        );
+        assert_eq!(crate::scene::doc::key_part("a \"b\".c"), "'a \"b\".c'");
         assert_eq!(crate::scene::doc::key_part("cube"), "cube");
     }
 
