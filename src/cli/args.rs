@@ -118,7 +118,7 @@ pub(crate) struct BenchArgs {
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
     /// Primary-ray passes and renders per row; the fastest of each counts.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     pub repeat: usize,
     /// Worker threads (default: all cores).
     #[arg(long)]

@@ -33,7 +33,19 @@ fn pick_cases(all: Vec<bench::LazyCase>, texts: &[String]) -> crate::Result<Vec<
     Ok(picked)
 }
 
+/// The bench, its `--out` folder removed again if this run made it and a refusal left it
+/// empty.
 pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
+    let existed = args.out.exists();
+    let result = bench_into(args);
+    if result.is_err() && !existed {
+        // Only an empty folder goes.
+        let _ = std::fs::remove_dir(&args.out);
+    }
+    result
+}
+
+fn bench_into(args: &BenchArgs) -> crate::Result<()> {
     set_threads(args.threads)?;
     // What can be refused is refused before anything is measured.
     if args.scene.is_none() && !args.set.is_empty() {
@@ -55,7 +67,8 @@ pub(super) fn run_bench(args: &BenchArgs) -> crate::Result<()> {
         ));
     }
     let out_flag = format!("--out {}", args.out.display());
-    std::fs::create_dir_all(&args.out).map_err(|e| Error::flag(&out_flag, e))?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| Error::flag(&out_flag, super::render_cmd::folder_error(&args.out, &e)))?;
     let probe = args.out.join(format!(".probe-{}", std::process::id()));
     std::fs::write(&probe, b"").map_err(|e| Error::flag(&out_flag, e))?;
     let _ = std::fs::remove_file(&probe);

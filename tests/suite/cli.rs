@@ -543,6 +543,27 @@ fn bench_writes_its_table_csv_and_plot() {
             "{flag}: refused before measuring: {err}"
         );
     }
+    // Said plainly, and leaving no folder behind (the fifth trial): the file in --out's way,
+    // no repeat, and a refused scene's bench.
+    let (ok, err) = run(&["bench", "--quick", "--out", blocker.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("not-a-folder is a file, not a folder"),
+        "{err}"
+    );
+    let fresh = d.0.join("fresh");
+    let (ok, err) = run(&["bench", "--repeat", "0", "--out", fresh.to_str().unwrap()]);
+    assert!(!ok && err.contains("--repeat"), "{err}");
+    let scene = d.file("scene.toml", GOOD);
+    let (ok, err) = run(&[
+        "bench",
+        scene.to_str().unwrap(),
+        "--backend",
+        "no-such",
+        "--out",
+        fresh.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("no-such"), "{err}");
+    assert!(!fresh.exists(), "a refused bench leaves no folder it made");
 }
 
 #[test]
