@@ -421,16 +421,39 @@ impl Sky {
 /// A PNG's linear RGB texels (see [`read_image`]) from `r`, its bytes; `path` names it in
 /// errors (a file, or a glTF file's image).
 pub(crate) fn read_png(
-    r: impl std::io::Read,
+    mut r: impl std::io::Read,
     path: &std::path::Path,
 ) -> crate::Result<(usize, usize, Texels)> {
+    use std::io::Read;
     let bad = |m: String| crate::Error::image(path, m, None);
     const TEXEL: u64 = 12;
-    let mut decoder = png::Decoder::new(r);
-    decoder.set_transformations(png::Transformations::EXPAND);
-    let mut reader = decoder
-        .read_info()
+    // The signature and the header's size, kept: where the decoder's own limits refuse the
+    // header ("limits are exceeded"), the size it claims is said instead.
+    let mut head = Vec::with_capacity(24);
+    (&mut r)
+        .take(24)
+        .read_to_end(&mut head)
         .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
+    let mut decoder = png::Decoder::new(std::io::Cursor::new(head.clone()).chain(r));
+    decoder.set_transformations(png::Transformations::EXPAND);
+    let mut reader = decoder.read_info().map_err(|e| {
+        let claimed = (head.len() == 24 && &head[12..16] == b"IHDR").then(|| {
+            let word = |at: usize| {
+                u32::from_be_bytes([head[at], head[at + 1], head[at + 2], head[at + 3]])
+            };
+            (word(16) as usize, word(20) as usize)
+        });
+        match (e, claimed) {
+            (png::DecodingError::LimitsExceeded, Some((w, h))) => {
+                fits(path, w, h, TEXEL).err().unwrap_or_else(|| {
+                    bad(format!(
+                        "not a readable PNG: {w}x{h} is beyond its decoder's limits"
+                    ))
+                })
+            }
+            (e, _) => bad(format!("not a readable PNG: {e}")),
+        }
+    })?;
     let (w, h) = (reader.info().width as usize, reader.info().height as usize);
     let n = (w as u64 * h as u64).max(1);
     fits(path, w, h, TEXEL + reader.output_buffer_size() as u64 / n)?;

@@ -226,6 +226,34 @@ fn an_image_wraps_a_sphere_by_longitude_and_latitude() {
     // A mesh cannot take an image yet; an image that is not one is refused.
     d.file("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n");
     d.file("junk.png", "not a png");
+    // A PNG whose header claims 2^30 pixels a side (its decoder's limits refused it as
+    // "limits are exceeded", from the fifth trial): its size is said.
+    let chunk = |kind: &[u8], data: &[u8]| {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        c.extend_from_slice(kind);
+        c.extend_from_slice(data);
+        // PNG's CRC-32 over the kind and the data, bit by bit.
+        let mut crc = !0u32;
+        for &byte in kind.iter().chain(data) {
+            crc ^= u32::from(byte);
+            for _ in 0..8 {
+                crc = if crc & 1 == 1 {
+                    (crc >> 1) ^ 0xEDB8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        c.extend_from_slice(&(!crc).to_be_bytes());
+        c
+    };
+    let mut huge = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = (1u32 << 30).to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&(1u32 << 30).to_be_bytes());
+    ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
+    huge.extend(chunk(b"IHDR", &ihdr));
+    huge.extend(chunk(b"IDAT", &[0; 16]));
+    std::fs::write(d.0.join("huge.png"), huge).unwrap();
     for (from, to, needles) in [
         (
             "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1",
@@ -236,6 +264,14 @@ fn an_image_wraps_a_sphere_by_longitude_and_latitude() {
             "image = \"map.png\"",
             "image = \"junk.png\"",
             &["junk.png", "not a readable PNG"][..],
+        ),
+        (
+            "image = \"map.png\"",
+            "image = \"huge.png\"",
+            &[
+                "huge.png",
+                "it is 1073741824x1073741824; a texture has 1 to 2^28 texels",
+            ][..],
         ),
         (
             "image = \"map.png\"",
