@@ -447,10 +447,14 @@ pub(super) fn run_render(args: &RenderArgs) -> crate::Result<()> {
 }
 
 pub(super) fn run_assemble(output: &Path, tiles: &[PathBuf]) -> crate::Result<()> {
-    if output::Format::for_path(output).map_err(|e| e.on_flag("-o"))? != output::Format::Exr {
+    // A name of no image format is asked for as an EXR, the one assemble writes.
+    if !matches!(output::Format::for_path(output), Ok(output::Format::Exr)) {
         return Err(Error::flag(
             "-o",
-            "the assembled image is an EXR: give a .exr",
+            format!(
+                "`{}`: the assembled image is an EXR: give a name ending in .exr",
+                output.display()
+            ),
         ));
     }
     if tiles.iter().any(|t| same_file(t, output)) {

@@ -49,6 +49,15 @@ fn assembled_tiles_are_the_whole_render() {
     assert!(!ok && err.contains("uncovered"), "{err}");
     let (ok, err) = run(&["assemble", "-o", s(&bad), s(&tiles[0]), s(&tiles[0])]);
     assert!(!ok && err.contains("overlaps"), "{err}");
+    // An output that is no EXR, a folder or a PNG, is asked for as the EXR assemble writes
+    // (a folder was told ".exr or .png", from the fifth trial).
+    for out in [d.0.clone(), d.0.join("joined.png")] {
+        let (ok, err) = run(&["assemble", "-o", s(&out), s(&tiles[0]), s(&tiles[1])]);
+        assert!(
+            !ok && err.contains("the assembled image is an EXR: give a name ending in .exr"),
+            "{err}"
+        );
+    }
     // A tile of another render (another view time) among them is refused.
     let other = d.0.join("other.exr");
     render(
