@@ -188,6 +188,18 @@ fn script(
 
 fn slurm(args: &SlurmArgs) -> crate::Result<()> {
     let (scene, plan) = Plan::new(args)?;
+    // A file the scene reads is no output, as render refuses it: here before anything is
+    // submitted (a tiled still's is written by the assembly, which does not know the scene).
+    match &scene.film {
+        Some(f) if args.tiles.is_none() => {
+            let pattern = film::FramePattern::parse(&args.output)?;
+            let (first, last) = film::frame_range(f, args.frames)?;
+            for k in first..=last {
+                super::render_cmd::not_an_input(&scene, &pattern.path(k), &format!("frame {k}"))?;
+            }
+        }
+        _ => super::render_cmd::not_an_input(&scene, &args.output, "the output")?,
+    }
     let jobs = match (&scene.film, args.tiles) {
         (Some(f), None) => plan.film_jobs(f, args)?,
         (_, grid) => plan.image_jobs(&scene, grid, args)?,
@@ -450,8 +462,9 @@ fn directives(
             ));
         }
         // sbatch's command line outranks the script's own --array: every task would render
-        // the same frame or tile.
-        if a.starts_with("--array") || a.starts_with("-a") {
+        // the same frame or tile. (getopt takes any prefix of --array from --ar on.)
+        let long = a.split('=').next().unwrap_or(a);
+        if a.starts_with("-a") || long.len() >= 4 && "--array".starts_with(long) {
             return Err(Error::flag(
                 "--sbatch-arg",
                 format!(
@@ -498,8 +511,14 @@ fn directives(
     Ok(out)
 }
 
-/// Whether sbatch's --mem takes `v`: digits, then at most one of its units.
+/// Whether sbatch's --mem takes `v`: digits, then at most one of its units, which may end in
+/// B (8G, 8GB).
 fn slurm_size(v: &str) -> bool {
+    let unit = |s: &str| s.ends_with(['K', 'M', 'G', 'T', 'k', 'm', 'g', 't']);
+    let v = match v.strip_suffix(['B', 'b']) {
+        Some(rest) if unit(rest) => rest,
+        _ => v,
+    };
     let digits = v.trim_end_matches(['K', 'M', 'G', 'T', 'k', 'm', 'g', 't']);
     v.len() - digits.len() <= 1 && !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
 }

@@ -186,7 +186,7 @@ pub(crate) fn key_part(name: &str) -> String {
 
 /// A `--set` key's parts, split at the dots outside quotes, each with whether it was quoted
 /// (`"..."` or `'...'`, taken as written); None for an unclosed quote.
-fn key_parts(key: &str) -> Option<Vec<(String, bool)>> {
+pub(crate) fn key_parts(key: &str) -> Option<Vec<(String, bool)>> {
     let mut parts = vec![(String::new(), false)];
     let mut quote: Option<char> = None;
     for c in key.chars() {

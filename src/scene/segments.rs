@@ -189,7 +189,15 @@ pub(crate) fn read(t: &Table, dir_key: &str, whose: Whose) -> SceneResult<Option
     let line = Worldline::new(Event::ORIGIN, &segments);
     for (i, (segment, s)) in segments.iter().zip(&tables).enumerate() {
         if let (Motion::Accelerated(_), Some(u)) = (segment.motion, segment.until) {
-            let rapidity = line.velocity(u).rapidity();
+            // The accelerated piece's own velocity at its end (at `u` the worldline is already
+            // in the next piece, which may give a velocity of its own).
+            let rapidity = line
+                .pieces
+                .iter()
+                .zip(&line.spans)
+                .find(|(p, span)| matches!(p, Piece::Accelerated(_)) && span.1 == u)
+                .map_or_else(|| line.velocity(u), |(p, _)| p.velocity_at(u))
+                .rapidity();
             if rapidity.is_nan() || rapidity > super::envelope::MAX_RAPIDITY {
                 return Err(s.error(
                     "acceleration",

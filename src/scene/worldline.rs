@@ -44,7 +44,7 @@ impl Piece {
         }
     }
 
-    fn velocity_at(&self, t: f64) -> Velocity {
+    pub(super) fn velocity_at(&self, t: f64) -> Velocity {
         match self {
             Piece::Uniform { velocity, .. } => *velocity,
             Piece::Accelerated(h) => h.velocity(h.theta_at(t)),

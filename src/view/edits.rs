@@ -322,7 +322,10 @@ pub(crate) fn with_overrides(
         let value: toml_edit::Value = raw
             .parse()
             .unwrap_or_else(|_| toml_edit::Value::from(raw.to_string()));
-        let segs: Vec<&str> = key.trim().split('.').collect();
+        // Split as the loader splits it: at the dots outside quotes (`group."Cube.001"`).
+        let parts = crate::scene::doc::key_parts(key.trim())
+            .ok_or_else(|| refuse!("{shown}: a quote in the key is not closed"))?;
+        let segs: Vec<&str> = parts.iter().map(|(s, _)| s.as_str()).collect();
         let lost = || refuse!("{shown}: the file has no place for `{}`", key.trim());
         let mut table: &mut dyn toml_edit::TableLike = doc.as_table_mut();
         let mut i = 0;
@@ -452,6 +455,14 @@ mod tests {
             why.contains("--set group.nothing") && why.contains("nothing"),
             "{why}"
         );
+        // A name with dots, in quotes, as the loader reads it (it was split at its dot here).
+        let dotted = SCENE.replace("\"lattice\"", "\"Cube.001\"");
+        let over = sets(&["group.\"Cube.001\".velocity=[0.3, 0, 0]"]);
+        let text = with_overrides(&dotted, "v.toml", &over).unwrap();
+        let a = crate::scene::load_str("v.toml", &dotted, &over).unwrap();
+        let b = crate::scene::load_str("v.toml", &text, &[]).unwrap();
+        assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        assert!((b.groups[0].velocity.beta() - 0.3).abs() < 1e-12, "{text}");
     }
 
     #[test]

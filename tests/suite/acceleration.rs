@@ -446,6 +446,10 @@ fn bad_accelerations_name_the_key() {
             "by its end (world time 1000000000), beyond the speeds rest-embree renders correctly: rapidity up to 20.0",
         ),
         (
+            base("worldline = [{ until = 0, velocity = [0, 0, 0] }, { until = 1e9, acceleration = [0.4, 0, 0] }, { velocity = [0, 0, 0] }]", sphere),
+            "worldline.1.acceleration`: segment 2 reaches rapidity",
+        ),
+        (
             base("worldline = [{ until = 5, velocity = [0.5, 0, 0] }, { until = 9, velocity = [0, 0, 0] }]", sphere),
             "test.toml:6: key `group.ball.worldline.1.until`: the last segment lasts for ever, so it has no end at 9",
         ),

@@ -203,8 +203,16 @@ fn bad_farms_are_clear_errors() {
             "--mem: `abc` is no value sbatch takes",
         ),
         (
-            vec![s(&still), "-o", "x.exr", "--mem", "8GB"],
+            vec![s(&still), "-o", "x.exr", "--mem", "8GiB"],
             "K, M, G or T",
+        ),
+        (
+            vec![s(&still), "-o", "x.exr", "--mem", "8B"],
+            "K, M, G or T",
+        ),
+        (
+            vec![s(&still), "-o", "x.exr", "--sbatch-arg=--arr=0-3"],
+            "the farm makes the job array itself",
         ),
         (
             vec![s(&still), "-o", "x.exr", "--time", "abc"],
@@ -224,6 +232,28 @@ fn bad_farms_are_clear_errors() {
         let (code, err) = status(&all);
         assert_eq!(code, Some(1), "{all:?}: {err}");
         assert!(err.contains(needle), "{all:?}: {err}");
+    }
+    // A file the scene reads as the output, of a still, a tiled still (written by the
+    // assembly) or a film's frame: refused before anything is submitted (from a review).
+    let map = d.0.join("map.exr");
+    render(&["render", s(&still), "-o", s(&map), "-q"]);
+    let sky = d.file("sky.toml", &format!("{GOOD}\n[sky]\nmap = \"map.exr\"\n"));
+    std::fs::copy(&map, d.0.join("m-01.exr")).unwrap();
+    let sky_film = d.file(
+        "sky-film.toml",
+        &format!("{GOOD}\n[sky]\nmap = \"m-01.exr\"\n[film]\nstart = 9.0\nend = 10.0\nfps = 2\n"),
+    );
+    let frames = d.0.join("m-##.exr");
+    for args in [
+        vec![s(&sky), "-o", s(&map), "--dry-run"],
+        vec![s(&sky), "-o", s(&map), "--tiles", "2x1", "--dry-run"],
+        vec![s(&sky_film), "-o", s(&frames), "--dry-run"],
+    ] {
+        let mut all = vec!["farm", "slurm"];
+        all.extend(args);
+        let (code, err) = status(&all);
+        assert_eq!(code, Some(1), "{all:?}: {err}");
+        assert!(err.contains("which the scene reads"), "{all:?}: {err}");
     }
     // Without sbatch on PATH: an error that says so (a PATH with nothing on it).
     let out = Command::new(env!("CARGO_BIN_EXE_rest-embree"))
@@ -322,6 +352,8 @@ fn bad_farms_are_clear_errors() {
         ("0", "90"),
         ("512", "90:30"),
         ("8g", "1-12"),
+        ("16GB", "45"),
+        ("512mb", "45"),
         ("1T", "2-0:30"),
         ("64M", "3-04:05:06"),
         ("2K", "UNLIMITED"),
