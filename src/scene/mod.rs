@@ -22,6 +22,7 @@ mod pass_set;
 mod procedural;
 mod reader;
 mod segments;
+mod set_forms;
 mod settings;
 mod shared_meshes;
 mod speed;
@@ -36,14 +37,15 @@ mod transform;
 mod worldline;
 
 pub use crate::error::SceneError;
+pub(crate) use load::load_file_as;
 pub use load::{load_file, load_str, FrameSize};
-pub(crate) use load::{load_file_as, superseded};
 pub(crate) use model::MAX_FRAME_PIXELS;
 pub use model::{
     Accelerated, Camera, Clock, Film, Fog, FrameSpacing, Group, ImageSettings, Integrator, Light,
     Material, Medium, ObjectInfo, Projection, RenderSettings, Scene,
 };
 pub use pass_set::{Pass, PassSet};
+pub(crate) use set_forms::superseded;
 pub use texture::{ImageTexture, Sample as TextureSample, Sky, Texture};
 pub use timing::Timing;
 pub use worldline::Worldline;

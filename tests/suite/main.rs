@@ -33,6 +33,7 @@ mod primitives;
 mod radar;
 mod relativity;
 mod scenes_load;
+mod set_keys;
 mod shading;
 mod shutter;
 mod sky;
